@@ -1,0 +1,133 @@
+"""Collision checking of robot states against the robot itself and the scene, with coal.
+
+One pinocchio GeometryModel holds the robot's URDF collision geometry, the
+world objects (on the universe joint) and attached objects (on their link's
+joint). Only pairs whose distance can change with the joints are checked per
+state; pairs that never move relative to each other are checked once, at
+construction. A batch of states is checked in one C++ call.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import coal
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from moveplan.core.errors import ConfigError, StartInCollision, UnknownName
+from moveplan.core.robot import Robot
+from moveplan.core.types import CollisionObject, Shape
+
+__all__ = ["CollisionChecker", "coal_geometry"]
+
+
+def coal_geometry(shape: Shape, source: str = "scene") -> coal.CollisionGeometry:
+    """Return the coal geometry of a scene shape (sizes in [m])."""
+    if shape.kind == "box":
+        return coal.Box(*shape.dims)
+    if shape.kind == "cylinder":
+        radius, length = shape.dims
+        return coal.Cylinder(radius, length)
+    if shape.kind == "sphere":
+        return coal.Sphere(shape.dims[0])
+    path = Path(shape.mesh_path)
+    if not path.is_file():
+        raise ConfigError(f"{source}: mesh file not found: {path}")
+    try:
+        return coal.MeshLoader().load(str(path), np.array(shape.scale, dtype=float))
+    except (RuntimeError, ValueError) as exc:
+        raise ConfigError(f"{source}: cannot read mesh {path}: {exc}") from None
+
+
+class CollisionChecker:
+    """Answers whether robot configurations collide, and which pair collides."""
+
+    def __init__(self, robot: Robot, objects: tuple[CollisionObject, ...] = (), source: str = "scene") -> None:
+        self.robot = robot
+        model = robot.model
+        config = robot.config
+        try:
+            geom = pin.buildGeomFromUrdf(
+                model, str(config.urdf_path), pin.GeometryType.COLLISION,
+                package_dirs=[str(p) for p in config.package_paths],
+            )
+        except (RuntimeError, ValueError, OSError) as exc:
+            raise ConfigError(f"{config.urdf_path}: cannot load collision geometry: {exc}") from None
+        owner = [str(model.frames[g.parentFrame].name) for g in geom.geometryObjects]
+        touch: list[frozenset[str]] = [frozenset() for _ in owner]
+        for obj in objects:
+            owner.append(obj.link or obj.name)
+            touch.append(frozenset((obj.link, *obj.touch_links)) if obj.link else frozenset())
+            geom.addGeometryObject(self._placed(obj, source))
+        self.owner = tuple(owner)
+        robot_count = len(owner) - len(objects)
+        joint_of = [g.parentJoint for g in geom.geometryObjects]
+        disabled = config.srdf.disabled_pairs
+        fixed_pairs: list[tuple[int, int]] = []
+        for i in range(len(owner)):
+            for j in range(i + 1, len(owner)):
+                a, b = owner[i], owner[j]
+                if a == b or frozenset((a, b)) in disabled:
+                    continue
+                if a in touch[j] or b in touch[i]:
+                    continue  # an attached object may touch its link and touch_links
+                if i >= robot_count and j >= robot_count and (joint_of[i] == 0 and joint_of[j] == 0):
+                    continue  # world objects never move relative to each other
+                if joint_of[i] == joint_of[j]:
+                    fixed_pairs.append((i, j))
+                else:
+                    geom.addCollisionPair(pin.CollisionPair(i, j))
+        self.geometry = geom
+        self.data = geom.createData()
+        self._pool = pin.GeometryPool(model, geom, 1)
+        self._check_fixed_pairs(fixed_pairs, robot_count)
+
+    def _placed(self, obj: CollisionObject, source: str) -> pin.GeometryObject:
+        model = self.robot.model
+        if obj.link:
+            if not model.existFrame(obj.link):
+                raise UnknownName("link", obj.link, f"{source}: attached object '{obj.name}'", self.robot.link_names)
+            frame = model.frames[model.getFrameId(obj.link)]
+            placement = frame.placement * pin.SE3(obj.transform)
+            return pin.GeometryObject(obj.name, frame.parentJoint, model.getFrameId(obj.link),
+                                      placement, coal_geometry(obj.shape, source))
+        return pin.GeometryObject(obj.name, 0, 0, pin.SE3(obj.transform), coal_geometry(obj.shape, source))
+
+    def _check_fixed_pairs(self, pairs: list[tuple[int, int]], robot_count: int) -> None:
+        """Raise StartInCollision if a pair that never moves is in contact (it would be, always)."""
+        pin.updateGeometryPlacements(self.robot.model, self.robot.data, self.geometry, self.data,
+                                     self.robot.neutral())
+        request = coal.CollisionRequest()
+        for i, j in pairs:
+            if i < robot_count and j < robot_count:
+                continue  # links on one joint are rigidly attached: their contact is by design
+            result = coal.CollisionResult()
+            a, b = self.geometry.geometryObjects[i], self.geometry.geometryObjects[j]
+            if coal.collide(a.geometry, coal.Transform3s(self.data.oMg[i]), b.geometry,
+                            coal.Transform3s(self.data.oMg[j]), request, result):
+                raise StartInCollision((self.owner[i], self.owner[j]), where="every state")
+
+    def in_collision(self, q: NDArray[np.float64]) -> bool:
+        """Return True if configuration `q` collides."""
+        return bool(pin.computeCollisions(self.robot.model, self.robot.data, self.geometry, self.data, q, True))
+
+    def colliding_pair(self, q: NDArray[np.float64]) -> tuple[str, str] | None:
+        """Return the names of the first colliding pair in configuration `q`, or None."""
+        if not self.in_collision(q):
+            return None
+        for k, result in enumerate(self.data.collisionResults):
+            if result.isCollision():
+                pair = self.geometry.collisionPairs[k]
+                return self.owner[pair.first], self.owner[pair.second]
+        return None  # pragma: no cover - computeCollisions said there was one
+
+    def free_batch(self, q: NDArray[np.float64], stop_at_first: bool = False) -> NDArray[np.bool_]:
+        """Return, for configurations of shape (nq, k), which are collision-free.
+
+        With `stop_at_first`, checking ends at the first colliding state; states after it
+        read as free, so only `all()` of the answer is meaningful.
+        """
+        hits = pin.computeCollisionsInParallel(1, self._pool, np.asfortranarray(q), True, stop_at_first)
+        return ~np.asarray(hits, dtype=bool)

@@ -1,0 +1,487 @@
+"""MCAP I/O: plans written as ROS 2 bags, plans and summaries of any MCAP file read back.
+
+The only module that imports mcap and mcap_ros2. Plan files follow DESIGN section 6 and
+rosbag2's own layout, so `ros2 bag`, Foxglove and rosbags open them: profile ros2,
+ros2msg schemas, CDR messages, QoS in channel metadata, a "rosbag2" metadata record,
+statistics, chunk and message indexes, CRCs.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import struct
+from collections import Counter
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from functools import cache
+from importlib.metadata import version
+from pathlib import Path
+from typing import IO, Any
+
+import zstandard
+from mcap.exceptions import EndOfFile, McapError
+from mcap.opcode import Opcode
+from mcap.reader import SeekingReader
+from mcap.records import Attachment, Channel, Header, McapRecord, Message, Metadata, Schema
+from mcap.stream_reader import MAGIC_SIZE, StreamReader
+from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
+
+# Private module: mcap_ros2's public Writer cannot set channel metadata (no QoS, so nothing
+# is latched on playback); serialize_dynamic is the encoder behind it, built from schema text.
+from mcap_ros2._dynamic import serialize_dynamic
+from mcap_ros2.decoder import DecoderFactory
+
+from moveplan.core import ros_messages as msgs
+from moveplan.core.errors import InputError
+from moveplan.core.types import JointTrajectory, Plan
+
+__all__ = [
+    "BagSummary",
+    "PlanFile",
+    "PlanStepRecord",
+    "TopicSummary",
+    "read_plan",
+    "summarize",
+    "write_plan",
+]
+
+_TRAJECTORY = "/planned_trajectory"
+# topic -> (message type, latched). Latched topics are offered transient_local, so a late
+# subscriber (RViz, robot_state_publisher) still gets them from `ros2 bag play`. The
+# trajectory stays volatile: a controller that joins late must not receive a stale step.
+_TOPICS: dict[str, tuple[str, bool]] = {
+    "/robot_description": ("std_msgs/msg/String", True),
+    "/tf_static": ("tf2_msgs/msg/TFMessage", True),
+    "/planning_scene_markers": ("visualization_msgs/msg/MarkerArray", True),
+    "/display_planned_path": ("moveit_msgs/msg/DisplayTrajectory", True),
+    _TRAJECTORY: ("trajectory_msgs/msg/JointTrajectory", False),
+    "/tf": ("tf2_msgs/msg/TFMessage", False),
+}
+_PLAN_KEYS = ("robot_name", "group", "planning_frame", "step_names", "limits", "distro")
+_MEDIA_TYPES = {".urdf": "application/xml", ".srdf": "application/xml", ".yaml": "application/yaml"}
+_MAGIC = b"\x89MCAP0\r\n"
+# What mcap and the decompressors raise on a damaged file (lz4 raises RuntimeError).
+_DAMAGE = (McapError, EOFError, ValueError, struct.error, RuntimeError, zstandard.ZstdError)
+
+
+@dataclass(frozen=True)
+class PlanStepRecord:
+    """One step read back from a plan file: name, start on the plan's timeline in [s], motion."""
+
+    name: str
+    start_s: float
+    trajectory: JointTrajectory
+
+
+@dataclass(frozen=True)
+class PlanFile:
+    """A plan read back from an MCAP file: its steps plus what execute and checks need."""
+
+    robot_name: str
+    group: str
+    planning_frame: str
+    distro: str
+    steps: tuple[PlanStepRecord, ...]
+    attachments: dict[str, bytes]
+    metadata: dict[str, str]
+    limits: dict[str, dict[str, float]]
+
+
+@dataclass(frozen=True)
+class TopicSummary:
+    """One channel: topic, type, message encoding, count, offered durability ("" if unknown)."""
+
+    topic: str
+    type: str
+    encoding: str
+    count: int
+    qos_durability: str
+
+
+@dataclass(frozen=True)
+class BagSummary:
+    """What `moveplan inspect` shows of an MCAP file; times are log times in [ns]."""
+
+    profile: str
+    library: str
+    start_ns: int
+    end_ns: int
+    duration_s: float
+    topics: tuple[TopicSummary, ...]
+    metadata: tuple[str, ...]
+    attachments: tuple[str, ...]
+
+
+def write_plan(path: Path, plan: Plan, distro: str = "jazzy") -> None:
+    """Write `plan` to `path` as a ROS 2 bag for `distro`, atomically; return None.
+
+    Raises:
+        UsageError: `distro` has no shipped message definitions.
+        InputError: `path` cannot be written.
+
+    """
+    schemas = {msgtype: msgs.schema_text(msgtype, distro) for msgtype, _ in _TOPICS.values()}
+    messages = _plan_messages(plan)
+    metadata = {
+        **plan.metadata,
+        "robot_name": plan.robot_name,
+        "group": plan.group,
+        "planning_frame": plan.planning_frame,
+        "step_names": json.dumps([step.name for step in plan.steps]),
+        "limits": json.dumps(plan.limits, sort_keys=True),
+        "distro": distro,
+    }
+    with _atomic_writer(path) as writer:
+        schema_ids: dict[str, int] = {}
+        channel_ids: dict[str, int] = {}
+        for topic in dict.fromkeys(topic for topic, _, _ in messages):
+            msgtype, latched = _TOPICS[topic]
+            if msgtype not in schema_ids:
+                schema_ids[msgtype] = writer.register_schema(msgtype, "ros2msg", schemas[msgtype])
+            qos = {"offered_qos_profiles": msgs.offered_qos_profiles(latched)}
+            channel_ids[topic] = writer.register_channel(topic, "cdr", schema_ids[msgtype], qos)
+        for topic, log_time_ns, message in messages:
+            msgtype = _TOPICS[topic][0]
+            data = _encoder(msgtype, schemas[msgtype])(message)
+            writer.add_message(channel_ids[topic], log_time_ns, data, publish_time=log_time_ns)
+        writer.add_metadata("rosbag2", {"ROS_DISTRO": distro})
+        writer.add_metadata("moveplan", metadata)
+        for name, content in plan.attachments.items():
+            media_type = _MEDIA_TYPES.get(Path(name).suffix.lower(), "application/octet-stream")
+            writer.add_attachment(0, 0, name, media_type, content)
+
+
+def read_plan(path: Path) -> PlanFile:
+    """Return the plan stored in the moveplan MCAP file at `path`.
+
+    Raises:
+        InputError: The file is missing, not MCAP, truncated, corrupt or not a moveplan plan.
+
+    """
+    with _open_mcap(path) as stream:
+        contents = _scan(path, stream, keep_topic=_TRAJECTORY)
+    info = next((m.metadata for m in contents.metadata if m.name == "moveplan"), {})
+    if any(key not in info for key in _PLAN_KEYS):
+        raise InputError(f"{path}: not a moveplan plan file (no complete 'moveplan' metadata)")
+    try:
+        step_names = [str(name) for name in json.loads(info["step_names"])]
+        limits = {
+            joint: {key: float(value) for key, value in joint_limits.items()}
+            for joint, joint_limits in json.loads(info["limits"]).items()
+        }
+    except (ValueError, TypeError, AttributeError) as exc:
+        raise InputError(f"{path}: 'moveplan' metadata is malformed: {exc}") from exc
+    if len(contents.kept) != len(step_names):
+        raise InputError(
+            f"{path}: {len(contents.kept)} messages on {_TRAJECTORY} "
+            f"but {len(step_names)} step names in its metadata"
+        )
+    factory = DecoderFactory()
+    steps = []
+    for name, (channel, schema, message) in zip(step_names, contents.kept, strict=True):
+        decode = factory.decoder_for(channel.message_encoding, schema)
+        if decode is None or schema is None or schema.name != _TOPICS[_TRAJECTORY][0]:
+            raise InputError(
+                f"{path}: {_TRAJECTORY} must hold CDR trajectory_msgs/msg/JointTrajectory "
+                "messages with a ros2msg schema"
+            )
+        try:
+            trajectory = msgs.trajectory_from_message(decode(message.data))
+        except (*_DAMAGE, TypeError, IndexError, AttributeError) as exc:
+            raise InputError(
+                f"{path}: step '{name}' on {_TRAJECTORY} is unreadable: {exc}"
+            ) from exc
+        steps.append(PlanStepRecord(name, message.log_time / 1e9, trajectory))
+    return PlanFile(
+        robot_name=info["robot_name"],
+        group=info["group"],
+        planning_frame=info["planning_frame"],
+        distro=info["distro"],
+        steps=tuple(steps),
+        attachments={attachment.name: attachment.data for attachment in contents.attachments},
+        metadata={key: value for key, value in info.items() if key not in _PLAN_KEYS},
+        limits=limits,
+    )
+
+
+def summarize(path: Path) -> BagSummary:
+    """Return profile, topics, counts, time range, metadata and attachment names of an MCAP file.
+
+    Uses the summary section's statistics when present, else counts in one linear pass.
+
+    Raises:
+        InputError: The file is missing, not MCAP, truncated or corrupt.
+
+    """
+    with _open_mcap(path) as stream:
+        indexed = _summary_from_index(stream)
+        if indexed is not None:
+            return indexed
+        contents = _scan(path, stream, keep_topic=None)
+    return _bag_summary(
+        contents.header or Header(profile="", library=""),
+        contents.start_ns,
+        contents.end_ns,
+        [
+            (channel, contents.schemas.get(channel.schema_id), contents.counts[channel.id])
+            for channel in contents.channels.values()
+        ],
+        tuple(record.name for record in contents.metadata),
+        tuple(record.name for record in contents.attachments),
+    )
+
+
+# --- writing -------------------------------------------------------------------------------------
+
+
+@contextmanager
+def _atomic_writer(path: Path) -> Iterator[Writer]:
+    """Yield a started mcap Writer on a temporary file beside `path`; finish, then rename.
+
+    On any error the temporary file is removed: `path` is either untouched or complete.
+    """
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    library = f"moveplan {version('moveplan')}; {LIBRARY_IDENTIFIER}"
+    try:
+        # open(mode "x"), not tempfile: the output gets the user's umask permissions.
+        with temporary.open("xb") as stream:
+            writer = Writer(stream, compression=CompressionType.ZSTD, enable_data_crcs=True)
+            writer.start(profile="ros2", library=library)
+            yield writer
+            writer.finish()  # type: ignore[no-untyped-call]  # mcap leaves it unannotated
+        temporary.replace(path)
+    except BaseException as exc:
+        temporary.unlink(missing_ok=True)
+        if isinstance(exc, OSError):
+            raise InputError(f"{path}: cannot write: {exc.strerror or exc}") from exc
+        raise
+
+
+def _plan_messages(plan: Plan) -> list[tuple[str, int, dict[str, Any]]]:
+    """Return (topic, log time [ns], message) for every message of `plan`, in log-time order."""
+    if not plan.steps:
+        raise ValueError("a plan needs at least one step")
+    frame = plan.planning_frame
+    trajectories = [step.trajectory for step in plan.steps]
+    statics = plan.static_frames
+    messages = [
+        ("/robot_description", 0, msgs.string(plan.urdf)),
+        (
+            "/tf_static",
+            0,
+            msgs.tf_message(
+                [f.parent for f in statics],
+                [f.name for f in statics],
+                [f.transform for f in statics],
+                stamp_ns=0,
+            ),
+        ),
+        ("/planning_scene_markers", 0, msgs.marker_array(plan.objects, frame)),
+        ("/display_planned_path", 0, msgs.display_trajectory(plan.robot_name, trajectories, frame)),
+    ]
+    # Starts add up integer durations, so a step starts exactly where the previous one's
+    # last time_from_start ends.
+    start_ns = 0
+    for trajectory in trajectories:
+        messages.append((_TRAJECTORY, start_ns, msgs.joint_trajectory(trajectory, frame)))
+        start_ns += msgs.seconds_to_ns(trajectory.duration_s)
+    if plan.tf is not None:
+        tf = plan.tf
+        for time_s, transforms in zip(tf.times_s, tf.transforms, strict=True):
+            stamp_ns = msgs.seconds_to_ns(float(time_s))
+            message = msgs.tf_message(tf.parents, tf.children, list(transforms), stamp_ns)
+            messages.append(("/tf", stamp_ns, message))
+    # A stable sort: messages logged at the same time keep the order above.
+    return sorted(messages, key=lambda item: item[1])
+
+
+@cache
+def _encoder(msgtype: str, schema_text: bytes) -> Callable[[dict[str, Any]], bytes]:
+    """Return the CDR encoder of `msgtype` built from its schema text (cached: building is slow)."""
+    encoders = serialize_dynamic(msgtype, schema_text.decode())
+    return encoders[msgtype]
+
+
+# --- reading -------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class _Contents:
+    """What a linear pass over an MCAP file found; `kept` holds one topic's messages."""
+
+    header: Header | None
+    schemas: dict[int, Schema]
+    channels: dict[int, Channel]
+    counts: Counter[int]
+    start_ns: int
+    end_ns: int
+    metadata: tuple[Metadata, ...]
+    attachments: tuple[Attachment, ...]
+    kept: tuple[tuple[Channel, Schema | None, Message], ...]
+
+
+@contextmanager
+def _open_mcap(path: Path) -> Iterator[IO[bytes]]:
+    """Yield `path` opened for reading, after checking that it starts like an MCAP file."""
+    try:
+        stream = path.open("rb")
+    except FileNotFoundError:
+        raise InputError(f"{path}: file not found") from None
+    except IsADirectoryError:
+        raise InputError(f"{path}: is a folder; give the .mcap file inside it") from None
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror or exc}") from exc
+    with stream:
+        if stream.read(MAGIC_SIZE) != _MAGIC:
+            raise InputError(f"{path}: not an MCAP file (it does not start with the MCAP magic)")
+        yield stream
+
+
+def _summary_from_index(stream: IO[bytes]) -> BagSummary | None:
+    """Return the summary from the file's summary section, or None where that is incomplete."""
+    stream.seek(0)
+    try:
+        reader = SeekingReader(stream)
+        header = reader.get_header()
+        summary = reader.get_summary()
+    except (*_DAMAGE, OSError):
+        return None  # no readable footer (unfinished or damaged): left to the linear pass
+    if summary is None or summary.statistics is None:
+        return None
+    stats = summary.statistics
+    if stats.metadata_count != len(summary.metadata_indexes):
+        return None
+    if stats.attachment_count != len(summary.attachment_indexes):
+        return None
+    return _bag_summary(
+        header,
+        stats.message_start_time if stats.message_count else 0,
+        stats.message_end_time if stats.message_count else 0,
+        [
+            (
+                channel,
+                summary.schemas.get(channel.schema_id),
+                stats.channel_message_counts.get(channel.id, 0),
+            )
+            for channel in summary.channels.values()
+        ],
+        tuple(index.name for index in summary.metadata_indexes),
+        tuple(index.name for index in summary.attachment_indexes),
+    )
+
+
+def _scan(path: Path, stream: IO[bytes], keep_topic: str | None) -> _Contents:
+    """Return the contents of an MCAP file read record by record, keeping `keep_topic`'s messages.
+
+    A file that stops on a record boundary without a footer (its writer never finished)
+    is read as far as it goes; one that stops inside a record is truncated.
+    """
+    header = None
+    schemas: dict[int, Schema] = {}
+    channels: dict[int, Channel] = {}
+    counts: Counter[int] = Counter()
+    times: list[int] = []
+    metadata: list[Metadata] = []
+    attachments: list[Attachment] = []
+    kept: list[tuple[Channel, Schema | None, Message]] = []
+    for record in _records(path, stream):
+        if isinstance(record, Header):
+            header = record
+        elif isinstance(record, Schema):
+            schemas[record.id] = record
+        elif isinstance(record, Channel):
+            channels[record.id] = record
+        elif isinstance(record, Message):
+            channel = channels.get(record.channel_id)
+            if channel is None:
+                raise InputError(f"{path}: a message uses undefined channel {record.channel_id}")
+            counts[record.channel_id] += 1
+            times.append(record.log_time)
+            if channel.topic == keep_topic:
+                kept.append((channel, schemas.get(channel.schema_id), record))
+        elif isinstance(record, Metadata):
+            metadata.append(record)
+        elif isinstance(record, Attachment):
+            attachments.append(record)
+    return _Contents(
+        header=header,
+        schemas=schemas,
+        channels=channels,
+        counts=counts,
+        start_ns=min(times, default=0),
+        end_ns=max(times, default=0),
+        metadata=tuple(metadata),
+        attachments=tuple(attachments),
+        kept=tuple(sorted(kept, key=lambda item: item[2].log_time)),
+    )
+
+
+def _records(path: Path, stream: IO[bytes]) -> Iterator[McapRecord]:
+    """Yield every record of an MCAP file in file order, chunks opened and CRCs checked."""
+    stream.seek(0)
+    records = StreamReader(stream, validate_crcs=True).records
+    while True:
+        try:
+            record = next(records)
+        except StopIteration:
+            return
+        except _DAMAGE as exc:
+            cut = _cut_record(stream)
+            if cut is None and isinstance(exc, EndOfFile):
+                return
+            if cut is not None:
+                message = f"file is truncated (the record at byte {cut} runs past its end)"
+            else:
+                message = f"corrupt MCAP data: {type(exc).__name__}: {exc}".removesuffix(": ")
+            raise InputError(f"{path}: {message}") from exc
+        yield record
+
+
+def _cut_record(stream: IO[bytes]) -> int | None:
+    """Return the offset of the first record that runs past the end of the file, or None."""
+    size = stream.seek(0, os.SEEK_END)
+    offset = MAGIC_SIZE
+    while offset < size:
+        stream.seek(offset)
+        head = stream.read(9)
+        if len(head) < 9:
+            return offset
+        opcode, length = struct.unpack("<BQ", head)
+        end = offset + 9 + length + (MAGIC_SIZE if opcode == Opcode.FOOTER else 0)
+        if end > size:
+            return offset
+        offset = end
+    return None
+
+
+def _bag_summary(
+    header: Header,
+    start_ns: int,
+    end_ns: int,
+    channels: list[tuple[Channel, Schema | None, int]],
+    metadata: tuple[str, ...],
+    attachments: tuple[str, ...],
+) -> BagSummary:
+    """Return a BagSummary of (channel, schema, message count) triples, sorted by topic."""
+    topics = [
+        TopicSummary(
+            topic=channel.topic,
+            type=schema.name if schema is not None else "",
+            encoding=channel.message_encoding,
+            count=count,
+            qos_durability=msgs.durability(channel.metadata.get("offered_qos_profiles", "")),
+        )
+        for channel, schema, count in channels
+    ]
+    return BagSummary(
+        profile=header.profile,
+        library=header.library,
+        start_ns=start_ns,
+        end_ns=end_ns,
+        duration_s=(end_ns - start_ns) / 1e9,
+        topics=tuple(sorted(topics, key=lambda topic: topic.topic)),
+        metadata=metadata,
+        attachments=attachments,
+    )

@@ -1,0 +1,184 @@
+"""Value types shared across core: trajectories, scene geometry and plans.
+
+Arrays are copied, shape-checked and made read-only on construction, so a value
+cannot change after it has been checked.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+import numpy.typing as npt
+from numpy.typing import NDArray
+
+__all__ = [
+    "CollisionObject",
+    "Frame",
+    "JointTrajectory",
+    "Plan",
+    "Shape",
+    "StepResult",
+    "TfSamples",
+    "frozen_array",
+]
+
+
+def frozen_array(value: npt.ArrayLike, shape: tuple[int | None, ...], name: str) -> NDArray[np.float64]:
+    """Return a read-only float64 copy of `value`, checked against `shape` (None = any size)."""
+    array = np.array(value, dtype=np.float64)
+    if array.ndim != len(shape) or any(
+        want is not None and got != want for got, want in zip(array.shape, shape, strict=True)
+    ):
+        raise ValueError(f"{name}: expected shape {shape}, got {array.shape}")
+    array.setflags(write=False)
+    return array
+
+
+@dataclass(frozen=True)
+class JointTrajectory:
+    """Timed joint trajectory, one row per point, like trajectory_msgs/JointTrajectory.
+
+    Attributes:
+        joint_names: Joint order of the columns.
+        times_s: Time from start of each point in [s], strictly increasing, first 0.
+        positions: Joint positions in [rad] or [m], shape (N, n).
+        velocities: In [rad]/[s], shape (N, n).
+        accelerations: In [rad]/[s]^2, shape (N, n).
+    """
+
+    joint_names: tuple[str, ...]
+    times_s: NDArray[np.float64]
+    positions: NDArray[np.float64]
+    velocities: NDArray[np.float64]
+    accelerations: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        n = len(self.joint_names)
+        times = frozen_array(self.times_s, (None,), "times_s")
+        count = len(times)
+        object.__setattr__(self, "joint_names", tuple(self.joint_names))
+        object.__setattr__(self, "times_s", times)
+        for name in ("positions", "velocities", "accelerations"):
+            object.__setattr__(self, name, frozen_array(getattr(self, name), (count, n), name))
+        if count == 0:
+            raise ValueError("a trajectory needs at least one point")
+        if np.any(np.diff(times) <= 0.0):
+            raise ValueError("trajectory times must be strictly increasing")
+
+    @property
+    def duration_s(self) -> float:
+        """Return the time of the last point in [s]."""
+        return float(self.times_s[-1])
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A static transform `parent_T_frame`, like one static_transform_publisher."""
+
+    name: str
+    parent: str
+    transform: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "transform", frozen_array(self.transform, (4, 4), "transform"))
+
+
+@dataclass(frozen=True)
+class Shape:
+    """Collision shape in its own frame, sizes in [m].
+
+    box: dims = (x, y, z) full sizes; cylinder: dims = (radius, length) along local z;
+    sphere: dims = (radius,); mesh: `mesh_path` with `scale` (sx, sy, sz).
+    """
+
+    kind: Literal["box", "cylinder", "sphere", "mesh"]
+    dims: tuple[float, ...] = ()
+    mesh_path: str = ""
+    scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
+
+
+@dataclass(frozen=True)
+class CollisionObject:
+    """A world collision object, placed in the planning frame (`planning_T_object`).
+
+    `link` is set for objects attached to a robot link; then `transform` is
+    `link_T_object` and `touch_links` may touch it.
+    """
+
+    name: str
+    shape: Shape
+    transform: NDArray[np.float64]
+    link: str = ""
+    touch_links: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "transform", frozen_array(self.transform, (4, 4), "transform"))
+
+
+@dataclass(frozen=True)
+class TfSamples:
+    """Poses of moving links along a plan, for /tf playback.
+
+    Attributes:
+        times_s: Sample times on the plan's timeline in [s], shape (M,).
+        parents: Parent frame of each transform, length L.
+        children: Child frame of each transform, length L.
+        transforms: `parent_T_child` per sample, shape (M, L, 4, 4).
+    """
+
+    times_s: NDArray[np.float64]
+    parents: tuple[str, ...]
+    children: tuple[str, ...]
+    transforms: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        times = frozen_array(self.times_s, (None,), "times_s")
+        object.__setattr__(self, "times_s", times)
+        shape = (len(times), len(self.children), 4, 4)
+        object.__setattr__(self, "transforms", frozen_array(self.transforms, shape, "transforms"))
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """One planned motion: its goal as requested, how it was planned, and its trajectory."""
+
+    name: str
+    goal: dict[str, Any]
+    planner: str
+    planning_time_s: float
+    trajectory: JointTrajectory
+    fraction: float = 1.0
+    residual: dict[str, float] | None = None
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A whole plan: steps in order plus everything needed to replay or check it.
+
+    Attributes:
+        robot_name: The robot's name (URDF / moveplan.yaml).
+        group: Planning group.
+        planning_frame: Root frame the scene and /tf are expressed in.
+        steps: Planned steps; each step's trajectory starts at time 0.
+        urdf: URDF text, written once to /robot_description.
+        static_frames: Static transforms for /tf_static (scene frames, fixed robot joints).
+        objects: Scene collision objects, for /planning_scene_markers.
+        tf: Moving-link poses along the whole plan, for /tf.
+        limits: Per joint, unscaled limits {"max_velocity": .., "max_acceleration": ..}.
+        attachments: Config files to embed, file name -> bytes (SRDF, joint limits, controllers ...).
+        metadata: Flat string map stored as MCAP metadata "moveplan" (seed, planner, version ...).
+    """
+
+    robot_name: str
+    group: str
+    planning_frame: str
+    steps: tuple[StepResult, ...]
+    urdf: str
+    static_frames: tuple[Frame, ...] = ()
+    objects: tuple[CollisionObject, ...] = ()
+    tf: TfSamples | None = None
+    limits: dict[str, dict[str, float]] = field(default_factory=dict)
+    attachments: dict[str, bytes] = field(default_factory=dict)
+    metadata: dict[str, str] = field(default_factory=dict)
