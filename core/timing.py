@@ -65,7 +65,7 @@ def time_parameterize(
     for _ in range(_ATTEMPTS):
         trajectory = _toppra(joint_names, path, max_velocity * velocity_margin,
                              max_acceleration * acceleration_margin, sample_period_s)
-        peak_v, peak_a = peak_rates(trajectory)
+        peak_v, peak_a = peak_rates(trajectory, per_segment=64)
         excess_v = float(np.max(peak_v / max_velocity))
         excess_a = float(np.max(peak_a / max_acceleration))
         if excess_v <= 1.0 and excess_a <= 1.0:
@@ -96,7 +96,7 @@ def _soft_ends(grid: NDArray[np.float64], sd: NDArray[np.float64], ramp_s: float
     for x, side in ((1.0 - grid, slice(-6, None)), (grid, slice(0, 6))):
         window = grid[side]
         decel = np.abs(np.diff(speed2[side])) / (2 * np.diff(window))
-        rate = float(np.max(decel)) * 0.9
+        rate = float(np.max(decel))
         if rate <= 0.0:
             continue
         delta = rate * ramp_s**2 / 12.0

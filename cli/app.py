@@ -1,0 +1,150 @@
+"""The `moveplan` command line: parse flags, make one core call, render, exit with the documented code.
+
+Heavy libraries (pinocchio, coal, ompl, toppra, mcap) are imported inside the
+commands, so `moveplan --help` stays fast.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from moveplan.cli.errors import exit_codes
+from moveplan.cli.parsing import parse_joints, parse_number, parse_scaling
+
+__all__ = ["app", "main"]
+
+app = typer.Typer(
+    name="moveplan",
+    help="MoveIt-style planning and ros2_control execution checks from one command line: files in, files out.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON document on stdout, nothing else.")]
+QuietOpt = Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")]
+VerboseOpt = Annotated[bool, typer.Option("--verbose", "-v", help="Log what happens to stderr.")]
+
+
+def _logging(verbose: bool, quiet: bool) -> None:
+    level = logging.DEBUG if verbose else logging.ERROR if quiet else logging.WARNING
+    logging.basicConfig(level=level, format="moveplan: %(levelname)s: %(message)s")
+    logging.getLogger("toppra").setLevel(max(level, logging.WARNING))
+
+
+@app.command()
+def plan(
+    task: Annotated[Path | None, typer.Argument(help="Task file (DESIGN section 4).", show_default=False)] = None,
+    output: Annotated[Path, typer.Option("--output", "-o", help="Plan file to write (.mcap).")] = Path("plan.mcap"),
+    robot: Annotated[Path | None, typer.Option(help="Robot config: a moveplan.yaml or a folder holding one.")] = None,
+    scene: Annotated[Path | None, typer.Option(help="Scene file: frames and collision objects.")] = None,
+    group: Annotated[str | None, typer.Option(help="Planning group (default: the config's).")] = None,
+    start_joints: Annotated[str | None, typer.Option(help="Start joint values, '0,-1.57,...' or 'joint=value'.")] = None,
+    start_named: Annotated[str | None, typer.Option(help="Start at an SRDF group_state.")] = None,
+    start_from: Annotated[Path | None, typer.Option(help="Start where a previous plan file ends.")] = None,
+    joints: Annotated[str | None, typer.Option(help="Joint goal: 'q1,...,qn' or 'elbow_joint=1.2,...'.")] = None,
+    named: Annotated[str | None, typer.Option(help="Goal: an SRDF group_state.")] = None,
+    planner: Annotated[str | None, typer.Option(help="OMPL geometric planner (default RRTConnect).")] = None,
+    planning_time: Annotated[str | None, typer.Option(help="Seconds the planner may search per step.")] = None,
+    seed: Annotated[int | None, typer.Option(min=0, help="Random seed: same seed, same plan.")] = None,
+    velocity_scaling: Annotated[str | None, typer.Option(help="Fraction of the velocity limits, in (0, 1].")] = None,
+    acceleration_scaling: Annotated[str | None, typer.Option(help="Fraction of the acceleration limits.")] = None,
+    package_path: Annotated[list[Path] | None, typer.Option(help="Folder searched for package:// URIs.")] = None,
+    ros_distro: Annotated[str, typer.Option(help="Message layout to write: jazzy or humble.")] = "jazzy",
+    as_json: JsonOpt = False,
+    quiet: QuietOpt = False,
+    verbose: VerboseOpt = False,
+) -> None:
+    """Plan collision-free, time-parameterised motions and write them to MCAP."""
+    _logging(verbose, quiet)
+    with exit_codes(as_json):
+        flags = _plan_flags(locals())
+        from moveplan.cli import render
+        from moveplan.core import pipeline, recording
+        from moveplan.core.tasks import load_task
+
+        request = pipeline.resolve_request(load_task(task) if task else None, flags)
+        result = pipeline.plan(request)
+        recording.write_plan(output, result, ros_distro)
+    render.plan_summary(result, output, as_json, quiet)
+
+
+def _plan_flags(args: dict[str, Any]) -> dict[str, Any]:
+    """Return the plan flags as typed values, None where not given."""
+    from moveplan.core.errors import UsageError
+    from moveplan.core.tasks import StepSpec
+
+    starts = [k for k in ("start_joints", "start_named", "start_from") if args[k] is not None]
+    goals = [k for k in ("joints", "named") if args[k] is not None]
+    if len(starts) > 1 or len(goals) > 1:
+        raise UsageError(f"give one start flag and one goal flag, got {', '.join('--' + k.replace('_', '-') for k in starts + goals)}")
+    start: dict[str, Any] = {}
+    if args["start_joints"] is not None:
+        start = parse_joints(args["start_joints"], "--start-joints")
+    elif args["start_named"] is not None:
+        start = {"named": args["start_named"]}
+    elif args["start_from"] is not None:
+        start = {"from": args["start_from"]}
+    steps = []
+    if args["joints"] is not None:
+        steps.append(StepSpec("goal", parse_joints(args["joints"], "--joints")))
+    elif args["named"] is not None:
+        steps.append(StepSpec(args["named"], {"named": args["named"]}))
+    planning_time = None
+    if args["planning_time"] is not None:
+        planning_time = parse_number(args["planning_time"], "--planning-time")
+        if planning_time <= 0:
+            raise UsageError(f"--planning-time: expected a positive number of seconds, got '{args['planning_time']}'")
+    return {
+        "robot": args["robot"], "scene": args["scene"], "group": args["group"], "start": start, "steps": steps,
+        "planner": args["planner"], "planning_time": planning_time, "seed": args["seed"],
+        "velocity_scaling": parse_scaling(args["velocity_scaling"], "--velocity-scaling"),
+        "acceleration_scaling": parse_scaling(args["acceleration_scaling"], "--acceleration-scaling"),
+        "package_paths": tuple(args["package_path"] or ()),
+    }
+
+
+@app.command("robot")
+def robot_info(
+    config: Annotated[Path, typer.Argument(help="Robot config: a moveplan.yaml or a folder holding one.")],
+    as_json: JsonOpt = False,
+    quiet: QuietOpt = False,
+) -> None:
+    """Show a robot config: groups, joints and limits with their sources, frames, named states, controllers."""
+    _logging(False, quiet)
+    with exit_codes(as_json):
+        from moveplan.cli import render
+        from moveplan.core.config import load_robot_config
+
+        loaded = load_robot_config(config)
+    render.robot_summary(loaded, as_json, quiet)
+
+
+@app.command()
+def inspect(
+    file: Annotated[Path, typer.Argument(help="Any MCAP file; plan files get a per-step summary.")],
+    as_json: JsonOpt = False,
+    quiet: QuietOpt = False,
+) -> None:
+    """Summarise an MCAP bag: topics, types, counts; for plans, each step's duration and peak rates."""
+    _logging(False, quiet)
+    with exit_codes(as_json):
+        from moveplan.cli import render
+        from moveplan.core import recording
+
+        summary = recording.summarize(file)
+        plan_file = recording.read_plan(file) if "moveplan" in summary.metadata else None
+    render.inspect_summary(file, summary, plan_file, as_json, quiet)
+
+
+def main() -> None:
+    """Run the moveplan command line."""
+    app()
+
+
+if __name__ == "__main__":
+    main()

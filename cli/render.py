@@ -1,0 +1,151 @@
+"""Render results: rich tables for people (on stderr when --json is not given), JSON for scripts."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+from moveplan.core.config import RobotConfig
+from moveplan.core.recording import BagSummary, PlanFile
+from moveplan.core.trajectory import peak_rates
+from moveplan.core.types import Plan
+
+__all__ = ["inspect_summary", "plan_summary", "robot_summary"]
+
+_console = Console()
+
+
+def _emit(document: dict[str, Any]) -> None:
+    print(json.dumps(document, indent=2))
+
+
+def plan_summary(plan: Plan, output: Path, as_json: bool, quiet: bool) -> None:
+    """Print what was planned: one row per step, or the plan JSON document."""
+    steps = [
+        {
+            "name": s.name, "status": "ok", "goal": s.goal, "planner": s.planner,
+            "planning_time_s": round(s.planning_time_s, 6), "duration_s": round(s.trajectory.duration_s, 6),
+            "fraction": s.fraction, "residual": s.residual, "points": len(s.trajectory.times_s),
+        }
+        for s in plan.steps
+    ]
+    if as_json:
+        _emit({"ok": True, "output": str(output), "robot": plan.robot_name, "group": plan.group,
+               "steps": steps, "error": None})
+        return
+    if quiet:
+        return
+    table = Table(title=f"{plan.robot_name} / {plan.group} -> {output}")
+    for column in ("step", "goal", "planner", "planning [ms]", "duration [s]", "points"):
+        table.add_column(column)
+    for s in steps:
+        table.add_row(s["name"], _short(s["goal"]), s["planner"], f"{1e3 * s['planning_time_s']:.1f}",
+                      f"{s['duration_s']:.3f}", str(s["points"]))
+    _console.print(table)
+
+
+def _short(goal: dict[str, Any]) -> str:
+    text = json.dumps(goal, separators=(",", ":"))
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
+    """Print a robot config: groups, joints with limits and sources, named states, frames, controllers."""
+    links = sorted({j.parent for j in config.urdf_joints.values()} | {j.child for j in config.urdf_joints.values()})
+    document = {
+        "name": config.name,
+        "groups": {n: {"joints": list(g.joints), "base": g.base, "tip": g.tip} for n, g in config.srdf.groups.items()},
+        "joints": {
+            n: {"lower": lim.lower, "upper": lim.upper, "max_velocity": lim.max_velocity,
+                "max_acceleration": None if np.isnan(lim.max_acceleration) else lim.max_acceleration,
+                "continuous": lim.continuous, "source": lim.source}
+            for n, lim in config.limits.items()
+        },
+        "named_states": {
+            group: {name: [values.get(j) for j in config.srdf.groups[group].joints] for name, values in states.items()}
+            for group, states in config.srdf.group_states.items()
+        },
+        "frames": links,
+        "default_scaling": {"velocity": config.default_velocity_scaling,
+                            "acceleration": config.default_acceleration_scaling},
+        "controllers": {
+            n: {"joints": list(c.joints), "update_rate": c.update_rate_hz,
+                "command_interfaces": list(c.command_interfaces), "state_interfaces": list(c.state_interfaces),
+                "constraints": {"goal_time": c.goal_time_s, "stopped_velocity_tolerance": c.stopped_velocity_tolerance,
+                                **{j: {"trajectory": c.trajectory_tolerance[j], "goal": c.goal_tolerance[j]}
+                                   for j in c.joints}}}
+            for n, c in config.controllers.items()
+        },
+        "initial_positions": config.initial_positions,
+    }
+    if as_json:
+        _emit(document)
+        return
+    if quiet:
+        return
+    _console.print(f"[bold]{config.name}[/bold]  ({config.root})")
+    for name, group in config.srdf.groups.items():
+        _console.print(f"group [bold]{name}[/bold]: {group.base} -> {group.tip}, joints {', '.join(group.joints)}")
+    joints = Table(title="joints")
+    for column in ("joint", "lower", "upper", "max vel", "max acc", "position from", "velocity from", "accel from"):
+        joints.add_column(column)
+    for name, lim in config.limits.items():
+        joints.add_row(name, f"{lim.lower:.4g}", f"{lim.upper:.4g}", f"{lim.max_velocity:.4g}",
+                       f"{lim.max_acceleration:.4g}", lim.source["position"], lim.source["velocity"],
+                       lim.source["acceleration"] or "[red]missing[/red]")
+    _console.print(joints)
+    for group, states in document["named_states"].items():
+        for name, values in states.items():
+            _console.print(f"named state {group}/{name}: {values}")
+    for name, controller in document["controllers"].items():
+        _console.print(f"controller {name} @ {controller['update_rate']:g} Hz: {controller['constraints']}")
+    _console.print(f"frames: {', '.join(links)}")
+
+
+def inspect_summary(path: Path, summary: BagSummary, plan: PlanFile | None, as_json: bool, quiet: bool) -> None:
+    """Print topics of any bag, and for a plan file each step's duration and peak rates."""
+    steps = []
+    if plan is not None:
+        for step in plan.steps:
+            peak_v, peak_a = peak_rates(step.trajectory)
+            names = step.trajectory.joint_names
+            v_limit = np.array([plan.limits[j]["max_velocity"] for j in names])
+            a_limit = np.array([plan.limits[j]["max_acceleration"] for j in names])
+            steps.append({
+                "name": step.name, "start_s": step.start_s, "duration_s": step.trajectory.duration_s,
+                "points": len(step.trajectory.times_s),
+                "peak_velocity_fraction": float(np.max(peak_v / v_limit)),
+                "peak_acceleration_fraction": float(np.max(peak_a / a_limit)),
+            })
+    document = {
+        "file": str(path), "profile": summary.profile, "library": summary.library,
+        "duration_s": summary.duration_s,
+        "topics": [{"topic": t.topic, "type": t.type, "encoding": t.encoding, "count": t.count,
+                    "durability": t.qos_durability} for t in summary.topics],
+        "metadata": list(summary.metadata), "attachments": list(summary.attachments),
+        "plan": None if plan is None else {"robot": plan.robot_name, "group": plan.group, "steps": steps},
+    }
+    if as_json:
+        _emit(document)
+        return
+    if quiet:
+        return
+    topics = Table(title=f"{path}  ({summary.profile}, {summary.duration_s:.3f} s)")
+    for column in ("topic", "type", "count", "durability"):
+        topics.add_column(column)
+    for t in summary.topics:
+        topics.add_row(t.topic, t.type, str(t.count), t.qos_durability)
+    _console.print(topics)
+    if steps:
+        table = Table(title=f"plan: {plan.robot_name if plan else ''}")
+        for column in ("step", "start [s]", "duration [s]", "points", "peak vel / limit", "peak acc / limit"):
+            table.add_column(column)
+        for s in steps:
+            table.add_row(s["name"], f"{s['start_s']:.3f}", f"{s['duration_s']:.3f}", str(s["points"]),
+                          f"{s['peak_velocity_fraction']:.2f}", f"{s['peak_acceleration_fraction']:.2f}")
+        _console.print(table)

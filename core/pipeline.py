@@ -1,0 +1,281 @@
+"""The plan pipeline: request -> robot, scene, start -> per step goal, path, timing -> Plan.
+
+Data flows one way; this module is the only one that composes planning,
+timing and recording. Precedence of settings lives in `resolve_request`:
+flag > task file > robot config > built-in default.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+from importlib.metadata import version
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from moveplan.core import recording
+from moveplan.core.collision import CollisionChecker
+from moveplan.core.config import RobotConfig, load_robot_config
+from moveplan.core.errors import ConfigError, GoalInCollision, PlanningFailed, StartInCollision, UsageError
+from moveplan.core.goals import check_limits, joint_target
+from moveplan.core.planning import interpolate, plan_path, seed_planner
+from moveplan.core.robot import Robot
+from moveplan.core.scene import Scene, empty_scene, load_scene
+from moveplan.core.tasks import StepSpec, TaskFile
+from moveplan.core.timing import time_parameterize
+from moveplan.core.trajectory import sample
+from moveplan.core.types import Frame, JointTrajectory, Plan, StepResult, TfSamples
+
+__all__ = ["PlanRequest", "plan", "resolve_request"]
+
+logger = logging.getLogger(__name__)
+
+# Planning checks edges every 0.01 rad; the timed trajectory is checked twice as finely.
+_PLAN_RESOLUTION = 0.01
+_CHECK_RESOLUTION = 0.005
+_TF_RATE_HZ = 30.0
+
+
+@dataclass(frozen=True)
+class PlanRequest:
+    """Everything one `moveplan plan` run needs, after precedence has been applied."""
+
+    robot: Path
+    steps: tuple[StepSpec, ...]
+    scene: Path | None = None
+    group: str | None = None
+    start: dict[str, Any] = field(default_factory=dict)
+    planner: str | None = None
+    planning_time: float | None = None
+    velocity_scaling: float | None = None
+    acceleration_scaling: float | None = None
+    seed: int = 0
+    package_paths: tuple[Path, ...] = ()
+    task: TaskFile | None = None
+
+
+def resolve_request(task: TaskFile | None, flags: dict[str, Any]) -> PlanRequest:
+    """Return the request that flags and task give together: a flag wins over the task."""
+    task_values: dict[str, Any] = {}
+    if task is not None:
+        task_values = {"robot": task.robot, "scene": task.scene, "group": task.group, "seed": task.seed,
+                       **task.defaults}
+    merged = {k: v for k, v in task_values.items() if v is not None}
+    merged.update({k: v for k, v in flags.items() if v is not None and k not in ("steps", "start")})
+    steps = tuple(flags.get("steps") or ())
+    if steps and task is not None and task.steps:
+        raise UsageError(f"{task.source} has steps; give a goal by flag or by task, not both")
+    if task is not None and not steps:
+        steps = task.steps
+    if not steps:
+        raise UsageError("no goal: give --joints, --named, or a task file with steps")
+    if "robot" not in merged:
+        raise UsageError("no robot: give --robot or a task file naming one")
+    start = flags.get("start") or (task.start if task is not None else {})
+    return PlanRequest(
+        robot=Path(merged["robot"]), steps=steps, scene=merged.get("scene"), group=merged.get("group"),
+        start=start, planner=merged.get("planner"), planning_time=merged.get("planning_time"),
+        velocity_scaling=merged.get("velocity_scaling"), acceleration_scaling=merged.get("acceleration_scaling"),
+        seed=int(merged.get("seed") or 0), package_paths=tuple(flags.get("package_paths") or ()), task=task,
+    )
+
+
+def plan(request: PlanRequest) -> Plan:
+    """Return the timed, collision-free plan for every step of `request`, in order."""
+    seed_planner(request.seed)
+    config = load_robot_config(request.robot, request.package_paths)
+    robot = Robot(config, request.group)
+    scene = load_scene(request.scene, robot) if request.scene else empty_scene()
+    checker = CollisionChecker(robot, scene.objects, scene.source)
+    base = robot.neutral()
+    current = _start_values(request, robot, base)
+    pair = checker.colliding_pair(robot.configuration(current, base))
+    if pair:
+        raise StartInCollision(pair)
+
+    steps: list[StepResult] = []
+    for spec in request.steps:
+        try:
+            step = _plan_step(spec, request, robot, checker, base, current)
+        except (PlanningFailed, StartInCollision, ConfigError) as exc:
+            raise _in_step(exc, spec.name) from None
+        steps.append(step)
+        current = step.trajectory.positions[-1].copy()
+    return Plan(
+        robot_name=config.name,
+        group=robot.group.name,
+        planning_frame=robot.root_link,
+        steps=tuple(steps),
+        urdf=config.urdf,
+        static_frames=_static_frames(robot, scene, base),
+        objects=scene.objects,
+        tf=_tf_samples(robot, base, steps),
+        limits={j: {"lower": float(robot.lower[i]), "upper": float(robot.upper[i]),
+                    "max_velocity": float(robot.max_velocity[i]),
+                    "max_acceleration": float(robot.max_acceleration[i])}
+                for i, j in enumerate(robot.joint_names)},
+        attachments=_attachments(config, request),
+        metadata={"seed": str(request.seed), "moveplan_version": version("moveplan"),
+                  "planners": ",".join(s.planner for s in steps)},
+    )
+
+
+def _in_step(exc: Exception, step: str) -> Exception:
+    """Return `exc` with the failing step's name in front of its message."""
+    exc.args = (f"step '{step}': {exc.args[0] if exc.args else exc}",)
+    return exc
+
+
+def _start_values(request: PlanRequest, robot: Robot, base: NDArray[np.float64]) -> NDArray[np.float64]:
+    start = request.start
+    neutral = robot.values(base)
+    if not start:
+        return neutral
+    if "from" in start:
+        last = recording.read_plan(Path(start["from"])).steps[-1].trajectory
+        values = dict(zip(last.joint_names, last.positions[-1], strict=True))
+        start = {"joints": {j: float(v) for j, v in values.items() if j in robot.joint_names}}
+    source = str(request.task.source) if request.task else "--start-joints"
+    values = joint_target(robot, start, neutral, source)
+    return values
+
+
+def _scaling(robot: Robot, request: PlanRequest, spec: StepSpec) -> tuple[float, float]:
+    config = robot.config
+    velocity = spec.velocity_scaling or request.velocity_scaling or config.default_velocity_scaling
+    acceleration = spec.acceleration_scaling or request.acceleration_scaling or config.default_acceleration_scaling
+    return velocity, acceleration
+
+
+def _plan_step(
+    spec: StepSpec,
+    request: PlanRequest,
+    robot: Robot,
+    checker: CollisionChecker,
+    base: NDArray[np.float64],
+    start: NDArray[np.float64],
+) -> StepResult:
+    began = time.perf_counter()
+    source = str(request.task.source) if request.task else "--joints"
+    goal = joint_target(robot, spec.goal, start, source)
+    pair = checker.colliding_pair(robot.configuration(goal, base))
+    if pair:
+        raise GoalInCollision(pair)
+    missing = [j for i, j in enumerate(robot.joint_names) if not np.isfinite(robot.max_acceleration[i])]
+    if missing:
+        raise ConfigError(f"{robot.config.root}: no acceleration limit for joints {', '.join(missing)} "
+                          "(joint_limits.yaml: has_acceleration_limits, max_acceleration)")
+
+    def free_batch(values: NDArray[np.float64]) -> NDArray[np.bool_]:
+        return checker.free_batch(robot.configurations(values, base))
+
+    planner = spec.planner or request.planner or robot.config.planning["planner"]
+    planning_time = spec.planning_time or request.planning_time or robot.config.planning["planning_time"]
+    path = plan_path(start, goal, robot.lower, robot.upper, free_batch, planner, planning_time, _PLAN_RESOLUTION)
+    v_scale, a_scale = _scaling(robot, request, spec)
+    trajectory = _timed_and_checked(robot, path.waypoints, v_scale, a_scale, free_batch, checker, base)
+    check_limits(robot, trajectory.positions.max(axis=0))
+    check_limits(robot, trajectory.positions.min(axis=0))
+    return StepResult(
+        name=spec.name,
+        goal=_describe(spec.goal),
+        planner=planner,
+        planning_time_s=time.perf_counter() - began,
+        trajectory=trajectory,
+        residual={"joints_rad": float(np.max(np.abs(trajectory.positions[-1] - goal)))},
+    )
+
+
+def _timed_and_checked(
+    robot: Robot,
+    waypoints: NDArray[np.float64],
+    v_scale: float,
+    a_scale: float,
+    free_batch: Any,
+    checker: CollisionChecker,
+    base: NDArray[np.float64],
+) -> JointTrajectory:
+    """Return the timed trajectory, checked for collisions as the controller interpolates it."""
+    for max_step in (0.05, 0.01):
+        trajectory = time_parameterize(
+            robot.joint_names, waypoints, robot.max_velocity * v_scale, robot.max_acceleration * a_scale,
+            max_step=max_step,
+        )
+        states = _dense_states(trajectory)
+        free = free_batch(states)
+        if free.all():
+            return trajectory
+        logger.debug("timed trajectory leaves the checked path at step %.3f rad; resampling", max_step)
+    bad = states[int(np.argmin(free))]
+    pair = checker.colliding_pair(robot.configuration(bad, base)) or ("?", "?")
+    raise PlanningFailed(f"the timed trajectory collides ({pair[0]} touches {pair[1]}) where the path did not")
+
+
+def _dense_states(trajectory: JointTrajectory) -> NDArray[np.float64]:
+    """Return states along the interpolated trajectory no more than the check resolution apart."""
+    knots = trajectory.times_s
+    if len(knots) == 1:
+        return np.asarray(trajectory.positions)
+    step = np.max(np.abs(np.diff(trajectory.positions, axis=0)), axis=1)
+    times = [knots[:1]]
+    for k in range(len(knots) - 1):
+        # Quintic segments can bulge slightly past the chord: sample with a safety factor of 2.
+        count = max(1, int(np.ceil(2 * step[k] / _CHECK_RESOLUTION)))
+        times.append(knots[k] + (knots[k + 1] - knots[k]) * np.arange(1, count + 1) / count)
+    positions, _, _ = sample(trajectory, np.concatenate(times))
+    return positions
+
+
+def _describe(goal: dict[str, Any]) -> dict[str, Any]:
+    return {k: (dict(v) if isinstance(v, dict) else list(v) if isinstance(v, list | tuple) else v)
+            for k, v in goal.items()}
+
+
+def _static_frames(robot: Robot, scene: Scene, base: NDArray[np.float64]) -> tuple[Frame, ...]:
+    """Return scene frames plus the robot's fixed joints, as robot_state_publisher would latch them."""
+    pin.framesForwardKinematics(robot.model, robot.data, base)
+    fixed = []
+    for joint in robot.config.urdf_joints.values():
+        if joint.type == "fixed":
+            fixed.append(Frame(joint.child, joint.parent, _relative(robot, base, joint.parent, joint.child)))
+    return (*fixed, *scene.frames)
+
+
+def _relative(robot: Robot, q: NDArray[np.float64], parent: str, child: str) -> NDArray[np.float64]:
+    data = robot.data
+    model = robot.model
+    return np.array((data.oMf[model.getFrameId(parent)].inverse() * data.oMf[model.getFrameId(child)]).homogeneous)
+
+
+def _tf_samples(robot: Robot, base: NDArray[np.float64], steps: list[StepResult]) -> TfSamples:
+    """Return the moving joints' transforms along the whole plan, at a playback rate."""
+    moving = [j for j in robot.config.urdf_joints.values() if j.type != "fixed"]
+    times_all, rows = [], []
+    offset = 0.0
+    for step in steps:
+        trajectory = step.trajectory
+        count = max(2, int(np.ceil(trajectory.duration_s * _TF_RATE_HZ)) + 1)
+        times = np.linspace(0.0, trajectory.duration_s, count)
+        positions, _, _ = sample(trajectory, times)
+        for t, values in zip(times, positions, strict=True):
+            q = robot.configuration(values, base)
+            pin.framesForwardKinematics(robot.model, robot.data, q)
+            rows.append([_relative(robot, q, j.parent, j.child) for j in moving])
+            times_all.append(offset + t)
+        offset += trajectory.duration_s
+    return TfSamples(np.array(times_all), tuple(j.parent for j in moving), tuple(j.child for j in moving),
+                     np.array(rows).reshape(len(times_all), len(moving), 4, 4))
+
+
+def _attachments(config: RobotConfig, request: PlanRequest) -> dict[str, bytes]:
+    files = dict(config.files)
+    if request.scene is not None:
+        files[f"scene{Path(request.scene).suffix}"] = Path(request.scene).read_bytes()
+    if request.task is not None:
+        files["task.yaml"] = request.task.raw
+    return files

@@ -1,0 +1,148 @@
+"""Joint-space path planning with OMPL's geometric planners.
+
+The planner sees the group's joint values in a box of joint limits. Every edge
+it tries is checked by interpolating it at `resolution` and testing all those
+states in one batch call; the returned path is simplified with OMPL's own
+simplifier under the same checks.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from moveplan.core.errors import PlanningFailed, UsageError, known
+from moveplan.core.types import frozen_array
+
+__all__ = ["PLANNERS", "PathResult", "interpolate", "plan_path", "seed_planner"]
+
+logger = logging.getLogger(__name__)
+ou.setLogLevel(ou.LOG_ERROR)
+
+PLANNERS = tuple(
+    name for name in dir(og)
+    if name[0].isupper() and isinstance(getattr(og, name), type) and issubclass(getattr(og, name), ob.Planner)
+)
+
+FreeBatch = Callable[[NDArray[np.float64]], NDArray[np.bool_]]
+_seeded: list[int] = []
+
+
+def seed_planner(seed: int) -> None:
+    """Seed OMPL's process-wide random generator; it can only be seeded before first use."""
+    if _seeded:
+        if _seeded[0] != seed:
+            logger.warning("OMPL was already seeded with %d; seed %d is ignored", _seeded[0], seed)
+        return
+    ou.RNG.setSeed(seed + 1)  # OMPL refuses 0 as a seed
+    _seeded.append(seed)
+
+
+@dataclass(frozen=True)
+class PathResult:
+    """A collision-free joint-space path and how it was found.
+
+    Attributes:
+        waypoints: Path vertices, shape (K, dof), first = start, last = goal.
+        planner: The OMPL planner's name.
+        planning_s: Wall time of the search in [s].
+        simplify_s: Wall time of simplification in [s].
+    """
+
+    waypoints: NDArray[np.float64]
+    planner: str
+    planning_s: float
+    simplify_s: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "waypoints", frozen_array(self.waypoints, (None, None), "waypoints"))
+
+
+def interpolate(a: NDArray[np.float64], b: NDArray[np.float64], resolution: float) -> NDArray[np.float64]:
+    """Return states from `a` to `b` (both included), no joint moving more than `resolution` per step."""
+    count = max(1, int(np.ceil(np.max(np.abs(b - a)) / resolution)))
+    return a + (b - a) * (np.arange(count + 1) / count)[:, None]
+
+
+def plan_path(
+    start: NDArray[np.float64],
+    goal: NDArray[np.float64],
+    lower: NDArray[np.float64],
+    upper: NDArray[np.float64],
+    free_batch: FreeBatch,
+    planner: str = "RRTConnect",
+    time_s: float = 1.0,
+    resolution: float = 0.01,
+) -> PathResult:
+    """Return a collision-free path from `start` to `goal`, both given as group joint values.
+
+    `free_batch` answers, for states of shape (k, dof), which are collision-free.
+    Raises PlanningFailed when no path is found within `time_s` seconds.
+    """
+    if planner not in PLANNERS:
+        raise UsageError(f"unknown planner '{planner}'; OMPL geometric planners: {known(PLANNERS)}")
+    return _plan(start, goal, lower, upper, free_batch, planner, time_s, resolution)
+
+
+def _plan(
+    start: NDArray[np.float64],
+    goal: NDArray[np.float64],
+    lower: NDArray[np.float64],
+    upper: NDArray[np.float64],
+    free_batch: FreeBatch,
+    planner: str,
+    time_s: float,
+    resolution: float,
+) -> PathResult:
+    dof = len(start)
+    space = ob.RealVectorStateSpace(dof)
+    bounds = ob.RealVectorBounds(dof)
+    for i in range(dof):
+        bounds.setLow(i, float(lower[i]))
+        bounds.setHigh(i, float(upper[i]))
+    space.setBounds(bounds)
+    setup = og.SimpleSetup(space)
+
+    def values(state: ob.State) -> NDArray[np.float64]:
+        return np.array([state[i] for i in range(dof)])
+
+    setup.setStateValidityChecker(lambda state: bool(free_batch(values(state)[None, :])[0]))
+
+    class BatchMotionValidator(ob.MotionValidator):  # type: ignore[misc]
+        """Checks a whole edge in one batch call."""
+
+        def checkMotion(self, s1: ob.State, s2: ob.State, *rest: object) -> bool:  # noqa: N802 - OMPL's name
+            return bool(free_batch(interpolate(values(s1), values(s2), resolution)[1:]).all())
+
+    info = setup.getSpaceInformation()
+    info.setMotionValidator(BatchMotionValidator(info))
+    info.setStateValidityCheckingResolution(resolution / space.getMaximumExtent())
+    endpoints = []
+    for point in (start, goal):
+        state = space.allocState()
+        for i, value in enumerate(point):
+            state[i] = float(value)
+        endpoints.append(state)
+    setup.setStartAndGoalStates(endpoints[0], endpoints[1])
+    setup.setPlanner(getattr(og, planner)(info))
+
+    began = time.perf_counter()
+    status = setup.solve(ob.timedPlannerTerminationCondition(time_s))
+    planning_s = time.perf_counter() - began
+    if not setup.haveExactSolutionPath():
+        raise PlanningFailed(f"{planner} found no path in {time_s:g} s ({status})")
+    began = time.perf_counter()
+    setup.simplifySolution(max(time_s - planning_s, 0.05))
+    simplify_s = time.perf_counter() - began
+    path = setup.getSolutionPath()
+    waypoints = np.array([values(path.getState(k)) for k in range(path.getStateCount())])
+    waypoints[0], waypoints[-1] = start, goal
+    return PathResult(waypoints, planner, planning_s, simplify_s)

@@ -1,0 +1,42 @@
+"""Collision checking: self and scene, pair names, batch answers agree with single checks."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import TABLE_SCENE
+
+from moveplan.core.collision import CollisionChecker
+from moveplan.core.errors import StartInCollision
+from moveplan.core.robot import Robot
+from moveplan.core.scene import load_scene
+from moveplan.core.types import CollisionObject, Shape
+
+
+@pytest.fixture(scope="module")
+def checker(ur10e: Robot) -> CollisionChecker:
+    return CollisionChecker(ur10e, load_scene(TABLE_SCENE, ur10e).objects)
+
+
+def test_named_states_are_free_and_arm_in_table_names_the_pair(checker: CollisionChecker, ur10e: Robot) -> None:
+    assert checker.colliding_pair(ur10e.configuration([0, -np.pi / 2, -np.pi / 2, 0, 0, 0])) is None
+    assert checker.colliding_pair(ur10e.configuration([0, 0.3, 0, 0, 0, 0])) == ("upper_arm_link", "table")
+
+
+def test_folded_elbow_collides_with_the_arm_itself(checker: CollisionChecker, ur10e: Robot) -> None:
+    pair = checker.colliding_pair(ur10e.configuration([0, -np.pi / 2, 3.1, 0, 0, 0]))
+    assert pair is not None and "table" not in pair
+
+
+def test_batch_agrees_with_single_checks(checker: CollisionChecker, ur10e: Robot) -> None:
+    values = np.random.default_rng(0).uniform(ur10e.lower / 2, ur10e.upper / 2, (300, 6))
+    batch = checker.free_batch(ur10e.configurations(values))
+    single = [not checker.in_collision(ur10e.configuration(v)) for v in values]
+    assert batch.tolist() == single
+    assert 0 < batch.sum() < len(batch)
+
+
+def test_object_through_the_fixed_base_is_reported_once_at_load(ur10e: Robot) -> None:
+    post = CollisionObject("post", Shape("cylinder", (0.05, 1.0)), np.eye(4))
+    with pytest.raises(StartInCollision, match="post"):
+        CollisionChecker(ur10e, (post,))
