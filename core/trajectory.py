@@ -1,56 +1,112 @@
-"""Trajectory sampling as ros2_controllers' JointTrajectoryController interpolates it.
+"""Trajectory sampling as ros2_controllers' JointTrajectoryController (JTC) interpolates it.
 
-Between two points carrying positions, velocities and accelerations the
-controller uses a quintic polynomial per joint (joint_trajectory_controller
-trajectory.cpp, interpolation_method "splines"); after the last point it holds
-the last point. Sampling here is what the controller would command.
+Per segment, the spline degree follows the fields present at both ends
+(joint_trajectory_controller trajectory.cpp, interpolation_method "splines"):
+positions only give a linear segment, positions and velocities a cubic
+Hermite, all three a quintic. After the last point the controller holds the
+last point. Before the first point it blends from the state it read at its
+first sample ("point before") when the first point's time_from_start is > 0,
+and jumps to the first point when it is 0.
+
+Sample times are on the controller's timeline: 0 is the first sample, the
+trajectory's start (a MoveIt goal has header.stamp 0, "start now").
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from moveplan.core.types import JointTrajectory
+from moveplan.core.types import JointTrajectory, frozen_array
 
-__all__ = ["peak_rates", "sample"]
+__all__ = ["PointBefore", "peak_rates", "sample", "shortest_angular_distance"]
+
+Samples = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+
+
+@dataclass(frozen=True)
+class PointBefore:
+    """The state the controller read at its first sample, which it blends from to the first point.
+
+    Attributes:
+        positions: Joint positions in [rad] or [m], shape (n,).
+        velocities: In [rad]/[s], or None when the controller has no velocity state interface.
+        accelerations: In [rad]/[s]^2, or None without an acceleration state interface.
+    """
+
+    positions: NDArray[np.float64]
+    velocities: NDArray[np.float64] | None = None
+    accelerations: NDArray[np.float64] | None = None
+
+    def __post_init__(self) -> None:
+        positions = frozen_array(self.positions, (None,), "positions")
+        object.__setattr__(self, "positions", positions)
+        for name in ("velocities", "accelerations"):
+            if getattr(self, name) is not None:
+                value = frozen_array(getattr(self, name), positions.shape, name)
+                object.__setattr__(self, name, value)
+
+
+def shortest_angular_distance(
+    from_rad: npt.ArrayLike, to_rad: npt.ArrayLike
+) -> NDArray[np.float64]:
+    """Return `to - from` in [rad] wrapped into (-pi, pi], as angles::shortest_angular_distance."""
+    difference = np.asarray(to_rad, dtype=np.float64) - np.asarray(from_rad, dtype=np.float64)
+    wrapped = np.fmod(difference + np.pi, 2.0 * np.pi)
+    return np.where(wrapped <= 0.0, wrapped + np.pi, wrapped - np.pi)
 
 
 def sample(
-    trajectory: JointTrajectory, times_s: npt.ArrayLike
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """Return positions, velocities and accelerations, each (len(times), n), at `times_s`.
+    trajectory: JointTrajectory,
+    times_s: npt.ArrayLike,
+    *,
+    has_velocities: bool = True,
+    has_accelerations: bool = True,
+    point_before: PointBefore | None = None,
+    continuous: npt.ArrayLike | None = None,
+) -> Samples:
+    """Return positions, velocities and accelerations, each (len(times), n), at `times_s` in [s].
 
-    Times before the first point give the first point; after the last, the last point
-    with zero velocity and acceleration, as the controller holds it.
+    At and after the last point's time the last point is held, with its own velocities and
+    accelerations (0 where absent), as JTC holds it.
+
+    Args:
+        trajectory: The trajectory as sent to the controller.
+        times_s: Sample times on the controller's timeline in [s].
+        has_velocities: False if the points carry no velocities (an empty field in the message).
+        has_accelerations: False if the points carry no accelerations.
+        point_before: The state the controller read at its first sample (time 0), blended
+            from if the first point's time is > 0; without it, times before the first point
+            give the first point.
+        continuous: Per joint, True for URDF continuous joints: the point before is shifted by
+            whole turns towards the first point (JTC `wraparound_joint`).
     """
-    t = np.atleast_1d(np.asarray(times_s, dtype=float))
     knots = trajectory.times_s
-    p, v, a = trajectory.positions, trajectory.velocities, trajectory.accelerations
-    if len(knots) == 1:
-        return (np.repeat(p[:1], len(t), 0), np.zeros((len(t), p.shape[1])), np.zeros((len(t), p.shape[1])))
-    seg = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, len(knots) - 2)
-    h = (knots[seg + 1] - knots[seg])[:, None]
-    p0, v0, a0 = p[seg], v[seg], a[seg]
-    p1, v1, a1 = p[seg + 1], v[seg + 1], a[seg + 1]
-    dp = p1 - p0
-    c3 = (20 * dp - (8 * v1 + 12 * v0) * h - (3 * a0 - a1) * h**2) / (2 * h**3)
-    c4 = (-30 * dp + (14 * v1 + 16 * v0) * h + (3 * a0 - 2 * a1) * h**2) / (2 * h**4)
-    c5 = (12 * dp - 6 * (v1 + v0) * h - (a0 - a1) * h**2) / (2 * h**5)
-    x = np.clip(t - knots[seg], 0.0, h[:, 0])[:, None]
-    pos = p0 + x * (v0 + x * (a0 / 2 + x * (c3 + x * (c4 + x * c5))))
-    vel = v0 + x * (a0 + x * (3 * c3 + x * (4 * c4 + x * 5 * c5)))
-    acc = a0 + x * (6 * c3 + x * (12 * c4 + x * 20 * c5))
-    after = t >= knots[-1]
-    pos[after], vel[after], acc[after] = p[-1], 0.0, 0.0
-    before = t < knots[0]
-    pos[before], vel[before], acc[before] = p[0], 0.0, 0.0
-    return pos, vel, acc
+    positions = trajectory.positions
+    count, n = positions.shape
+    velocities = trajectory.velocities if has_velocities else np.zeros((count, n))
+    accelerations = trajectory.accelerations if has_accelerations else np.zeros((count, n))
+    has_v = np.full(count, has_velocities)
+    has_a = np.full(count, has_velocities and has_accelerations)
+    if point_before is not None and knots[0] > 0.0:
+        start = _wraparound(point_before.positions, positions[0], continuous)
+        knots = np.concatenate(([0.0], knots))
+        positions = np.vstack((start, positions))
+        velocities = np.vstack((_or_zeros(point_before.velocities, n), velocities))
+        accelerations = np.vstack((_or_zeros(point_before.accelerations, n), accelerations))
+        has_v = np.concatenate(([point_before.velocities is not None], has_v))
+        has_a = np.concatenate(([point_before.accelerations is not None and has_v[0]], has_a))
+    t = np.atleast_1d(np.asarray(times_s, dtype=np.float64))
+    return _sample_points(knots, positions, velocities, accelerations, has_v, has_a, t)
 
 
-def peak_rates(trajectory: JointTrajectory, per_segment: int = 16) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Return per joint the largest |velocity| and |acceleration| along the interpolated trajectory."""
+def peak_rates(
+    trajectory: JointTrajectory, per_segment: int = 16
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Return per joint the largest |velocity| and |acceleration| along the interpolation."""
     knots = trajectory.times_s
     if len(knots) == 1:
         zeros = np.zeros(len(trajectory.joint_names))
@@ -59,3 +115,82 @@ def peak_rates(trajectory: JointTrajectory, per_segment: int = 16) -> tuple[NDAr
     times = (knots[:-1, None] + np.diff(knots)[:, None] * fractions[None, :]).ravel()
     _, vel, acc = sample(trajectory, np.append(times, knots[-1] - 1e-12))
     return np.abs(vel).max(axis=0), np.abs(acc).max(axis=0)
+
+
+def _or_zeros(values: NDArray[np.float64] | None, n: int) -> NDArray[np.float64]:
+    return np.zeros(n) if values is None else values
+
+
+def _wraparound(
+    start: NDArray[np.float64], first: NDArray[np.float64], continuous: npt.ArrayLike | None
+) -> NDArray[np.float64]:
+    """Return `start` with continuous joints moved by whole turns to lie nearest to `first`."""
+    if continuous is None:
+        return start
+    distance = shortest_angular_distance(start, first)
+    # At exactly half a turn, JTC resolves the tie towards the side the first point lies on.
+    tie = np.abs(np.abs(distance) - np.pi) < 1e-9
+    distance = np.where(tie, np.where(first > start, np.abs(distance), -np.abs(distance)), distance)
+    return np.where(np.asarray(continuous, dtype=bool), first - distance, start)
+
+
+def _sample_points(
+    knots: NDArray[np.float64],
+    p: NDArray[np.float64],
+    v: NDArray[np.float64],
+    a: NDArray[np.float64],
+    has_v: NDArray[np.bool_],
+    has_a: NDArray[np.bool_],
+    t: NDArray[np.float64],
+) -> Samples:
+    """Return samples of the spline through the points; `has_v`/`has_a`: fields each point has."""
+    count, n = p.shape
+    if count == 1:
+        return _hold(p[0], v[0], a[0], len(t))
+    seg = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, count - 2)
+    c0, c1, c2, c3, c4, c5 = _coefficients(knots, p, v, a, has_v, has_a)[:, seg]
+    h = (knots[seg + 1] - knots[seg])[:, None]
+    x = np.clip(t[:, None] - knots[seg][:, None], 0.0, h)
+    pos = c0 + x * (c1 + x * (c2 + x * (c3 + x * (c4 + x * c5))))
+    vel = c1 + x * (2 * c2 + x * (3 * c3 + x * (4 * c4 + x * 5 * c5)))
+    acc = 2 * c2 + x * (6 * c3 + x * (12 * c4 + x * 20 * c5))
+    after = t >= knots[-1]
+    pos[after], vel[after], acc[after] = p[-1], v[-1], a[-1]
+    before = t < knots[0]
+    pos[before], vel[before], acc[before] = p[0], 0.0, 0.0
+    return pos, vel, acc
+
+
+def _hold(
+    p: NDArray[np.float64], v: NDArray[np.float64], a: NDArray[np.float64], count: int
+) -> Samples:
+    return np.tile(p, (count, 1)), np.tile(v, (count, 1)), np.tile(a, (count, 1))
+
+
+def _coefficients(
+    knots: NDArray[np.float64],
+    p: NDArray[np.float64],
+    v: NDArray[np.float64],
+    a: NDArray[np.float64],
+    has_v: NDArray[np.bool_],
+    has_a: NDArray[np.bool_],
+) -> NDArray[np.float64]:
+    """Return coefficients c0..c5 of powers of time per segment, shape (6, segments, n)."""
+    h = np.diff(knots)[:, None]
+    p0, v0, a0, p1, v1, a1 = p[:-1], v[:-1], a[:-1], p[1:], v[1:], a[1:]
+    dp = p1 - p0
+    cubic = (has_v[:-1] & has_v[1:])[:, None]
+    quintic = cubic & (has_a[:-1] & has_a[1:])[:, None]
+    zeros = np.zeros_like(p0)
+    c1 = np.where(cubic, v0, dp / h)
+    c2 = np.where(quintic, a0 / 2, np.where(cubic, (3 * dp - (2 * v0 + v1) * h) / h**2, zeros))
+    c3 = np.where(
+        quintic,
+        (20 * dp - (8 * v1 + 12 * v0) * h - (3 * a0 - a1) * h**2) / (2 * h**3),
+        np.where(cubic, (-2 * dp + (v0 + v1) * h) / h**3, zeros),
+    )
+    c4 = np.where(
+        quintic, (-30 * dp + (14 * v1 + 16 * v0) * h + (3 * a0 - 2 * a1) * h**2) / (2 * h**4), zeros
+    )
+    c5 = np.where(quintic, (12 * dp - 6 * (v1 + v0) * h - (a0 - a1) * h**2) / (2 * h**5), zeros)
+    return np.stack((p0, c1, c2, c3, c4, c5))
