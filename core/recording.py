@@ -20,6 +20,7 @@ from importlib.metadata import version
 from pathlib import Path
 from typing import IO, Any
 
+import numpy as np
 import zstandard
 from mcap.exceptions import EndOfFile, McapError
 from mcap.opcode import Opcode
@@ -123,7 +124,7 @@ def write_plan(path: Path, plan: Plan, distro: str = "jazzy") -> None:
 
     """
     schemas = {msgtype: msgs.schema_text(msgtype, distro) for msgtype, _ in _TOPICS.values()}
-    messages = _plan_messages(plan)
+    messages = _plan_messages(plan, schemas)
     metadata = {
         **plan.metadata,
         "robot_name": plan.robot_name,
@@ -142,9 +143,7 @@ def write_plan(path: Path, plan: Plan, distro: str = "jazzy") -> None:
                 schema_ids[msgtype] = writer.register_schema(msgtype, "ros2msg", schemas[msgtype])
             qos = {"offered_qos_profiles": msgs.offered_qos_profiles(latched)}
             channel_ids[topic] = writer.register_channel(topic, "cdr", schema_ids[msgtype], qos)
-        for topic, log_time_ns, message in messages:
-            msgtype = _TOPICS[topic][0]
-            data = _encoder(msgtype, schemas[msgtype])(message)
+        for topic, log_time_ns, data in messages:
             writer.add_message(channel_ids[topic], log_time_ns, data, publish_time=log_time_ns)
         writer.add_metadata("rosbag2", {"ROS_DISTRO": distro})
         writer.add_metadata("moveplan", metadata)
@@ -259,40 +258,52 @@ def _atomic_writer(path: Path) -> Iterator[Writer]:
         raise
 
 
-def _plan_messages(plan: Plan) -> list[tuple[str, int, dict[str, Any]]]:
-    """Return (topic, log time [ns], message) for every message of `plan`, in log-time order."""
+def _plan_messages(plan: Plan, schemas: dict[str, bytes]) -> list[tuple[str, int, bytes]]:
+    """Return (topic, log time [ns], CDR message) for every message of `plan`, in log-time order.
+
+    Trajectories and transforms take the fast `*_cdr` encoders; the two small messages
+    take the generic encoder built from `schemas` (message type -> schema text).
+    """
     if not plan.steps:
         raise ValueError("a plan needs at least one step")
+
+    def generic(topic: str, message: dict[str, Any]) -> bytes:
+        msgtype = _TOPICS[topic][0]
+        return _encoder(msgtype, schemas[msgtype])(message)
+
     frame = plan.planning_frame
     trajectories = [step.trajectory for step in plan.steps]
     statics = plan.static_frames
+    # reshape, not np.array alone: no static frames must still give shape (1, 0, 4, 4).
+    static_transforms = np.reshape([f.transform for f in statics], (1, len(statics), 4, 4))
+    [tf_static] = msgs.tf_messages_cdr(
+        [f.parent for f in statics], [f.name for f in statics], static_transforms, [0]
+    )
     messages = [
-        ("/robot_description", 0, msgs.string(plan.urdf)),
+        ("/robot_description", 0, generic("/robot_description", msgs.string(plan.urdf))),
+        ("/tf_static", 0, tf_static),
         (
-            "/tf_static",
+            "/planning_scene_markers",
             0,
-            msgs.tf_message(
-                [f.parent for f in statics],
-                [f.name for f in statics],
-                [f.transform for f in statics],
-                stamp_ns=0,
-            ),
+            generic("/planning_scene_markers", msgs.marker_array(plan.objects, frame)),
         ),
-        ("/planning_scene_markers", 0, msgs.marker_array(plan.objects, frame)),
-        ("/display_planned_path", 0, msgs.display_trajectory(plan.robot_name, trajectories, frame)),
+        (
+            "/display_planned_path",
+            0,
+            msgs.display_trajectory_cdr(plan.robot_name, trajectories, frame),
+        ),
     ]
     # Starts add up integer durations, so a step starts exactly where the previous one's
     # last time_from_start ends.
     start_ns = 0
     for trajectory in trajectories:
-        messages.append((_TRAJECTORY, start_ns, msgs.joint_trajectory(trajectory, frame)))
+        messages.append((_TRAJECTORY, start_ns, msgs.joint_trajectory_cdr(trajectory, frame)))
         start_ns += msgs.seconds_to_ns(trajectory.duration_s)
     if plan.tf is not None:
         tf = plan.tf
-        for time_s, transforms in zip(tf.times_s, tf.transforms, strict=True):
-            stamp_ns = msgs.seconds_to_ns(float(time_s))
-            message = msgs.tf_message(tf.parents, tf.children, list(transforms), stamp_ns)
-            messages.append(("/tf", stamp_ns, message))
+        stamps_ns = [msgs.seconds_to_ns(float(time_s)) for time_s in tf.times_s]
+        encoded = msgs.tf_messages_cdr(tf.parents, tf.children, tf.transforms, stamps_ns)
+        messages += [("/tf", stamp, data) for stamp, data in zip(stamps_ns, encoded, strict=True)]
     # A stable sort: messages logged at the same time keep the order above.
     return sorted(messages, key=lambda item: item[1])
 

@@ -1,8 +1,13 @@
-"""The ROS 2 side of plan files: shipped message definitions, QoS profiles, messages as dicts.
+"""The ROS 2 side of plan files: shipped message definitions, QoS profiles, messages.
 
 Messages are plain dicts for a schema-driven CDR encoder. Field names follow the .msg
 definitions in core/msgs; a field left out is written with its default (zero, empty or
 the definition's constant) by the encoder.
+
+The big, numerous messages (trajectories, /tf) also have `*_cdr` twins that write CDR
+bytes directly with bulk float packing: a generic encoder spends a Python call per float.
+Each twin writes exactly the bytes the generic encoder makes of its dict builder's message
+(the field layout is the same in every shipped distro; tests/test_recording.py checks both).
 """
 
 from __future__ import annotations
@@ -17,19 +22,23 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from moveplan.core.cdr import CdrWriter, patched_copies, time_array
 from moveplan.core.errors import UsageError, known
 from moveplan.core.types import CollisionObject, JointTrajectory
 
 __all__ = [
     "display_trajectory",
+    "display_trajectory_cdr",
     "durability",
     "joint_trajectory",
+    "joint_trajectory_cdr",
     "marker_array",
     "offered_qos_profiles",
     "schema_text",
     "seconds_to_ns",
     "string",
     "tf_message",
+    "tf_messages_cdr",
     "time_msg",
     "trajectory_from_message",
 ]
@@ -166,6 +175,74 @@ def tf_message(
     }
 
 
+def joint_trajectory_cdr(trajectory: JointTrajectory, frame_id: str) -> bytes:
+    """Return `joint_trajectory(trajectory, frame_id)` encoded as CDR."""
+    writer = CdrWriter()
+    _write_joint_trajectory(writer, trajectory, frame_id)
+    return writer.data()
+
+
+def display_trajectory_cdr(
+    robot_name: str, trajectories: Sequence[JointTrajectory], frame_id: str
+) -> bytes:
+    """Return `display_trajectory(robot_name, trajectories, frame_id)` encoded as CDR."""
+    writer = CdrWriter()
+    writer.string(robot_name)  # model_id
+    writer.uint32(len(trajectories))
+    for trajectory in trajectories:  # moveit_msgs/RobotTrajectory
+        _write_joint_trajectory(writer, trajectory, frame_id)
+        # An empty trajectory_msgs/MultiDOFJointTrajectory: header, joint_names[], points[].
+        writer.time(0)
+        writer.string("")
+        writer.uint32(0)
+        writer.uint32(0)
+    first = trajectories[0]
+    # trajectory_start, a moveit_msgs/RobotState; first its sensor_msgs/JointState.
+    writer.time(0)
+    writer.string(frame_id)
+    writer.strings(first.joint_names)
+    writer.float64_sequence(first.positions[0])
+    writer.float64_sequence(first.velocities[0])
+    writer.uint32(0)  # effort[]
+    # An empty sensor_msgs/MultiDOFJointState: header, then joint_names[], transforms[],
+    # twist[], wrench[].
+    writer.time(0)
+    writer.string("")
+    for _ in range(4):
+        writer.uint32(0)
+    writer.uint32(0)  # attached_collision_objects[]
+    writer.boolean(False)  # is_diff
+    return writer.data()
+
+
+def tf_messages_cdr(
+    parents: Sequence[str],
+    children: Sequence[str],
+    transforms: NDArray[np.float64],
+    stamps_ns: Sequence[int],
+) -> list[bytes]:
+    """Return one CDR `tf_message` per stamp; `transforms` has shape (stamps, children, 4, 4)."""
+    # The messages differ only in stamps and poses: one template written field by field,
+    # then copies of it patched in bulk (a plan has ~180 messages of ~7 transforms).
+    template = CdrWriter()
+    template.uint32(len(children))
+    stamp_at, pose_at = [], []
+    for parent, child in zip(parents, children, strict=True):
+        # geometry_msgs/TransformStamped: header, child_frame_id, then a Transform of
+        # translation xyz and rotation xyzw, seven float64 in a row.
+        stamp_at.append(template.time(0))
+        template.string(parent)
+        template.string(child)
+        pose_at.append(template.float64_array(np.zeros(7)))
+    poses = np.concatenate([transforms[..., :3, 3], _quaternions(transforms)], axis=-1)
+    poses = poses.astype("<f8", copy=False)
+    stamps = time_array(stamps_ns)
+    patches: list[tuple[int, NDArray[np.generic]]] = [(start, stamps) for start in stamp_at]
+    patches += [(start, poses[:, child]) for child, start in enumerate(pose_at)]
+    messages = patched_copies(template.data(), len(stamps), patches)
+    return [message.tobytes() for message in messages]
+
+
 def marker_array(objects: Sequence[CollisionObject], planning_frame: str) -> Message:
     """Return a visualization_msgs/MarkerArray with one marker per collision object."""
     return {"markers": [_marker(obj, index, planning_frame) for index, obj in enumerate(objects)]}
@@ -201,6 +278,38 @@ def _marker(obj: CollisionObject, marker_id: int, planning_frame: str) -> Messag
     }
 
 
+def _write_joint_trajectory(writer: CdrWriter, trajectory: JointTrajectory, frame_id: str) -> None:
+    """Write the fields of `joint_trajectory(trajectory, frame_id)` to `writer`; return None."""
+    writer.time(0)
+    writer.string(frame_id)
+    writer.strings(trajectory.joint_names)
+    times_ns = [seconds_to_ns(t) for t in trajectory.times_s.tolist()]
+    motion = (trajectory.positions, trajectory.velocities, trajectory.accelerations)
+    arrays = [values.astype("<f8", copy=False) for values in motion]
+
+    def write_point(i: int) -> list[int]:
+        """Write point `i`; return where its positions, velocities, accelerations, time start."""
+        indexes = [writer.float64_sequence(values[i]) for values in arrays]
+        writer.uint32(0)  # effort[]
+        return [*indexes, writer.time(times_ns[i])]
+
+    writer.uint32(len(times_ns))
+    write_point(0)
+    if len(times_ns) == 1:
+        return
+    # A point's padding depends on where it starts, mod 8, and the first may start
+    # anywhere. Every point ends at the same offset mod 8, though, so from the second on
+    # all points share one layout: the second is written field by field and the rest are
+    # copies of it with their own values (its size, a multiple of 8, keeps them aligned).
+    start = len(writer)
+    indexes = write_point(1)
+    template = writer.data()[start:]
+    assert len(template) % 8 == 0, len(template)
+    columns: list[NDArray[np.generic]] = [*arrays, time_array(times_ns)]
+    patches = [(index - start, column[2:]) for index, column in zip(indexes, columns, strict=True)]
+    writer.raw(patched_copies(template, len(times_ns) - 2, patches).tobytes())
+
+
 def _xyz(transform: NDArray[np.float64]) -> Message:
     x, y, z = transform[:3, 3].tolist()
     return {"x": x, "y": y, "z": z}
@@ -208,27 +317,36 @@ def _xyz(transform: NDArray[np.float64]) -> Message:
 
 def _quaternion(transform: NDArray[np.float64]) -> Message:
     """Return the rotation of a 4x4 transform as a unit quaternion with w >= 0."""
-    m = transform[:3, :3]
-    trace = m[0, 0] + m[1, 1] + m[2, 2]
-    # Shepperd's method: divide by the largest of the four candidates, for accuracy.
-    if trace > 0.0:
-        s = 2.0 * np.sqrt(1.0 + trace)
-        q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, s / 4]
-    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
-        s = 2.0 * np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
-        q = [s / 4, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s, (m[2, 1] - m[1, 2]) / s]
-    elif m[1, 1] > m[2, 2]:
-        s = 2.0 * np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
-        q = [(m[0, 1] + m[1, 0]) / s, s / 4, (m[1, 2] + m[2, 1]) / s, (m[0, 2] - m[2, 0]) / s]
-    else:
-        s = 2.0 * np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
-        q = [(m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, s / 4, (m[1, 0] - m[0, 1]) / s]
-    xyzw = np.array(q, dtype=np.float64)
-    xyzw /= np.linalg.norm(xyzw)
-    if xyzw[3] < 0.0:
-        xyzw = -xyzw
-    x, y, z, w = xyzw.tolist()
+    x, y, z, w = _quaternions(transform).tolist()
     return {"x": x, "y": y, "z": z, "w": w}
+
+
+def _quaternions(transforms: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Return the rotations of 4x4 transforms (..., 4, 4) as unit quaternions xyzw with w >= 0."""
+    (m00, m01, m02), (m10, m11, m12), (m20, m21, m22) = np.moveaxis(
+        transforms[..., :3, :3], (-2, -1), (0, 1)
+    )
+    trace = m00 + m11 + m22
+    # Shepperd's method: divide by the largest of the four candidates, for accuracy. All
+    # four are computed and one kept, so the others may divide by zero or take sqrt(< 0).
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = 2.0 * np.sqrt(1.0 + trace)
+        q0 = [(m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s, s / 4]
+        s = 2.0 * np.sqrt(1.0 + m00 - m11 - m22)
+        q1 = [s / 4, (m01 + m10) / s, (m02 + m20) / s, (m21 - m12) / s]
+        s = 2.0 * np.sqrt(1.0 + m11 - m00 - m22)
+        q2 = [(m01 + m10) / s, s / 4, (m12 + m21) / s, (m02 - m20) / s]
+        s = 2.0 * np.sqrt(1.0 + m22 - m00 - m11)
+        q3 = [(m02 + m20) / s, (m12 + m21) / s, s / 4, (m10 - m01) / s]
+    # np.select takes the first true condition, like an if/elif chain.
+    conditions = [trace > 0.0, (m00 > m11) & (m00 > m22), m11 > m22]
+    candidates = [np.stack(q, axis=-1) for q in (q0, q1, q2, q3)]
+    xyzw = np.select([c[..., None] for c in conditions], candidates[:3], candidates[3])
+    # The norm as a plain sum over the last axis, not BLAS: the same bits for one transform
+    # or many, whatever the machine.
+    xyzw /= np.linalg.norm(xyzw, axis=-1, keepdims=True)
+    result: NDArray[np.float64] = np.where(xyzw[..., 3:] < 0.0, -xyzw, xyzw)
+    return result
 
 
 def trajectory_from_message(message: Any) -> JointTrajectory:

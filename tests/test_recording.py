@@ -11,10 +11,13 @@ from typing import Any
 import mcap.writer
 import numpy as np
 import pytest
+from mcap.reader import make_reader
+from mcap_ros2._dynamic import serialize_dynamic
 from rosbags.highlevel import AnyReader
 from rosbags.interfaces import ConnectionExtRosbag2, QosDurability
 
 from moveplan.core import recording
+from moveplan.core import ros_messages as msgs
 from moveplan.core.errors import InputError, UsageError
 from moveplan.core.types import (
     CollisionObject,
@@ -36,6 +39,11 @@ TYPES = {
     "/display_planned_path": "moveit_msgs/msg/DisplayTrajectory",
     "/tf": "tf2_msgs/msg/TFMessage",
 }
+DISTROS = sorted(
+    entry.name
+    for entry in files("moveplan.core.msgs").iterdir()
+    if entry.is_dir() and entry.name.isalpha()
+)
 
 
 def transform(
@@ -566,3 +574,143 @@ def test_unknown_distro_raises_usage_error_listing_known_ones(tmp_path: Path, pl
     with pytest.raises(UsageError, match="rolling.*humble, jazzy"):
         recording.write_plan(tmp_path / "plan.mcap", plan, distro="rolling")
     assert list(tmp_path.iterdir()) == []
+
+
+# --- the fast CDR encoders write what the generic encoder writes ---------------------------------
+
+# Names of every length mod 8, so strings leave every possible padding before what follows.
+ODD_NAMES = ("j", "jo", "joi", "join", "joint", "joint_", "joint_1", "joint_12", "joint_123")
+
+
+def generic(msgtype: str, distro: str, message: dict[str, Any]) -> bytes:
+    """CDR of `message` from mcap_ros2's schema-driven encoder, the reference."""
+    schema = files("moveplan.core.msgs").joinpath(distro, msgtype.replace("/", "__") + ".msg")
+    return bytes(serialize_dynamic(msgtype, schema.read_text())[msgtype](message))
+
+
+def random_trajectory(names: tuple[str, ...], count: int, seed: int) -> JointTrajectory:
+    rng = np.random.default_rng(seed)
+    times = np.cumsum(rng.uniform(1e-3, 0.9, count)) - 1e-3  # some stamps past a second
+    times[0] = 0.0
+    shape = (count, len(names))
+    return JointTrajectory(
+        names, times, rng.normal(size=shape), rng.normal(size=shape), rng.normal(size=shape)
+    )
+
+
+def random_transforms(samples: int, count: int, seed: int) -> np.ndarray:
+    """Rotations about random axes plus half turns about x, y and z (each Shepperd branch)."""
+    rng = np.random.default_rng(seed)
+    result = np.empty((samples, count, 4, 4))
+    for index in np.ndindex(samples, count):
+        axis = [(1, 0, 0), (0, 1, 0), (0, 0, 1), tuple(rng.normal(size=3))][sum(index) % 4]
+        angle = np.pi if sum(index) % 4 < 3 else rng.uniform(-np.pi, np.pi)
+        unit = tuple(np.array(axis, dtype=float) / np.linalg.norm(axis))
+        result[index] = transform(tuple(rng.normal(size=3)), unit, angle)
+    return result
+
+
+@pytest.mark.parametrize("distro", DISTROS)
+@pytest.mark.parametrize("frame_id", ["", "w", "base_link", "odd_frame"])
+@pytest.mark.parametrize(
+    ("joints", "count"), [(2, 1), (1, 2), (3, 3), (6, 600), (7, 5), (9, 4), (0, 3)]
+)
+def test_fast_joint_trajectory_matches_the_generic_encoder(
+    distro: str, frame_id: str, joints: int, count: int
+) -> None:
+    trajectory = random_trajectory(ODD_NAMES[:joints], count, seed=joints * count)
+    message = msgs.joint_trajectory(trajectory, frame_id)
+    expected = generic("trajectory_msgs/msg/JointTrajectory", distro, message)
+    assert msgs.joint_trajectory_cdr(trajectory, frame_id) == expected
+
+
+@pytest.mark.parametrize("distro", DISTROS)
+@pytest.mark.parametrize("robot_name", ["ur10e", "arm", "twolink"])
+@pytest.mark.parametrize("counts", [[1], [587], [3, 1, 40], [2, 2]])
+def test_fast_display_trajectory_matches_the_generic_encoder(
+    distro: str, robot_name: str, counts: list[int]
+) -> None:
+    names = ODD_NAMES[1:7]
+    trajectories = [random_trajectory(names, count, seed) for seed, count in enumerate(counts)]
+    message = msgs.display_trajectory(robot_name, trajectories, "world")
+    expected = generic("moveit_msgs/msg/DisplayTrajectory", distro, message)
+    assert msgs.display_trajectory_cdr(robot_name, trajectories, "world") == expected
+
+
+@pytest.mark.parametrize("distro", DISTROS)
+@pytest.mark.parametrize(("samples", "count"), [(0, 3), (1, 0), (1, 1), (3, 7), (180, 7)])
+def test_fast_tf_messages_match_the_generic_encoder(distro: str, samples: int, count: int) -> None:
+    parents = tuple(ODD_NAMES[(i + 3) % len(ODD_NAMES)] for i in range(count))
+    children = tuple(ODD_NAMES[i % len(ODD_NAMES)] for i in range(count))
+    transforms = random_transforms(samples, count, seed=samples + count)
+    stamps_ns = [i * 987_654_321 for i in range(samples)]  # seconds and nanoseconds
+    encoded = msgs.tf_messages_cdr(parents, children, transforms, stamps_ns)
+    assert len(encoded) == samples
+    for data, sample, stamp_ns in zip(encoded, transforms, stamps_ns, strict=True):
+        message = msgs.tf_message(parents, children, list(sample), stamp_ns)
+        assert data == generic("tf2_msgs/msg/TFMessage", distro, message)
+
+
+@pytest.fixture
+def edge_plan(plan: Plan) -> Plan:
+    """Several steps of odd joint names, one of a single point, no /tf samples, no statics."""
+    names = ("a", "bcd", "efghi")
+    steps = tuple(
+        StepResult(f"step_{i}", {}, "RRTConnect", 0.01, random_trajectory(names, count, seed=i))
+        for i, count in enumerate([1, 5, 2, 30])
+    )
+    tf = TfSamples(np.zeros(0), ("odd",), ("frame",), np.zeros((0, 1, 4, 4)))
+    changes = {"steps": steps, "tf": tf, "planning_frame": "wor", "static_frames": ()}
+    return Plan(**{**vars(plan), **changes})
+
+
+@pytest.mark.parametrize("distro", DISTROS)
+@pytest.mark.parametrize("which", ["plan", "edge_plan"])
+def test_every_written_message_is_what_the_generic_encoder_writes(
+    tmp_path: Path, distro: str, which: str, request: pytest.FixtureRequest
+) -> None:
+    plan = request.getfixturevalue(which)
+    path = tmp_path / "plan.mcap"
+    recording.write_plan(path, plan, distro=distro)
+    frame, trajectories = plan.planning_frame, [step.trajectory for step in plan.steps]
+    statics = plan.static_frames
+    expected = {
+        "/robot_description": [msgs.string(plan.urdf)],
+        "/tf_static": [
+            msgs.tf_message(
+                [f.parent for f in statics],
+                [f.name for f in statics],
+                [f.transform for f in statics],
+                stamp_ns=0,
+            )
+        ],
+        "/planning_scene_markers": [msgs.marker_array(plan.objects, frame)],
+        "/display_planned_path": [msgs.display_trajectory(plan.robot_name, trajectories, frame)],
+        "/planned_trajectory": [msgs.joint_trajectory(t, frame) for t in trajectories],
+        "/tf": [
+            msgs.tf_message(
+                plan.tf.parents, plan.tf.children, list(sample), round(float(time_s) * 1e9)
+            )
+            for time_s, sample in zip(plan.tf.times_s, plan.tf.transforms, strict=True)
+        ],
+    }
+    written: dict[str, list[bytes]] = {topic: [] for topic in TYPES}
+    with path.open("rb") as stream:
+        for _, channel, message in make_reader(stream).iter_messages(log_time_order=False):
+            written[channel.topic].append(message.data)
+    for topic, messages in expected.items():
+        want = [generic(TYPES[topic], distro, message) for message in messages]
+        assert written[topic] == want, topic
+    decoded = read_all(path)  # and an independent reader decodes every one of them
+    assert len(decoded) == sum(len(messages) for messages in expected.values())
+    trajectory_messages = on(decoded, "/planned_trajectory")
+    for (_, message), trajectory in zip(trajectory_messages, trajectories, strict=True):
+        np.testing.assert_array_equal([p.positions for p in message.points], trajectory.positions)
+
+
+def test_same_edge_plan_written_twice_gives_identical_bytes(
+    tmp_path: Path, edge_plan: Plan
+) -> None:
+    recording.write_plan(tmp_path / "a.mcap", edge_plan)
+    recording.write_plan(tmp_path / "b.mcap", edge_plan)
+    assert (tmp_path / "a.mcap").read_bytes() == (tmp_path / "b.mcap").read_bytes()
