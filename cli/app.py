@@ -13,7 +13,15 @@ from typing import Annotated, Any
 import typer
 
 from moveplan.cli.errors import exit_codes
-from moveplan.cli.parsing import parse_joints, parse_number, parse_scaling
+from moveplan.cli.parsing import (
+    parse_disturbance,
+    parse_joints,
+    parse_number,
+    parse_params,
+    parse_pose,
+    parse_scaling,
+    parse_shift,
+)
 
 __all__ = ["app", "main"]
 
@@ -33,7 +41,6 @@ VerboseOpt = Annotated[bool, typer.Option("--verbose", "-v", help="Log what happ
 def _logging(verbose: bool, quiet: bool) -> None:
     level = logging.DEBUG if verbose else logging.ERROR if quiet else logging.WARNING
     logging.basicConfig(level=level, format="moveplan: %(levelname)s: %(message)s")
-    logging.getLogger("toppra").setLevel(max(level, logging.WARNING))
 
 
 @app.command()
@@ -48,6 +55,14 @@ def plan(
     start_from: Annotated[Path | None, typer.Option(help="Start where a previous plan file ends.")] = None,
     joints: Annotated[str | None, typer.Option(help="Joint goal: 'q1,...,qn' or 'elbow_joint=1.2,...'.")] = None,
     named: Annotated[str | None, typer.Option(help="Goal: an SRDF group_state.")] = None,
+    pose: Annotated[str | None, typer.Option(help="Goal pose of the tip: 'x,y,z[,roll,pitch,yaw | ,qx,qy,qz,qw]'.")] = None,
+    frame: Annotated[str | None, typer.Option(help="Frame --pose is given in: a scene frame or robot link.")] = None,
+    link: Annotated[str | None, typer.Option(help="Link --pose moves (default: the group's tip).")] = None,
+    shift: Annotated[str | None, typer.Option(help="Move the tip from where it is: 'z=0.1' or 'x=0.05,yaw=0.3'.")] = None,
+    shift_frame: Annotated[str | None, typer.Option(
+        help="Axes of --shift: tool (default), base, moveit (shift_pose_target) or any frame.")] = None,
+    linear: Annotated[bool, typer.Option("--linear", help="Move the tip along a straight line.")] = False,
+    min_fraction: Annotated[str | None, typer.Option(help="With --linear: fail below this fraction (default 1).")] = None,
     planner: Annotated[str | None, typer.Option(help="OMPL geometric planner (default RRTConnect).")] = None,
     planning_time: Annotated[str | None, typer.Option(help="Seconds the planner may search per step.")] = None,
     seed: Annotated[int | None, typer.Option(min=0, help="Random seed: same seed, same plan.")] = None,
@@ -79,7 +94,7 @@ def _plan_flags(args: dict[str, Any]) -> dict[str, Any]:
     from moveplan.core.tasks import StepSpec
 
     starts = [k for k in ("start_joints", "start_named", "start_from") if args[k] is not None]
-    goals = [k for k in ("joints", "named") if args[k] is not None]
+    goals = [k for k in ("joints", "named", "pose", "shift") if args[k] is not None]
     if len(starts) > 1 or len(goals) > 1:
         raise UsageError(f"give one start flag and one goal flag, got {', '.join('--' + k.replace('_', '-') for k in starts + goals)}")
     start: dict[str, Any] = {}
@@ -89,11 +104,27 @@ def _plan_flags(args: dict[str, Any]) -> dict[str, Any]:
         start = {"named": args["start_named"]}
     elif args["start_from"] is not None:
         start = {"from": args["start_from"]}
+    for flag, needs in (("frame", "pose"), ("link", "pose"), ("shift_frame", "shift")):
+        if args[flag] is not None and args[needs] is None:
+            raise UsageError(f"--{flag.replace('_', '-')} goes with --{needs}")
+    if args["linear"] and not ({"pose", "shift"} & set(goals)):
+        raise UsageError("--linear goes with --pose or --shift")
     steps = []
     if args["joints"] is not None:
         steps.append(StepSpec("goal", parse_joints(args["joints"], "--joints")))
     elif args["named"] is not None:
         steps.append(StepSpec(args["named"], {"named": args["named"]}))
+    elif args["pose"] is not None:
+        goal = {"pose": {**parse_pose(args["pose"], "--pose"), "frame": args["frame"], "link": args["link"]}}
+        steps.append(StepSpec("pose", goal, linear=args["linear"]))
+    elif args["shift"] is not None:
+        goal = {"shift": {**parse_shift(args["shift"], "--shift"), "frame": args["shift_frame"] or "tool"}}
+        steps.append(StepSpec("shift", goal, linear=args["linear"]))
+    min_fraction = None
+    if args["min_fraction"] is not None:
+        min_fraction = parse_number(args["min_fraction"], "--min-fraction")
+        if not 0.0 <= min_fraction <= 1.0:
+            raise UsageError(f"--min-fraction: expected a number in [0, 1], got '{args['min_fraction']}'")
     planning_time = None
     if args["planning_time"] is not None:
         planning_time = parse_number(args["planning_time"], "--planning-time")
@@ -104,8 +135,51 @@ def _plan_flags(args: dict[str, Any]) -> dict[str, Any]:
         "planner": args["planner"], "planning_time": planning_time, "seed": args["seed"],
         "velocity_scaling": parse_scaling(args["velocity_scaling"], "--velocity-scaling"),
         "acceleration_scaling": parse_scaling(args["acceleration_scaling"], "--acceleration-scaling"),
-        "package_paths": tuple(args["package_path"] or ()),
+        "package_paths": tuple(args["package_path"] or ()), "min_fraction": min_fraction,
     }
+
+
+@app.command()
+def execute(
+    plan_file: Annotated[Path, typer.Argument(metavar="PLAN", help="Plan file written by moveplan plan.")],
+    fake: Annotated[bool, typer.Option("--fake", help="Replay through a simulated controller (required).")] = False,
+    output: Annotated[Path | None, typer.Option("--output", "-o", help="Write what happened to this .mcap.")] = None,
+    plant: Annotated[str, typer.Option(help="Hardware model: mirror, lag or pid.")] = "mirror",
+    plant_param: Annotated[list[str] | None, typer.Option(help="Plant parameter k=v, e.g. tau=0.05.")] = None,
+    disturb: Annotated[list[str] | None, typer.Option(help="Fault: 't=1.2,joint=elbow_joint,delta=0.05'.")] = None,
+    start_joints: Annotated[str | None, typer.Option(help="Robot not where the plan starts: 'joint=value,...'.")] = None,
+    controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml overriding the plan's.")] = None,
+    seed: Annotated[int, typer.Option(min=0, help="Seed for plant noise.")] = 0,
+    ros_distro: Annotated[str, typer.Option(help="Controller-state layout to write: jazzy or humble.")] = "jazzy",
+    as_json: JsonOpt = False,
+    quiet: QuietOpt = False,
+    verbose: VerboseOpt = False,
+) -> None:
+    """Replay a plan through a simulated JointTrajectoryController and report every tolerance violation."""
+    _logging(verbose, quiet)
+    with exit_codes(as_json):
+        from moveplan.core.errors import UsageError
+
+        if not fake:
+            raise UsageError("only fake execution exists yet: add --fake to replay through a simulated controller")
+        from moveplan.cli import render
+        from moveplan.core.execution import ExecuteRequest, execute as run
+
+        request = ExecuteRequest(
+            plan=plan_file, plant=plant, plant_params=parse_params(plant_param or [], "--plant-param"),
+            disturbances=tuple(parse_disturbance(d) for d in disturb or []),
+            start_joints=parse_joints(start_joints, "--start-joints")["joints"] if start_joints else None,
+            controllers=controllers, seed=seed,
+        )
+        if request.start_joints is not None and not isinstance(request.start_joints, dict):
+            raise UsageError("--start-joints: give joint=value pairs")
+        outcome = run(request)
+        if output is not None:
+            from moveplan.core import recording
+
+            recording.write_execution(output, outcome, ros_distro)
+    render.execution_summary(outcome, output, as_json, quiet)
+    raise typer.Exit(0 if outcome.ok else 5)
 
 
 @app.command("robot")

@@ -10,7 +10,9 @@ from typing import Any
 
 from moveplan.core.errors import UsageError
 
-__all__ = ["parse_joints", "parse_number", "parse_scaling"]
+__all__ = [
+    "parse_disturbance", "parse_joints", "parse_number", "parse_params", "parse_pose", "parse_scaling", "parse_shift",
+]
 
 _BINARY: dict[type, Callable[[float, float], float]] = {
     ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
@@ -61,3 +63,57 @@ def parse_joints(text: str, what: str) -> dict[str, Any]:
     if any("=" in item for item in items):
         raise UsageError(f"{what}: give either all values or name=value pairs, not a mix")
     return {"joints": [parse_number(item, what) for item in items]}
+
+
+def parse_pose(text: str, what: str) -> dict[str, Any]:
+    """Return a pose goal from "x,y,z", "x,y,z,roll,pitch,yaw" or "x,y,z,qx,qy,qz,qw"."""
+    values = [parse_number(item, what) for item in text.split(",")] if text.strip() else []
+    if len(values) not in (3, 6, 7):
+        raise UsageError(f"{what}: expected 'x,y,z', 'x,y,z,roll,pitch,yaw' or 'x,y,z,qx,qy,qz,qw', "
+                         f"got {len(values)} values")
+    pose: dict[str, Any] = {"xyz": values[:3], "rpy": None, "quat": None}
+    if len(values) == 6:
+        pose["rpy"] = values[3:]
+    elif len(values) == 7:
+        if math.fsum(v * v for v in values[3:]) < 1e-12:
+            raise UsageError(f"{what}: the quaternion (qx,qy,qz,qw) has zero norm; it is not a rotation")
+        pose["quat"] = values[3:]
+    return pose
+
+
+def parse_shift(text: str, what: str) -> dict[str, Any]:
+    """Return shift displacements from "z=0.1" or "x=0.05,yaw=0.3" (metres and radians)."""
+    axes = ("x", "y", "z", "roll", "pitch", "yaw")
+    shift: dict[str, Any] = {}
+    for item in text.split(","):
+        name, _, value = item.partition("=")
+        name = name.strip()
+        if name not in axes or not value.strip():
+            raise UsageError(f"{what}: expected axis=value pairs with axes {', '.join(axes)}, got '{item.strip()}'")
+        shift[name] = parse_number(value, f"{what} {name}")
+    return shift
+
+
+def parse_params(items: list[str], what: str) -> dict[str, float]:
+    """Return parameters from "k=v" items (values may be pi expressions)."""
+    params: dict[str, float] = {}
+    for item in items:
+        key, _, value = item.partition("=")
+        if not key.strip() or not value.strip():
+            raise UsageError(f"{what}: expected key=value, got '{item}'")
+        params[key.strip()] = parse_number(value, f"{what} {key.strip()}")
+    return params
+
+
+def parse_disturbance(text: str) -> Any:
+    """Return a Disturbance from "t=1.2,joint=elbow_joint,delta=0.05"."""
+    from moveplan.core.controller import Disturbance
+
+    fields = dict(item.partition("=")[::2] for item in text.split(","))
+    fields = {k.strip(): v.strip() for k, v in fields.items()}
+    if set(fields) != {"t", "joint", "delta"} or not fields["joint"]:
+        raise UsageError(f"--disturb: expected 't=SECONDS,joint=NAME,delta=RAD', got '{text}'")
+    time_s = parse_number(fields["t"], "--disturb t")
+    if time_s < 0:
+        raise UsageError(f"--disturb: t must not be negative, got '{fields['t']}'")
+    return Disturbance(time_s, fields["joint"], parse_number(fields["delta"], "--disturb delta"))

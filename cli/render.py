@@ -11,11 +11,12 @@ from rich.console import Console
 from rich.table import Table
 
 from moveplan.core.config import RobotConfig
+from moveplan.core.execution import PlanExecution
 from moveplan.core.recording import BagSummary, PlanFile
 from moveplan.core.trajectory import peak_rates
 from moveplan.core.types import Plan
 
-__all__ = ["inspect_summary", "plan_summary", "robot_summary"]
+__all__ = ["execution_summary", "inspect_summary", "plan_summary", "robot_summary"]
 
 _console = Console()
 
@@ -149,3 +150,51 @@ def inspect_summary(path: Path, summary: BagSummary, plan: PlanFile | None, as_j
             table.add_row(s["name"], f"{s['start_s']:.3f}", f"{s['duration_s']:.3f}", str(s["points"]),
                           f"{s['peak_velocity_fraction']:.2f}", f"{s['peak_acceleration_fraction']:.2f}")
         _console.print(table)
+
+
+def execution_document(outcome: PlanExecution) -> dict[str, Any]:
+    """Return the execute / check-tolerances JSON document of an execution."""
+    return {
+        "ok": outcome.ok,
+        "result": {"code": outcome.result.code, "name": outcome.result.name, "message": outcome.result.message},
+        "violations": [
+            {"check": v.check, "joint": v.joint, "time_s": v.time_s, "reference": v.reference, "actual": v.actual,
+             "error": v.error, "tolerance": v.tolerance, "step": step}
+            for step, v in outcome.violations
+        ],
+        "margins": outcome.margins,
+        "duration_s": outcome.duration_s,
+        "controller": outcome.controller.name,
+        "steps": [{"name": s.name, "ok": s.report.ok, "result": s.report.result.name,
+                   "duration_s": s.report.duration_s} for s in outcome.steps],
+    }
+
+
+def execution_summary(outcome: PlanExecution, output: Path | None, as_json: bool, quiet: bool) -> None:
+    """Print the result, every violation and the per-joint margins, or the JSON document."""
+    document = execution_document(outcome)
+    if output is not None:
+        document["output"] = str(output)
+    if as_json:
+        _emit(document)
+        return
+    if quiet:
+        return
+    colour = "green" if outcome.ok else "red"
+    _console.print(f"[{colour}]{outcome.result.name}[/{colour}] ({outcome.result.code}): {outcome.result.message}")
+    if document["violations"]:
+        table = Table(title="violations")
+        for column in ("step", "check", "joint", "time [s]", "reference", "actual", "error", "tolerance"):
+            table.add_column(column)
+        for v in document["violations"]:
+            table.add_row(v["step"], v["check"], v["joint"], f"{v['time_s']:.3f}", f"{v['reference']:.4f}",
+                          f"{v['actual']:.4f}", f"{v['error']:.4f}", f"{v['tolerance']:.4f}")
+        _console.print(table)
+    if document["margins"]:
+        table = Table(title=f"smallest margin to tolerance ({outcome.controller.name})")
+        table.add_column("joint")
+        table.add_column("margin [rad]")
+        for joint, margin in document["margins"].items():
+            table.add_row(joint, f"[{'red' if margin < 0 else 'green'}]{margin:.4f}[/]")
+        _console.print(table)
+    _console.print(f"executed {len(outcome.steps)} of {len(outcome.plan.steps)} steps in {outcome.duration_s:.3f} s")

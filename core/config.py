@@ -29,6 +29,7 @@ __all__ = [
     "check_keys",
     "load_robot_config",
     "load_yaml",
+    "parse_controllers",
     "number",
     "resolve_config_path",
 ]
@@ -242,7 +243,8 @@ def load_robot_config(robot: str | Path, package_paths: tuple[Path, ...] = ()) -
         file = root / top[key]
         if not file.is_file():
             raise ConfigError(f"{path}: {key}: file not found: {file}")
-        files[file.name] = file.read_bytes()
+        # Keyed by the path moveplan.yaml names, so the files can be laid out again as a config.
+        files[top[key]] = file.read_bytes()
         return file
 
     urdf_path = named_file("urdf")
@@ -256,7 +258,7 @@ def load_robot_config(robot: str | Path, package_paths: tuple[Path, ...] = ()) -
     limits = _merge_limits(urdf_path, urdf_joints, limits_path, limit_overrides)
 
     controllers_path = named_file("controllers", required=False)
-    controllers = _parse_controllers(controllers_path) if controllers_path else {}
+    controllers = parse_controllers(controllers_path) if controllers_path else {}
     moveit_path = named_file("moveit_controllers", required=False)
     execution = _parse_execution(moveit_path) if moveit_path else ExecutionConfig()
     initial_path = named_file("initial_positions", required=False)
@@ -473,7 +475,8 @@ def _ros_parameters(top: dict[str, Any], node: str, path: Path) -> dict[str, Any
     return mapping(section.get("ros__parameters"), f"{path}: {node}.ros__parameters")
 
 
-def _parse_controllers(path: Path) -> dict[str, ControllerConfig]:
+def parse_controllers(path: Path) -> dict[str, ControllerConfig]:
+    """Return the JointTrajectoryControllers configured in a ros2_controllers.yaml."""
     top = mapping(load_yaml(path), str(path))
     manager = _ros_parameters(top, "controller_manager", path)
     rate = number(manager.get("update_rate", 100), f"{path}: controller_manager.ros__parameters.update_rate",

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from importlib.metadata import version
 from pathlib import Path
@@ -21,8 +22,17 @@ from numpy.typing import NDArray
 from moveplan.core import recording
 from moveplan.core.collision import CollisionChecker
 from moveplan.core.config import RobotConfig, load_robot_config
-from moveplan.core.errors import ConfigError, GoalInCollision, PlanningFailed, StartInCollision, UsageError
-from moveplan.core.goals import check_limits, joint_target
+from moveplan.core.errors import (
+    ConfigError,
+    GoalInCollision,
+    GoalUnreachable,
+    PlanningFailed,
+    StartInCollision,
+    UsageError,
+)
+from moveplan.core.cartesian import straight_line
+from moveplan.core.goals import check_limits, joint_target, pose_error, tip_target
+from moveplan.core.kinematics import solve_ik
 from moveplan.core.planning import interpolate, plan_path, seed_planner
 from moveplan.core.robot import Robot
 from moveplan.core.scene import Scene, empty_scene, load_scene
@@ -35,8 +45,10 @@ __all__ = ["PlanRequest", "plan", "resolve_request"]
 
 logger = logging.getLogger(__name__)
 
-# Planning checks edges every 0.01 rad; the timed trajectory is checked twice as finely.
-_PLAN_RESOLUTION = 0.01
+# The search checks edges every 0.02 rad; what is written is certified much finer, at
+# 0.0025 rad as the controller interpolates it. A trajectory that fails certification is
+# planned again with fine edge checks and a closer-following time parameterisation.
+_ATTEMPTS = ((0.02, 0.05), (0.005, 0.01))  # (edge check resolution [rad], timing resample step [rad])
 _CHECK_RESOLUTION = 0.005
 _TF_RATE_HZ = 30.0
 
@@ -55,6 +67,7 @@ class PlanRequest:
     velocity_scaling: float | None = None
     acceleration_scaling: float | None = None
     seed: int = 0
+    min_fraction: float = 1.0
     package_paths: tuple[Path, ...] = ()
     task: TaskFile | None = None
 
@@ -73,7 +86,7 @@ def resolve_request(task: TaskFile | None, flags: dict[str, Any]) -> PlanRequest
     if task is not None and not steps:
         steps = task.steps
     if not steps:
-        raise UsageError("no goal: give --joints, --named, or a task file with steps")
+        raise UsageError("no goal: give --joints, --named, --pose, --shift, or a task file with steps")
     if "robot" not in merged:
         raise UsageError("no robot: give --robot or a task file naming one")
     start = flags.get("start") or (task.start if task is not None else {})
@@ -81,7 +94,7 @@ def resolve_request(task: TaskFile | None, flags: dict[str, Any]) -> PlanRequest
         robot=Path(merged["robot"]), steps=steps, scene=merged.get("scene"), group=merged.get("group"),
         start=start, planner=merged.get("planner"), planning_time=merged.get("planning_time"),
         velocity_scaling=merged.get("velocity_scaling"), acceleration_scaling=merged.get("acceleration_scaling"),
-        seed=int(merged.get("seed") or 0), package_paths=tuple(flags.get("package_paths") or ()), task=task,
+        seed=int(merged.get("seed") or 0), min_fraction=float(merged.get("min_fraction", 1.0)), package_paths=tuple(flags.get("package_paths") or ()), task=task,
     )
 
 
@@ -101,8 +114,8 @@ def plan(request: PlanRequest) -> Plan:
     steps: list[StepResult] = []
     for spec in request.steps:
         try:
-            step = _plan_step(spec, request, robot, checker, base, current)
-        except (PlanningFailed, StartInCollision, ConfigError) as exc:
+            step = _plan_step(spec, request, robot, scene, checker, base, current)
+        except (PlanningFailed, GoalUnreachable, StartInCollision, ConfigError) as exc:
             raise _in_step(exc, spec.name) from None
         steps.append(step)
         current = step.trajectory.positions[-1].copy()
@@ -156,16 +169,13 @@ def _plan_step(
     spec: StepSpec,
     request: PlanRequest,
     robot: Robot,
+    scene: Scene,
     checker: CollisionChecker,
     base: NDArray[np.float64],
     start: NDArray[np.float64],
 ) -> StepResult:
     began = time.perf_counter()
-    source = str(request.task.source) if request.task else "--joints"
-    goal = joint_target(robot, spec.goal, start, source)
-    pair = checker.colliding_pair(robot.configuration(goal, base))
-    if pair:
-        raise GoalInCollision(pair)
+    source = str(request.task.source) if request.task else "flags"
     missing = [j for i, j in enumerate(robot.joint_names) if not np.isfinite(robot.max_acceleration[i])]
     if missing:
         raise ConfigError(f"{robot.config.root}: no acceleration limit for joints {', '.join(missing)} "
@@ -174,46 +184,69 @@ def _plan_step(
     def free_batch(values: NDArray[np.float64]) -> NDArray[np.bool_]:
         return checker.free_batch(robot.configurations(values, base))
 
+    def colliding_pair(q: NDArray[np.float64]) -> tuple[str, str] | None:
+        return checker.colliding_pair(q)
+
     planner = spec.planner or request.planner or robot.config.planning["planner"]
     planning_time = spec.planning_time or request.planning_time or robot.config.planning["planning_time"]
-    path = plan_path(start, goal, robot.lower, robot.upper, free_batch, planner, planning_time, _PLAN_RESOLUTION)
+    fraction, target_pose, link = 1.0, None, robot.group.tip
+    search: Callable[[float], NDArray[np.float64]]
+    if "joints" in spec.goal or "named" in spec.goal:
+        goal = joint_target(robot, spec.goal, start, "--joints" if request.task is None else source)
+        pair = checker.colliding_pair(robot.configuration(goal, base))
+        if pair:
+            raise GoalInCollision(pair)
+    else:
+        link, target_pose = tip_target(robot, scene, spec.goal, robot.configuration(start, base), source)
+        if not spec.linear:
+            # Exhaustive: the first valid solution from a far start is not always the nearest one.
+            goal = solve_ik(robot, target_pose, link, start, base=base, seed=request.seed, exhaustive=True,
+                            is_free=lambda v: bool(free_batch(v[None, :])[0]),
+                            colliding_pair=checker.colliding_pair).values
+    if spec.linear:
+        planner = "linear"
+        line = straight_line(robot, link, start, target_pose, base, free_batch, colliding_pair)
+        fraction = line.fraction
+        minimum = spec.min_fraction if spec.min_fraction is not None else request.min_fraction
+        if fraction < minimum:
+            x, y, z = line.stopped_at
+            raise PlanningFailed(f"straight line achieved {fraction:.1%} of the way (minimum {minimum:.0%}): "
+                                 f"{line.reason}; stopped at [{x:.4f}, {y:.4f}, {z:.4f}] in {robot.root_link}")
+        search = lambda resolution: np.asarray(line.waypoints)  # noqa: E731 - the line is already checked
+    else:
+        search = lambda resolution: plan_path(  # noqa: E731
+            start, goal, robot.lower, robot.upper, free_batch, planner, planning_time, resolution).waypoints
     v_scale, a_scale = _scaling(robot, request, spec)
-    trajectory = _timed_and_checked(robot, path.waypoints, v_scale, a_scale, free_batch, checker, base)
+    for resolution, max_step in _ATTEMPTS:
+        waypoints = search(resolution)
+        trajectory = time_parameterize(robot.joint_names, waypoints, robot.max_velocity * v_scale,
+                                       robot.max_acceleration * a_scale, max_step=max_step)
+        states = _dense_states(trajectory)
+        free = free_batch(states)
+        if free.all():
+            break
+        logger.debug("trajectory planned at %.3f rad collides when checked densely; planning finer", resolution)
+    else:
+        pair = checker.colliding_pair(robot.configuration(states[int(np.argmin(free))], base)) or ("?", "?")
+        raise PlanningFailed(f"the timed trajectory collides ({pair[0]} touches {pair[1]}) where the path did not")
     check_limits(robot, trajectory.positions.max(axis=0))
     check_limits(robot, trajectory.positions.min(axis=0))
+    end = trajectory.positions[-1]
+    if target_pose is None:
+        residual = {"joints_rad": float(np.max(np.abs(end - waypoints[-1])))}
+    else:
+        reached = robot.frame_pose(robot.configuration(end, base), link)
+        position, angle = pose_error(reached, target_pose)
+        residual = {"position_m": position, "orientation_rad": angle}
     return StepResult(
         name=spec.name,
         goal=_describe(spec.goal),
         planner=planner,
         planning_time_s=time.perf_counter() - began,
         trajectory=trajectory,
-        residual={"joints_rad": float(np.max(np.abs(trajectory.positions[-1] - goal)))},
+        fraction=fraction,
+        residual=residual,
     )
-
-
-def _timed_and_checked(
-    robot: Robot,
-    waypoints: NDArray[np.float64],
-    v_scale: float,
-    a_scale: float,
-    free_batch: Any,
-    checker: CollisionChecker,
-    base: NDArray[np.float64],
-) -> JointTrajectory:
-    """Return the timed trajectory, checked for collisions as the controller interpolates it."""
-    for max_step in (0.05, 0.01):
-        trajectory = time_parameterize(
-            robot.joint_names, waypoints, robot.max_velocity * v_scale, robot.max_acceleration * a_scale,
-            max_step=max_step,
-        )
-        states = _dense_states(trajectory)
-        free = free_batch(states)
-        if free.all():
-            return trajectory
-        logger.debug("timed trajectory leaves the checked path at step %.3f rad; resampling", max_step)
-    bad = states[int(np.argmin(free))]
-    pair = checker.colliding_pair(robot.configuration(bad, base)) or ("?", "?")
-    raise PlanningFailed(f"the timed trajectory collides ({pair[0]} touches {pair[1]}) where the path did not")
 
 
 def _dense_states(trajectory: JointTrajectory) -> NDArray[np.float64]:

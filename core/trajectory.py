@@ -103,18 +103,52 @@ def sample(
     return _sample_points(knots, positions, velocities, accelerations, has_v, has_a, t)
 
 
-def peak_rates(
-    trajectory: JointTrajectory, per_segment: int = 16
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Return per joint the largest |velocity| and |acceleration| along the interpolation."""
-    knots = trajectory.times_s
+def peak_rates(trajectory: JointTrajectory) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Return per joint the largest |velocity| and |acceleration| anywhere along the interpolation.
+
+    Exact for the controller's quintic segments: the acceleration of a segment is a
+    cubic, largest at an end or where the jerk (a quadratic) is zero; between those
+    points it is monotonic, so its zeros, where the velocity peaks, are found by bisection.
+    """
+    knots, p = trajectory.times_s, trajectory.positions
     if len(knots) == 1:
-        zeros = np.zeros(len(trajectory.joint_names))
-        return zeros, zeros
-    fractions = np.linspace(0.0, 1.0, per_segment + 1)[:-1]
-    times = (knots[:-1, None] + np.diff(knots)[:, None] * fractions[None, :]).ravel()
-    _, vel, acc = sample(trajectory, np.append(times, knots[-1] - 1e-12))
-    return np.abs(vel).max(axis=0), np.abs(acc).max(axis=0)
+        return np.abs(trajectory.velocities[0]), np.abs(trajectory.accelerations[0])
+    every = np.ones(len(knots), dtype=bool)
+    _, c1, c2, c3, c4, c5 = _coefficients(knots, p, trajectory.velocities, trajectory.accelerations, every, every)
+    h = np.broadcast_to(np.diff(knots)[:, None], c1.shape)
+
+    def velocity(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        return c1 + x * (2 * c2 + x * (3 * c3 + x * (4 * c4 + x * 5 * c5)))
+
+    def acceleration(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        return 2 * c2 + x * (6 * c3 + x * (12 * c4 + x * 20 * c5))
+
+    jerk_zeros = [np.where((r >= 0) & (r <= h), r, 0.0) for r in _quadratic_roots(60 * c5, 24 * c4, 6 * c3)]
+    bounds = np.sort(np.stack([np.zeros_like(h), *jerk_zeros, h]), axis=0)
+    peak_a = np.max(np.abs(np.stack([acceleration(x) for x in bounds])), axis=(0, 1))
+    candidates = [velocity(x) for x in bounds]
+    for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
+        a_lo = acceleration(lo)
+        crossing = np.sign(a_lo) * np.sign(acceleration(hi)) < 0
+        lo, hi = lo.copy(), hi.copy()
+        for _ in range(32):  # the bracket shrinks to 2^-32 of a segment; near a peak v is flat
+            mid = (lo + hi) / 2
+            same = np.sign(acceleration(mid)) == np.sign(a_lo)
+            lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+        candidates.append(np.where(crossing, velocity(lo), 0.0))
+    peak_v = np.max(np.abs(np.stack(candidates)), axis=(0, 1))
+    return peak_v, peak_a
+
+
+def _quadratic_roots(
+    a: NDArray[np.float64], b: NDArray[np.float64], c: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Return the real roots of a x^2 + b x + c elementwise (NaN or inf where there are none)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        root = np.sqrt(b * b - 4 * a * c)
+        # The numerically stable form; with a = 0 the second root is the linear one, -c / b.
+        q = -0.5 * (b + np.copysign(root, b))
+        return q / a, c / q
 
 
 def _or_zeros(values: NDArray[np.float64] | None, n: int) -> NDArray[np.float64]:

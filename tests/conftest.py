@@ -8,12 +8,15 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
 from moveplan.cli.app import app
 from moveplan.core.config import RobotConfig, load_robot_config
 from moveplan.core.robot import Robot
+from moveplan.core.trajectory import sample
+from moveplan.core.types import JointTrajectory
 
 ROOT = Path(__file__).resolve().parents[1]
 UR10E = ROOT / "configs" / "ur10e"
@@ -55,3 +58,12 @@ def run_process(*args: Any) -> subprocess.CompletedProcess[str]:
     """Run moveplan as its own process, as a user's shell would."""
     return subprocess.run([sys.executable, "-m", "moveplan.cli.app", *map(str, args)],
                           capture_output=True, text=True, timeout=300)
+
+
+def dense_peaks(trajectory: JointTrajectory, per_segment: int = 64) -> tuple[np.ndarray, np.ndarray]:
+    """Largest |velocity| and |acceleration| per joint, sampled densely (independent of peak_rates)."""
+    knots = trajectory.times_s
+    fractions = np.linspace(0.0, 1.0, per_segment + 1)
+    times = np.unique((knots[:-1, None] + np.diff(knots)[:, None] * fractions).ravel())
+    _, velocities, accelerations = sample(trajectory, times)
+    return np.abs(velocities).max(axis=0), np.abs(accelerations).max(axis=0)

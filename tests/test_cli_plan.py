@@ -7,14 +7,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import SAMPLES, TABLE_SCENE, UR10E, Cli, run_process
+from conftest import dense_peaks, SAMPLES, TABLE_SCENE, UR10E, Cli, run_process
 from rosbags.highlevel import AnyReader
 
 from moveplan.core.collision import CollisionChecker
 from moveplan.core.recording import read_plan
 from moveplan.core.robot import Robot
 from moveplan.core.scene import load_scene
-from moveplan.core.trajectory import peak_rates, sample
+from moveplan.core.trajectory import sample
 
 GOAL = [0.5, -1.2, -1.8, 0.0, 1.57, 0.0]
 HOME = [0.0, -np.pi / 2, -np.pi / 2, 0.0, 0.0, 0.0]
@@ -54,7 +54,7 @@ def test_trajectory_starts_at_start_and_ends_at_goal_at_rest(table_plan: Path) -
 
 def test_interpolated_trajectory_stays_within_scaled_limits_everywhere(table_plan: Path, ur10e: Robot) -> None:
     trajectory = read_plan(table_plan).steps[0].trajectory
-    peak_v, peak_a = peak_rates(trajectory, per_segment=64)
+    peak_v, peak_a = dense_peaks(trajectory)
     assert np.all(peak_v <= ur10e.max_velocity * 0.5 + 1e-9)
     assert np.all(peak_a <= ur10e.max_acceleration * 0.4 + 1e-9)
     # Time-optimal: some joint uses most of its scaled velocity or acceleration.

@@ -1,0 +1,147 @@
+"""Execution pipeline: a plan file -> its embedded config -> simulated controller per step -> report.
+
+Composes recording (reading plans), config, plants and the controller simulation,
+as the plan pipeline composes planning and timing. Each step of a plan is one
+FollowJointTrajectory goal, sent when the previous one has succeeded, from
+wherever the simulated robot then is.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from moveplan.core import recording
+from moveplan.core.config import CONFIG_FILE, ControllerConfig, RobotConfig, load_robot_config, parse_controllers
+from moveplan.core.controller import Disturbance, ExecutionReport, simulate
+from moveplan.core.errors import ConfigError, InputError, UnknownName
+from moveplan.core.plants import make_plant
+from moveplan.core.tolerances import ExecutionResult, Violation
+
+__all__ = ["ExecuteRequest", "PlanExecution", "StepExecution", "execute", "plan_config", "pick_controller"]
+
+
+@dataclass(frozen=True)
+class ExecuteRequest:
+    """What `moveplan execute --fake` was asked to do."""
+
+    plan: Path
+    plant: str = "mirror"
+    plant_params: Mapping[str, float] | None = None
+    disturbances: Sequence[Disturbance] = ()
+    start_joints: Mapping[str, float] | None = None
+    controllers: Path | None = None
+    seed: int = 0
+
+
+@dataclass(frozen=True)
+class StepExecution:
+    """One step's simulated execution; its times are from the step's start."""
+
+    name: str
+    report: ExecutionReport
+
+
+@dataclass(frozen=True)
+class PlanExecution:
+    """A whole plan's execution: the first failing step ends it."""
+
+    ok: bool
+    result: ExecutionResult
+    steps: tuple[StepExecution, ...]
+    controller: ControllerConfig
+    plan: recording.PlanFile
+
+    @property
+    def violations(self) -> tuple[tuple[str, Violation], ...]:
+        """Return every violation with the name of its step."""
+        return tuple((s.name, v) for s in self.steps for v in s.report.violations)
+
+    @property
+    def margins(self) -> dict[str, float]:
+        """Return per joint the smallest margin to its tolerance over all steps."""
+        margins: dict[str, float] = {}
+        for step in self.steps:
+            for joint, margin in step.report.margins.items():
+                margins[joint] = min(margin, margins.get(joint, margin))
+        return margins
+
+    @property
+    def duration_s(self) -> float:
+        """Return the simulated time of all executed steps in [s]."""
+        return sum(s.report.duration_s for s in self.steps)
+
+
+def plan_config(plan: recording.PlanFile, source: Path) -> RobotConfig:
+    """Return the robot config embedded in a plan file."""
+    if CONFIG_FILE not in plan.attachments:
+        raise InputError(f"{source}: the plan carries no robot config ({CONFIG_FILE} attachment missing)")
+    with tempfile.TemporaryDirectory(prefix="moveplan-") as folder:
+        for name, data in plan.attachments.items():
+            path = Path(folder) / name
+            if not path.resolve().is_relative_to(Path(folder).resolve()):
+                raise InputError(f"{source}: attachment name '{name}' points outside the config")
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(data)
+        try:
+            return load_robot_config(folder)
+        except ConfigError as exc:
+            raise InputError(f"{source}: embedded config: {exc}") from None
+
+
+def pick_controller(controllers: Mapping[str, ControllerConfig], joints: Sequence[str], source: str) -> ControllerConfig:
+    """Return the JointTrajectoryController that drives all of `joints`."""
+    fitting = [c for c in controllers.values() if set(joints) <= set(c.joints)]
+    if not fitting:
+        raise ConfigError(f"{source}: no JointTrajectoryController drives all of {', '.join(joints)}; "
+                          f"controllers: {', '.join(controllers) or '(none)'}")
+    return min(fitting, key=lambda c: len(c.joints))
+
+
+def execute(request: ExecuteRequest) -> PlanExecution:
+    """Return what executing the plan through the simulated controller did."""
+    plan = recording.read_plan(request.plan)
+    config = plan_config(plan, request.plan)
+    controllers = config.controllers
+    source = str(config.root / "ros2_controllers.yaml")
+    if request.controllers is not None:
+        controllers = parse_controllers(request.controllers)
+        source = str(request.controllers)
+    joints = plan.steps[0].trajectory.joint_names
+    controller = pick_controller(controllers, joints, source)
+    continuous = [j for j, lim in config.limits.items() if lim.continuous]
+    plant = make_plant(request.plant, dict(request.plant_params or {}), controller, continuous)
+    start = _start_positions(request, plan, controller)
+    steps = []
+    for step in plan.steps:
+        end = step.start_s + step.trajectory.duration_s
+        bumps = [Disturbance(d.time_s - step.start_s, d.joint, d.delta)
+                 for d in request.disturbances if step.start_s <= d.time_s < end or (d.time_s >= end and step is plan.steps[-1])]
+        report = simulate(step.trajectory, controller, config.execution, plant, continuous_joints=continuous,
+                          start_positions=start, disturbances=bumps, seed=request.seed)
+        steps.append(StepExecution(step.name, report))
+        if not report.ok:
+            break
+        start = report.actual_positions[-1] if len(report.times_s) else start
+    last = steps[-1].report
+    return PlanExecution(last.ok, last.result, tuple(steps), controller, plan)
+
+
+def _start_positions(
+    request: ExecuteRequest, plan: recording.PlanFile, controller: ControllerConfig
+) -> NDArray[np.float64] | None:
+    """Return where the simulated robot starts, in the controller's joint order (None = plan start)."""
+    if not request.start_joints:
+        return None
+    first = plan.steps[0].trajectory
+    start = dict(zip(first.joint_names, first.positions[0], strict=True))
+    for joint, value in request.start_joints.items():
+        if joint not in start:
+            raise UnknownName("joint", joint, "--start-joints", start)
+        start[joint] = value
+    return np.array([start[j] for j in controller.joints if j in start])

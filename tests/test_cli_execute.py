@@ -1,0 +1,102 @@
+"""`moveplan execute --fake`: a plan replayed through the simulated controller, verdicts and exit codes."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import SAMPLES, UR10E, Cli
+
+
+@pytest.fixture(scope="module")
+def plan_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("execute") / "plan.mcap"
+    result = Cli()("plan", SAMPLES / "ur10e_joint_goals.yaml", "-o", out)
+    assert result.exit_code == 0, result.stderr
+    return out
+
+
+def test_mirror_execution_succeeds_with_margins_and_exit_0(cli: Cli, plan_file: Path) -> None:
+    code, document = cli.json("execute", plan_file, "--fake")
+    assert code == 0
+    assert document["ok"] is True
+    assert document["result"] == {"code": 0, "name": "SUCCESSFUL", "message": document["result"]["message"]}
+    assert document["violations"] == []
+    assert set(document["margins"]) == {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint",
+                                        "wrist_2_joint", "wrist_3_joint"}
+    assert all(margin > 0 for margin in document["margins"].values())
+    assert [s["name"] for s in document["steps"]] == ["first", "second", "home"]
+    assert document["duration_s"] > 10
+
+
+def test_without_fake_says_only_fake_execution_exists_and_exits_2(cli: Cli, plan_file: Path) -> None:
+    result = cli("execute", plan_file)
+    assert result.exit_code == 2
+    assert "only fake execution exists" in result.stderr
+
+
+def test_disturbance_beyond_path_tolerance_is_reported_with_joint_time_and_numbers(cli: Cli, plan_file: Path) -> None:
+    code, document = cli.json("execute", plan_file, "--fake", "--disturb", "t=1.0,joint=elbow_joint,delta=0.3")
+    assert code == 5
+    assert document["result"]["name"] == "PATH_TOLERANCE_VIOLATED" and document["result"]["code"] == -4
+    violation = document["violations"][0]
+    assert violation["check"] == "path" and violation["joint"] == "elbow_joint" and violation["step"] == "first"
+    assert violation["time_s"] == pytest.approx(1.0, abs=0.01)
+    assert violation["tolerance"] == 0.2 and abs(violation["error"]) == pytest.approx(0.3, abs=1e-6)
+    assert document["margins"]["elbow_joint"] < 0
+
+
+def test_robot_away_from_the_plan_start_fails_moveits_start_check(cli: Cli, plan_file: Path) -> None:
+    code, document = cli.json("execute", plan_file, "--fake", "--start-joints", "elbow_joint=-1.6")
+    assert code == 5
+    assert document["result"]["name"] == "START_STATE_INVALID"
+    assert document["violations"][0]["check"] == "start_tolerance"
+    assert document["violations"][0]["joint"] == "elbow_joint"
+
+
+def test_slow_lag_plant_violates_the_path_tolerance(cli: Cli, plan_file: Path) -> None:
+    code, document = cli.json("execute", plan_file, "--fake", "--plant", "lag", "--plant-param", "tau=1.5")
+    assert code == 5
+    assert document["result"]["name"] == "PATH_TOLERANCE_VIOLATED"
+
+
+def test_tight_tolerances_from_controllers_override_fail_a_lagging_robot(cli: Cli, plan_file: Path,
+                                                                         tmp_path: Path) -> None:
+    tight = tmp_path / "ros2_controllers.yaml"
+    text = (UR10E / "ros2_controllers.yaml").read_text().replace("trajectory: 0.2", "trajectory: 0.001")
+    tight.write_text(text)
+    assert cli("execute", plan_file, "--fake", "--plant", "lag", "--plant-param", "tau=0.05").exit_code == 0
+    code, document = cli.json("execute", plan_file, "--fake", "--plant", "lag", "--plant-param", "tau=0.05",
+                              "--controllers", tight)
+    assert code == 5
+    assert document["violations"][0]["tolerance"] == 0.001
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--plant", "spring"], "mirror"),
+        (["--plant", "lag", "--plant-param", "tua=0.1"], "tau"),
+        (["--plant", "pid"], "[velocity] or [effort]"),
+        (["--disturb", "t=1,joint=elbow_joint"], "t=SECONDS"),
+        (["--plant-param", "tau"], "key=value"),
+    ],
+)
+def test_bad_execute_flags_exit_2(cli: Cli, plan_file: Path, args: list[str], message: str) -> None:
+    result = cli("execute", plan_file, "--fake", *args)
+    assert result.exit_code == 2, result.stderr
+    assert message in result.stderr and "Traceback" not in result.stderr
+
+
+def test_disturbing_an_unknown_joint_is_a_usage_error_listing_joints(cli: Cli, plan_file: Path) -> None:
+    result = cli("execute", plan_file, "--fake", "--disturb", "t=1,joint=elbw,delta=0.1")
+    assert result.exit_code == 2, result.stderr
+    assert "elbow_joint" in result.stderr
+
+
+def test_execute_on_a_file_that_is_not_a_plan_exits_3(cli: Cli, tmp_path: Path) -> None:
+    bad = tmp_path / "bad.mcap"
+    bad.write_bytes(b"\x89MCAP0\r\n" + b"\x00" * 20)
+    result = cli("execute", bad, "--fake")
+    assert result.exit_code == 3
+    assert "bad.mcap" in result.stderr
