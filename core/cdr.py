@@ -101,11 +101,20 @@ class CdrWriter:
         return self.float64_array(values)
 
 
-def time_array(stamps_ns: Iterable[int]) -> NDArray[np.uint32]:
-    """Return builtin_interfaces Time or Duration {sec, nanosec} rows for `stamps_ns` >= 0."""
-    # uint32 as in CdrWriter.time: a negative time raises OverflowError.
-    rows = [divmod(stamp_ns, 1_000_000_000) for stamp_ns in stamps_ns]
-    return np.array(rows, dtype="<u4").reshape(-1, 2)
+def time_array(stamps_ns: Iterable[int] | NDArray[np.integer]) -> NDArray[np.uint32]:
+    """Return builtin_interfaces Time or Duration {sec, nanosec} rows for `stamps_ns` >= 0.
+
+    Raises OverflowError for a negative time or one past uint32 seconds, as CdrWriter.time.
+    """
+    # Vectorized: an executed file has a stamp per control cycle, 1,000 per second.
+    if isinstance(stamps_ns, np.ndarray):
+        stamps = stamps_ns.astype(np.int64, copy=False).reshape(-1)
+    else:
+        stamps = np.fromiter(stamps_ns, dtype=np.int64)
+    sec, nanosec = np.divmod(stamps, 1_000_000_000)
+    if np.any(stamps < 0) or np.any(sec > np.iinfo(np.uint32).max):
+        raise OverflowError("a time must be >= 0 s with at most uint32 seconds")
+    return np.stack((sec, nanosec), axis=-1).astype("<u4")
 
 
 def patched_copies(

@@ -1,26 +1,28 @@
-"""MCAP I/O: plans written as ROS 2 bags, plans and summaries of any MCAP file read back.
+"""MCAP I/O: plans and executions written as ROS 2 bags, plans and summaries read back.
 
-The only module that imports mcap and mcap_ros2. Plan files follow DESIGN section 6 and
-rosbag2's own layout, so `ros2 bag`, Foxglove and rosbags open them: profile ros2,
-ros2msg schemas, CDR messages, QoS in channel metadata, a "rosbag2" metadata record,
-statistics, chunk and message indexes, CRCs.
+The only module that imports mcap and mcap_ros2. Plan and executed files follow DESIGN
+section 6 and rosbag2's own layout, so `ros2 bag`, Foxglove and rosbags open them:
+profile ros2, ros2msg schemas, CDR messages, QoS in channel metadata, a "rosbag2"
+metadata record, statistics, chunk and message indexes, CRCs.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import os
 import struct
 from collections import Counter
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cache
 from importlib.metadata import version
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 import zstandard
 from mcap.exceptions import EndOfFile, McapError
 from mcap.opcode import Opcode
@@ -33,22 +35,37 @@ from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 # is latched on playback); serialize_dynamic is the encoder behind it, built from schema text.
 from mcap_ros2._dynamic import serialize_dynamic
 from mcap_ros2.decoder import DecoderFactory
+from numpy.typing import NDArray
 
 from moveplan.core import ros_messages as msgs
 from moveplan.core.errors import InputError
-from moveplan.core.types import JointTrajectory, Plan
+from moveplan.core.tolerances import velocity_error_computable
+from moveplan.core.types import JointTrajectory, Plan, TfSamples
+
+if TYPE_CHECKING:
+    # Only for annotations: execution imports this module (to read plans), and reading a
+    # plan needs nothing of the controller simulation.
+    from moveplan.core.config import ControllerConfig
+    from moveplan.core.controller import ExecutionReport
+    from moveplan.core.execution import PlanExecution
 
 __all__ = [
+    "EXECUTION_RESULT_TOPIC",
     "BagSummary",
     "PlanFile",
     "PlanStepRecord",
     "TopicSummary",
     "read_plan",
     "summarize",
+    "write_execution",
     "write_plan",
 ]
 
+EXECUTION_RESULT_TOPIC = "/moveplan/execution_result"
+"""Topic of an executed file's result: a std_msgs/String holding the result JSON."""
+
 _TRAJECTORY = "/planned_trajectory"
+_ROBOT_DESCRIPTION = "/robot_description"
 # topic -> (message type, latched). Latched topics are offered transient_local, so a late
 # subscriber (RViz, robot_state_publisher) still gets them from `ros2 bag play`. The
 # trajectory stays volatile: a controller that joins late must not receive a stale step.
@@ -62,6 +79,17 @@ _TOPICS: dict[str, tuple[str, bool]] = {
 }
 _PLAN_KEYS = ("robot_name", "group", "planning_frame", "step_names", "limits", "distro")
 _MEDIA_TYPES = {".urdf": "application/xml", ".srdf": "application/xml", ".yaml": "application/yaml"}
+_STRING = "std_msgs/msg/String"
+_JOINT_STATE = "sensor_msgs/msg/JointState"
+_CONTROLLER_STATE = "control_msgs/msg/JointTrajectoryControllerState"
+_TF = "tf2_msgs/msg/TFMessage"
+# Where each output interface's command goes in the controller state's `output` point.
+_OUTPUT_FIELDS = {
+    "position": "positions",
+    "velocity": "velocities",
+    "acceleration": "accelerations",
+    "effort": "effort",
+}
 _MAGIC = b"\x89MCAP0\r\n"
 # What mcap and the decompressors raise on a damaged file (lz4 raises RuntimeError).
 _DAMAGE = (McapError, EOFError, ValueError, struct.error, RuntimeError, zstandard.ZstdError)
@@ -78,7 +106,10 @@ class PlanStepRecord:
 
 @dataclass(frozen=True)
 class PlanFile:
-    """A plan read back from an MCAP file: its steps plus what execute and checks need."""
+    """A plan read back from an MCAP file: its steps plus what execute and checks need.
+
+    `urdf` is the text of the file's /robot_description, "" if it has none.
+    """
 
     robot_name: str
     group: str
@@ -88,6 +119,7 @@ class PlanFile:
     attachments: dict[str, bytes]
     metadata: dict[str, str]
     limits: dict[str, dict[str, float]]
+    urdf: str = ""
 
 
 @dataclass(frozen=True)
@@ -134,22 +166,87 @@ def write_plan(path: Path, plan: Plan, distro: str = "jazzy") -> None:
         "limits": json.dumps(plan.limits, sort_keys=True),
         "distro": distro,
     }
-    with _atomic_writer(path) as writer:
-        schema_ids: dict[str, int] = {}
-        channel_ids: dict[str, int] = {}
-        for topic in dict.fromkeys(topic for topic, _, _ in messages):
-            msgtype, latched = _TOPICS[topic]
-            if msgtype not in schema_ids:
-                schema_ids[msgtype] = writer.register_schema(msgtype, "ros2msg", schemas[msgtype])
-            qos = {"offered_qos_profiles": msgs.offered_qos_profiles(latched)}
-            channel_ids[topic] = writer.register_channel(topic, "cdr", schema_ids[msgtype], qos)
-        for topic, log_time_ns, data in messages:
-            writer.add_message(channel_ids[topic], log_time_ns, data, publish_time=log_time_ns)
-        writer.add_metadata("rosbag2", {"ROS_DISTRO": distro})
-        writer.add_metadata("moveplan", metadata)
-        for name, content in plan.attachments.items():
-            media_type = _MEDIA_TYPES.get(Path(name).suffix.lower(), "application/octet-stream")
-            writer.add_attachment(0, 0, name, media_type, content)
+    topics = {topic: _TOPICS[topic] for topic in dict.fromkeys(t for t, _, _ in messages)}
+    _write_bag(
+        path,
+        topics,
+        schemas,
+        messages,
+        {"rosbag2": {"ROS_DISTRO": distro}, "moveplan": metadata},
+        plan.attachments,
+    )
+
+
+def write_execution(
+    path: Path, execution: PlanExecution, distro: str = "jazzy", tf: TfSamples | None = None
+) -> None:
+    """Write what `execution` did to `path` as a ROS 2 bag for `distro`, atomically; return None.
+
+    Log times run from 0, the execution's start; each step starts where the one before it
+    ended (its start plus its duration_s). Per control cycle: /joint_states (measured
+    state) and /<controller>/controller_state (JointTrajectoryControllerState in the
+    layout of `distro`). Once: /robot_description (the plan's URDF, if it has one) and
+    the result as JSON, on EXECUTION_RESULT_TOPIC and in the metadata record
+    "moveplan_execution" (one JSON value per key). /tf only if `tf` is given (times on
+    the execution's timeline). An execution that never started writes no cycles.
+
+    Raises:
+        UsageError: `distro` has no shipped message definitions.
+        InputError: `path` cannot be written.
+        ValueError: A step's output interface is not a JTC command interface.
+
+    """
+    controller = execution.controller
+    urdf = _plan_urdf(execution.plan)
+    state_topic = f"/{controller.name}/controller_state"
+    # Channels exist even without messages (an execution refused before its first cycle),
+    # so every executed file has the same topics and schemas.
+    topics = {_ROBOT_DESCRIPTION: (_STRING, True)} if urdf else {}
+    topics |= {"/joint_states": (_JOINT_STATE, False), state_topic: (_CONTROLLER_STATE, False)}
+    if tf is not None:
+        topics["/tf"] = (_TF, False)
+    # Latched: a late subscriber (a dashboard, `ros2 topic echo`) still gets the verdict.
+    topics[EXECUTION_RESULT_TOPIC] = (_STRING, True)
+    schemas = {msgtype: msgs.schema_text(msgtype, distro) for msgtype, _ in topics.values()}
+    string = _encoder(_STRING, schemas[_STRING])
+
+    messages: list[tuple[str, int, bytes]] = []
+    if urdf:
+        messages.append((_ROBOT_DESCRIPTION, 0, string(msgs.string(urdf))))
+    start_ns = 0
+    for step in execution.steps:
+        report = step.report
+        times_ns = _seconds_to_ns(report.times_s)
+        stamps_ns = start_ns + times_ns
+        joint_states = msgs.joint_states_cdr(
+            report.joint_names, stamps_ns, report.actual_positions, report.actual_velocities
+        )
+        states = _controller_states(report, controller, stamps_ns, times_ns)
+        controller_states = msgs.controller_states_cdr(states, distro)
+        for stamp, joint_state, state in zip(
+            stamps_ns.tolist(), joint_states, controller_states, strict=True
+        ):
+            messages += [("/joint_states", stamp, joint_state), (state_topic, stamp, state)]
+        # Integer nanoseconds, as for plan steps: no drift over many steps.
+        start_ns += msgs.seconds_to_ns(report.duration_s)
+    if tf is not None:
+        tf_stamps = _seconds_to_ns(tf.times_s).tolist()
+        encoded = msgs.tf_messages_cdr(tf.parents, tf.children, tf.transforms, tf_stamps)
+        messages += [("/tf", stamp, data) for stamp, data in zip(tf_stamps, encoded, strict=True)]
+    document = _execution_document(execution)
+    # Logged when the last step ended: that is when the result was known.
+    messages.append((EXECUTION_RESULT_TOPIC, start_ns, string(msgs.string(json.dumps(document)))))
+    # A stable sort: within a cycle the joint state comes before the controller state.
+    messages.sort(key=lambda item: item[1])
+    metadata = {key: json.dumps(value) for key, value in document.items()}
+    _write_bag(
+        path,
+        topics,
+        schemas,
+        messages,
+        {"rosbag2": {"ROS_DISTRO": distro}, "moveplan_execution": metadata},
+        {},
+    )
 
 
 def read_plan(path: Path) -> PlanFile:
@@ -160,7 +257,7 @@ def read_plan(path: Path) -> PlanFile:
 
     """
     with _open_mcap(path) as stream:
-        contents = _scan(path, stream, keep_topic=_TRAJECTORY)
+        contents = _scan(path, stream, keep_topics=(_TRAJECTORY, _ROBOT_DESCRIPTION))
     info = next((m.metadata for m in contents.metadata if m.name == "moveplan"), {})
     if any(key not in info for key in _PLAN_KEYS):
         raise InputError(f"{path}: not a moveplan plan file (no complete 'moveplan' metadata)")
@@ -172,14 +269,15 @@ def read_plan(path: Path) -> PlanFile:
         }
     except (ValueError, TypeError, AttributeError) as exc:
         raise InputError(f"{path}: 'moveplan' metadata is malformed: {exc}") from exc
-    if len(contents.kept) != len(step_names):
+    kept = [item for item in contents.kept if item[0].topic == _TRAJECTORY]
+    if len(kept) != len(step_names):
         raise InputError(
-            f"{path}: {len(contents.kept)} messages on {_TRAJECTORY} "
+            f"{path}: {len(kept)} messages on {_TRAJECTORY} "
             f"but {len(step_names)} step names in its metadata"
         )
     factory = DecoderFactory()
     steps = []
-    for name, (channel, schema, message) in zip(step_names, contents.kept, strict=True):
+    for name, (channel, schema, message) in zip(step_names, kept, strict=True):
         decode = factory.decoder_for(channel.message_encoding, schema)
         if decode is None or schema is None or schema.name != _TOPICS[_TRAJECTORY][0]:
             raise InputError(
@@ -193,6 +291,7 @@ def read_plan(path: Path) -> PlanFile:
                 f"{path}: step '{name}' on {_TRAJECTORY} is unreadable: {exc}"
             ) from exc
         steps.append(PlanStepRecord(name, message.log_time / 1e9, trajectory))
+    descriptions = [item for item in contents.kept if item[0].topic == _ROBOT_DESCRIPTION]
     return PlanFile(
         robot_name=info["robot_name"],
         group=info["group"],
@@ -202,6 +301,7 @@ def read_plan(path: Path) -> PlanFile:
         attachments={attachment.name: attachment.data for attachment in contents.attachments},
         metadata={key: value for key, value in info.items() if key not in _PLAN_KEYS},
         limits=limits,
+        urdf=_robot_description(path, factory, descriptions),
     )
 
 
@@ -218,7 +318,7 @@ def summarize(path: Path) -> BagSummary:
         indexed = _summary_from_index(stream)
         if indexed is not None:
             return indexed
-        contents = _scan(path, stream, keep_topic=None)
+        contents = _scan(path, stream, keep_topics=())
     return _bag_summary(
         contents.header or Header(profile="", library=""),
         contents.start_ns,
@@ -256,6 +356,154 @@ def _atomic_writer(path: Path) -> Iterator[Writer]:
         if isinstance(exc, OSError):
             raise InputError(f"{path}: cannot write: {exc.strerror or exc}") from exc
         raise
+
+
+def _write_bag(
+    path: Path,
+    topics: Mapping[str, tuple[str, bool]],
+    schemas: Mapping[str, bytes],
+    messages: list[tuple[str, int, bytes]],
+    metadata: Mapping[str, dict[str, str]],
+    attachments: Mapping[str, bytes],
+) -> None:
+    """Write a ROS 2 bag to `path` atomically; return None.
+
+    `topics` maps topic -> (message type, latched), in channel order; `schemas` maps
+    message type -> schema text; `messages` are (topic, log time [ns], CDR), in log-time
+    order; then metadata records and attachments, in order.
+    """
+    with _atomic_writer(path) as writer:
+        schema_ids: dict[str, int] = {}
+        channel_ids: dict[str, int] = {}
+        for topic, (msgtype, latched) in topics.items():
+            if msgtype not in schema_ids:
+                schema_ids[msgtype] = writer.register_schema(msgtype, "ros2msg", schemas[msgtype])
+            qos = {"offered_qos_profiles": msgs.offered_qos_profiles(latched)}
+            channel_ids[topic] = writer.register_channel(topic, "cdr", schema_ids[msgtype], qos)
+        add_message = writer.add_message
+        for topic, log_time_ns, data in messages:
+            add_message(channel_ids[topic], log_time_ns, data, log_time_ns)
+        for name, record in metadata.items():
+            writer.add_metadata(name, record)
+        for name, content in attachments.items():
+            media_type = _MEDIA_TYPES.get(Path(name).suffix.lower(), "application/octet-stream")
+            writer.add_attachment(0, 0, name, media_type, content)
+
+
+def _plan_urdf(plan: PlanFile) -> str:
+    """Return the plan's URDF: its /robot_description, else its one .urdf attachment, else ""."""
+    if plan.urdf:
+        return plan.urdf
+    urdfs = [data for name, data in plan.attachments.items() if name.lower().endswith(".urdf")]
+    return urdfs[0].decode() if len(urdfs) == 1 else ""
+
+
+def _seconds_to_ns(times_s: npt.ArrayLike) -> NDArray[np.int64]:
+    """Return times in [s] as the nearest int64 [ns], as `msgs.seconds_to_ns` rounds each."""
+    # np.rint and round() both round the same float product half to even.
+    return np.rint(np.asarray(times_s, dtype=np.float64) * 1e9).astype(np.int64)
+
+
+def _controller_states(
+    report: ExecutionReport,
+    controller: ControllerConfig,
+    stamps_ns: NDArray[np.int64],
+    times_ns: NDArray[np.int64],
+) -> msgs.ControllerStates:
+    """Return the state messages a JTC publishes over `report`'s cycles.
+
+    Filled as ros2_controllers fills them: reference = the sample at the cycle time
+    (positions, velocities, accelerations); feedback = what the state interfaces read,
+    velocities only with a velocity state interface; error positions = reference - feedback
+    (shortest angle for continuous joints); velocity error only where JTC computes it,
+    else 0 (see tolerances.velocity_error_computable); output = the command written, in
+    its interface's field. The plants model no acceleration state, read as 0.
+    """
+    if report.output_interface not in _OUTPUT_FIELDS:
+        raise ValueError(
+            f"output interface '{report.output_interface}' is not one of "
+            f"{', '.join(_OUTPUT_FIELDS)}"
+        )
+    zeros = np.zeros_like(report.actual_positions)
+    has_velocity = "velocity" in controller.state_interfaces
+    # JTC reads acceleration states only together with velocity states.
+    has_acceleration = has_velocity and "acceleration" in controller.state_interfaces
+    velocity_error = report.reference_velocities - report.actual_velocities
+    acceleration_error = report.reference_accelerations  # minus the acceleration read, 0
+    computes_acceleration = "acceleration" in controller.command_interfaces
+    return msgs.ControllerStates(
+        joint_names=report.joint_names,
+        stamps_ns=stamps_ns,
+        times_from_start_ns=times_ns,
+        reference=msgs.PointSeries(
+            report.reference_positions,
+            report.reference_velocities,
+            report.reference_accelerations,
+        ),
+        feedback=msgs.PointSeries(
+            report.actual_positions,
+            report.actual_velocities if has_velocity else None,
+            zeros if has_acceleration else None,
+        ),
+        error=msgs.PointSeries(
+            report.error,
+            (velocity_error if velocity_error_computable(controller) else zeros)
+            if has_velocity
+            else None,
+            (acceleration_error if computes_acceleration else zeros) if has_acceleration else None,
+        ),
+        output=msgs.PointSeries(**{_OUTPUT_FIELDS[report.output_interface]: report.output}),
+    )
+
+
+def _execution_document(execution: PlanExecution) -> dict[str, Any]:
+    """Return the result JSON document of an execution; non-finite numbers become null.
+
+    Keys: ok, result {code, name, message}, violations (each with its step; times from the
+    step's start), margins, then controller, duration_s and steps (name, ok, result,
+    start_s and duration_s on the execution's timeline).
+    """
+    steps, start_ns = [], 0
+    for step in execution.steps:
+        report = step.report
+        steps.append(
+            {
+                "name": step.name,
+                "ok": report.ok,
+                "result": report.result.name,
+                "start_s": start_ns / 1e9,
+                "duration_s": _finite(report.duration_s),
+            }
+        )
+        start_ns += msgs.seconds_to_ns(report.duration_s)
+    result = execution.result
+    return {
+        "ok": execution.ok,
+        "result": {"code": result.code, "name": result.name, "message": result.message},
+        "violations": [
+            {
+                "step": name,
+                "check": v.check,
+                "joint": v.joint,
+                "time_s": _finite(v.time_s),
+                "reference": _finite(v.reference),
+                "actual": _finite(v.actual),
+                "error": _finite(v.error),
+                "tolerance": _finite(v.tolerance),
+            }
+            for name, v in execution.violations
+        ],
+        "margins": {joint: _finite(margin) for joint, margin in execution.margins.items()},
+        "controller": execution.controller.name,
+        "duration_s": start_ns / 1e9,
+        "steps": steps,
+    }
+
+
+def _finite(value: float) -> float | None:
+    """Return `value` as a float, or None (JSON null) if NaN or infinite (a diverged plant)."""
+    number = float(value)
+    return number if math.isfinite(number) else None
 
 
 def _plan_messages(plan: Plan, schemas: dict[str, bytes]) -> list[tuple[str, int, bytes]]:
@@ -320,7 +568,7 @@ def _encoder(msgtype: str, schema_text: bytes) -> Callable[[dict[str, Any]], byt
 
 @dataclass(frozen=True)
 class _Contents:
-    """What a linear pass over an MCAP file found; `kept` holds one topic's messages."""
+    """What a linear pass over an MCAP file found; `kept` holds the kept topics' messages."""
 
     header: Header | None
     schemas: dict[int, Schema]
@@ -383,8 +631,8 @@ def _summary_from_index(stream: IO[bytes]) -> BagSummary | None:
     )
 
 
-def _scan(path: Path, stream: IO[bytes], keep_topic: str | None) -> _Contents:
-    """Return the contents of an MCAP file read record by record, keeping `keep_topic`'s messages.
+def _scan(path: Path, stream: IO[bytes], keep_topics: Collection[str]) -> _Contents:
+    """Return the contents of an MCAP file read record by record, keeping `keep_topics`' messages.
 
     A file that stops on a record boundary without a footer (its writer never finished)
     is read as far as it goes; one that stops inside a record is truncated.
@@ -410,7 +658,7 @@ def _scan(path: Path, stream: IO[bytes], keep_topic: str | None) -> _Contents:
                 raise InputError(f"{path}: a message uses undefined channel {record.channel_id}")
             counts[record.channel_id] += 1
             times.append(record.log_time)
-            if channel.topic == keep_topic:
+            if channel.topic in keep_topics:
                 kept.append((channel, schemas.get(channel.schema_id), record))
         elif isinstance(record, Metadata):
             metadata.append(record)
@@ -448,6 +696,31 @@ def _records(path: Path, stream: IO[bytes]) -> Iterator[McapRecord]:
                 message = f"corrupt MCAP data: {type(exc).__name__}: {exc}".removesuffix(": ")
             raise InputError(f"{path}: {message}") from exc
         yield record
+
+
+def _robot_description(
+    path: Path,
+    factory: DecoderFactory,
+    kept: list[tuple[Channel, Schema | None, Message]],
+) -> str:
+    """Return the URDF text of the first /robot_description message, "" if there is none.
+
+    Raises:
+        InputError: The message is not a readable std_msgs/msg/String.
+
+    """
+    if not kept:
+        return ""
+    channel, schema, message = kept[0]
+    decode = factory.decoder_for(channel.message_encoding, schema)
+    if decode is None or schema is None or schema.name != _STRING:
+        raise InputError(
+            f"{path}: {_ROBOT_DESCRIPTION} must hold a CDR {_STRING} with a ros2msg schema"
+        )
+    try:
+        return str(decode(message.data).data)
+    except (*_DAMAGE, TypeError, IndexError, AttributeError) as exc:
+        raise InputError(f"{path}: {_ROBOT_DESCRIPTION} is unreadable: {exc}") from exc
 
 
 def _cut_record(stream: IO[bytes]) -> int | None:

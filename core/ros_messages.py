@@ -4,16 +4,19 @@ Messages are plain dicts for a schema-driven CDR encoder. Field names follow the
 definitions in core/msgs; a field left out is written with its default (zero, empty or
 the definition's constant) by the encoder.
 
-The big, numerous messages (trajectories, /tf) also have `*_cdr` twins that write CDR
-bytes directly with bulk float packing: a generic encoder spends a Python call per float.
-Each twin writes exactly the bytes the generic encoder makes of its dict builder's message
-(the field layout is the same in every shipped distro; tests/test_recording.py checks both).
+The big, numerous messages (trajectories, /tf, joint states, controller states) also have
+`*_cdr` twins that write CDR bytes directly with bulk float packing: a generic encoder
+spends a Python call per float. Each twin writes exactly the bytes the generic encoder
+makes of its dict builder's message (tests/test_recording.py and tests/test_execution_file.py
+check every shipped distro). The field layout is the same in every distro except
+control_msgs/JointTrajectoryControllerState, whose builders read it from the distro's schema.
 """
 
 from __future__ import annotations
 
 import re
 from collections.abc import Sequence
+from dataclasses import dataclass, fields
 from functools import cache
 from importlib.resources import files
 from pathlib import Path
@@ -24,12 +27,18 @@ from numpy.typing import NDArray
 
 from moveplan.core.cdr import CdrWriter, patched_copies, time_array
 from moveplan.core.errors import UsageError, known
-from moveplan.core.types import CollisionObject, JointTrajectory
+from moveplan.core.types import CollisionObject, JointTrajectory, frozen_array
 
 __all__ = [
+    "ControllerStates",
+    "PointSeries",
+    "controller_state",
+    "controller_states_cdr",
     "display_trajectory",
     "display_trajectory_cdr",
     "durability",
+    "joint_state",
+    "joint_states_cdr",
     "joint_trajectory",
     "joint_trajectory_cdr",
     "marker_array",
@@ -49,6 +58,75 @@ _MARKER_TYPES = {"box": 1, "sphere": 2, "cylinder": 3, "mesh": 10}  # CUBE, SPHE
 # MoveIt's RViz defaults: scene objects green, attached objects purple.
 _SCENE_COLOR = {"r": 0.2, "g": 0.9, "b": 0.2, "a": 0.9}
 _ATTACHED_COLOR = {"r": 0.6, "g": 0.2, "b": 0.6, "a": 0.9}
+_CONTROLLER_STATE = "control_msgs/msg/JointTrajectoryControllerState"
+# Humble's deprecated points repeat the new ones: ros2_controllers#1985 fills `desired`
+# from the reference and `actual` from the feedback.
+_POINT_SOURCES = {
+    "reference": "reference",
+    "feedback": "feedback",
+    "error": "error",
+    "output": "output",
+    "desired": "reference",
+    "actual": "feedback",
+}
+
+
+@dataclass(frozen=True)
+class PointSeries:
+    """A trajectory_msgs/JointTrajectoryPoint per cycle: each field (K, n), or None = left empty.
+
+    As in JTC's state message, a field holds a value for every joint or is empty.
+    """
+
+    positions: NDArray[np.float64] | None = None
+    velocities: NDArray[np.float64] | None = None
+    accelerations: NDArray[np.float64] | None = None
+    effort: NDArray[np.float64] | None = None
+
+    def filled(self) -> list[NDArray[np.float64] | None]:
+        """Return positions, velocities, accelerations, effort in message field order."""
+        return [self.positions, self.velocities, self.accelerations, self.effort]
+
+
+@dataclass(frozen=True)
+class ControllerStates:
+    """A JointTrajectoryController's state over K cycles, one JointTrajectoryControllerState each.
+
+    Attributes:
+        joint_names: The controller's joints, the column order of every array (n).
+        stamps_ns: header.stamp of each cycle in [ns], shape (K,).
+        times_from_start_ns: time_from_start of each cycle's points in [ns], shape (K,).
+        reference, feedback, error, output: The message's points, fields (K, n) or None.
+
+    """
+
+    joint_names: tuple[str, ...]
+    stamps_ns: NDArray[np.int64]
+    times_from_start_ns: NDArray[np.int64]
+    reference: PointSeries
+    feedback: PointSeries
+    error: PointSeries
+    output: PointSeries
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "joint_names", tuple(self.joint_names))
+        stamps = np.array(self.stamps_ns, dtype=np.int64).reshape(-1)
+        times = np.array(self.times_from_start_ns, dtype=np.int64).reshape(-1)
+        if times.shape != stamps.shape:
+            raise ValueError(
+                f"times_from_start_ns: expected shape {stamps.shape}, got {times.shape}"
+            )
+        object.__setattr__(self, "stamps_ns", stamps)
+        object.__setattr__(self, "times_from_start_ns", times)
+        shape = (len(stamps), len(self.joint_names))
+        for name in ("reference", "feedback", "error", "output"):
+            series: PointSeries = getattr(self, name)
+            checked = {
+                field.name: frozen_array(value, shape, f"{name}.{field.name}")
+                for field, value in zip(fields(series), series.filled(), strict=True)
+                if value is not None
+            }
+            object.__setattr__(self, name, PointSeries(**checked))
 
 
 @cache
@@ -175,6 +253,51 @@ def tf_message(
     }
 
 
+def joint_state(
+    names: Sequence[str],
+    stamp_ns: int,
+    positions: NDArray[np.float64],
+    velocities: NDArray[np.float64],
+    frame_id: str = "",
+) -> Message:
+    """Return a sensor_msgs/JointState of measured positions and velocities, no effort."""
+    return {
+        "header": {"stamp": time_msg(stamp_ns), "frame_id": frame_id},
+        "name": list(names),
+        "position": np.asarray(positions, dtype=np.float64).tolist(),
+        "velocity": np.asarray(velocities, dtype=np.float64).tolist(),
+        "effort": [],
+    }
+
+
+def controller_state(states: ControllerStates, index: int, distro: str) -> Message:
+    """Return cycle `index` of `states` as a JointTrajectoryControllerState laid out for `distro`.
+
+    Multi-DOF fields stay empty and speed_scaling_factor (Jazzy) is 1.0; header.frame_id is
+    empty, as JTC leaves it.
+    """
+    tfs = time_msg(int(states.times_from_start_ns[index]))
+    message: Message = {}
+    for kind, name in _controller_state_fields(distro):
+        if kind == "header":
+            message[name] = {"stamp": time_msg(int(states.stamps_ns[index])), "frame_id": ""}
+        elif kind == "names":
+            message[name] = list(states.joint_names) if name == "joint_names" else []
+        elif kind == "point":
+            series: PointSeries = getattr(states, _POINT_SOURCES[name])
+            point = {
+                field.name: [] if value is None else value[index].tolist()
+                for field, value in zip(fields(series), series.filled(), strict=True)
+            }
+            message[name] = {**point, "time_from_start": tfs}
+        elif kind == "multi_dof_point":
+            empty: Message = {"transforms": [], "velocities": [], "accelerations": []}
+            message[name] = {**empty, "time_from_start": time_msg(0)}
+        else:
+            message[name] = 1.0  # speed_scaling_factor: JTC without scaling runs at 1
+    return message
+
+
 def joint_trajectory_cdr(trajectory: JointTrajectory, frame_id: str) -> bytes:
     """Return `joint_trajectory(trajectory, frame_id)` encoded as CDR."""
     writer = CdrWriter()
@@ -243,6 +366,62 @@ def tf_messages_cdr(
     return [message.tobytes() for message in messages]
 
 
+def joint_states_cdr(
+    names: Sequence[str],
+    stamps_ns: NDArray[np.int64],
+    positions: NDArray[np.float64],
+    velocities: NDArray[np.float64],
+    frame_id: str = "",
+) -> list[bytes]:
+    """Return one CDR `joint_state` per stamp; `positions` and `velocities` are (stamps, joints)."""
+    template = CdrWriter()
+    stamp_at = template.time(0)
+    template.string(frame_id)
+    template.strings(names)
+    zeros = np.zeros(len(names))
+    position_at = template.float64_sequence(zeros)
+    velocity_at = template.float64_sequence(zeros)
+    template.uint32(0)  # effort[]
+    patches: list[tuple[int, NDArray[np.generic]]] = [
+        (stamp_at, time_array(stamps_ns)),
+        (position_at, _column(positions)),
+        (velocity_at, _column(velocities)),
+    ]
+    return _copies(template.data(), len(stamps_ns), patches)
+
+
+def controller_states_cdr(states: ControllerStates, distro: str) -> list[bytes]:
+    """Return every cycle of `states` as CDR `controller_state`, laid out for `distro`."""
+    # Every message of a series has the same names and array lengths, so the same layout
+    # and padding: one template, patched per cycle.
+    template = CdrWriter()
+    count = len(states.stamps_ns)
+    times = time_array(states.times_from_start_ns)
+    zeros = np.zeros(len(states.joint_names))
+    patches: list[tuple[int, NDArray[np.generic]]] = []
+    for kind, name in _controller_state_fields(distro):
+        if kind == "header":
+            patches.append((template.time(0), time_array(states.stamps_ns)))
+            template.string("")
+        elif kind == "names":
+            template.strings(states.joint_names if name == "joint_names" else ())
+        elif kind == "point":
+            series: PointSeries = getattr(states, _POINT_SOURCES[name])
+            for values in series.filled():
+                if values is None:
+                    template.uint32(0)
+                else:
+                    patches.append((template.float64_sequence(zeros), _column(values)))
+            patches.append((template.time(0), times))
+        elif kind == "multi_dof_point":
+            for _ in range(3):  # transforms[], velocities[], accelerations[]
+                template.uint32(0)
+            template.time(0)
+        else:
+            template.float64_array(np.ones(1))  # speed_scaling_factor
+    return _copies(template.data(), count, patches)
+
+
 def marker_array(objects: Sequence[CollisionObject], planning_frame: str) -> Message:
     """Return a visualization_msgs/MarkerArray with one marker per collision object."""
     return {"markers": [_marker(obj, index, planning_frame) for index, obj in enumerate(objects)]}
@@ -308,6 +487,55 @@ def _write_joint_trajectory(writer: CdrWriter, trajectory: JointTrajectory, fram
     columns: list[NDArray[np.generic]] = [*arrays, time_array(times_ns)]
     patches = [(index - start, column[2:]) for index, column in zip(indexes, columns, strict=True)]
     writer.raw(patched_copies(template, len(times_ns) - 2, patches).tobytes())
+
+
+@cache
+def _controller_state_fields(distro: str) -> tuple[tuple[str, str], ...]:
+    """Return (kind, name) of each JointTrajectoryControllerState field of `distro`, in order.
+
+    Read from the shipped schema, as the layouts differ (Humble keeps the deprecated
+    desired/actual points, Jazzy adds speed_scaling_factor). Kinds: header, names, point,
+    multi_dof_point, scale.
+
+    Raises:
+        UsageError: `distro` has no shipped message definitions.
+        ValueError: The schema has a field these encoders do not know.
+
+    """
+    kinds = {
+        "std_msgs/Header": "header",
+        "string[]": "names",
+        "trajectory_msgs/JointTrajectoryPoint": "point",
+        "trajectory_msgs/MultiDOFJointTrajectoryPoint": "multi_dof_point",
+        "float64": "scale",
+    }
+    root = schema_text(_CONTROLLER_STATE, distro).decode().split("\n" + "=" * 80)[0]
+    result = []
+    for line in root.splitlines():
+        words = line.split("#", 1)[0].split()
+        if not words or "=" in line.split("#", 1)[0]:
+            continue  # blank, comment or constant
+        msgtype, name = words[0], words[1]
+        kind = kinds.get(msgtype)
+        known_point = kind != "point" or name in _POINT_SOURCES
+        if kind is None or not known_point or (kind == "scale" and name != "speed_scaling_factor"):
+            raise ValueError(f"{_CONTROLLER_STATE} ({distro}): unexpected field '{msgtype} {name}'")
+        result.append((kind, name))
+    return tuple(result)
+
+
+def _column(values: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Return (rows, n) values as little-endian float64 rows, for `patched_copies`."""
+    return np.asarray(values).astype("<f8", copy=False)
+
+
+def _copies(
+    template: bytes, count: int, patches: list[tuple[int, NDArray[np.generic]]]
+) -> list[bytes]:
+    """Return `count` copies of `template` patched row by row, as separate messages."""
+    if count == 0:
+        return []
+    return [row.tobytes() for row in patched_copies(template, count, patches)]
 
 
 def _xyz(transform: NDArray[np.float64]) -> Message:

@@ -28,7 +28,7 @@ logger = logging.getLogger(__name__)
 logging.getLogger("toppra").setLevel(logging.CRITICAL)
 
 _ATTEMPTS = 6
-_GRID_INTERVALS = 200
+_GRID_INTERVALS = 100
 
 
 def resample_path(waypoints: NDArray[np.float64], max_step: float) -> NDArray[np.float64]:
