@@ -177,7 +177,7 @@ def execute(
         if output is not None:
             from moveplan.core import recording
 
-            recording.write_execution(output, outcome, ros_distro)
+            recording.write_execution(output, outcome, ros_distro, tf=outcome.tf)
     render.execution_summary(outcome, output, as_json, quiet)
     raise typer.Exit(0 if outcome.ok else 5)
 

@@ -21,7 +21,11 @@ from moveplan.core.config import CONFIG_FILE, ControllerConfig, RobotConfig, loa
 from moveplan.core.controller import Disturbance, ExecutionReport, simulate
 from moveplan.core.errors import ConfigError, InputError, UnknownName
 from moveplan.core.plants import make_plant
+from moveplan.core.robot import Robot
 from moveplan.core.tolerances import ExecutionResult, Violation
+from moveplan.core.types import TfSamples
+
+_TF_RATE_HZ = 30.0
 
 __all__ = ["ExecuteRequest", "PlanExecution", "StepExecution", "execute", "plan_config", "pick_controller"]
 
@@ -56,6 +60,7 @@ class PlanExecution:
     steps: tuple[StepExecution, ...]
     controller: ControllerConfig
     plan: recording.PlanFile
+    tf: TfSamples | None = None
 
     @property
     def violations(self) -> tuple[tuple[str, Violation], ...]:
@@ -129,7 +134,26 @@ def execute(request: ExecuteRequest) -> PlanExecution:
             break
         start = report.actual_positions[-1] if len(report.times_s) else start
     last = steps[-1].report
-    return PlanExecution(last.ok, last.result, tuple(steps), controller, plan)
+    tf = _executed_tf(Robot(config, plan.group), steps)
+    return PlanExecution(last.ok, last.result, tuple(steps), controller, plan, tf)
+
+
+def _executed_tf(robot: Robot, steps: list[StepExecution]) -> TfSamples | None:
+    """Return link poses along what the simulated robot did, at a playback rate, steps end to end."""
+    times, values = [], []
+    offset = 0.0
+    for step in steps:
+        report = step.report
+        if len(report.times_s):
+            every = max(1, int(round(1.0 / (_TF_RATE_HZ * np.median(np.diff(report.times_s)))))) if len(report.times_s) > 1 else 1
+            rows = np.unique(np.append(np.arange(0, len(report.times_s), every), len(report.times_s) - 1))
+            columns = [report.joint_names.index(j) for j in robot.joint_names]
+            times.append(offset + report.times_s[rows])
+            values.append(report.actual_positions[rows][:, columns])
+        offset += report.duration_s
+    if not times:
+        return None
+    return robot.tf_samples(np.concatenate(times), np.concatenate(values), robot.neutral())
 
 
 def _start_positions(

@@ -16,7 +16,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pinocchio as pin
 from numpy.typing import NDArray
 
 from moveplan.core import recording
@@ -125,7 +124,7 @@ def plan(request: PlanRequest) -> Plan:
         planning_frame=robot.root_link,
         steps=tuple(steps),
         urdf=config.urdf,
-        static_frames=_static_frames(robot, scene, base),
+        static_frames=(*robot.fixed_frames(), *scene.frames),
         objects=scene.objects,
         tf=_tf_samples(robot, base, steps),
         limits={j: {"lower": float(robot.lower[i]), "upper": float(robot.upper[i]),
@@ -269,40 +268,18 @@ def _describe(goal: dict[str, Any]) -> dict[str, Any]:
             for k, v in goal.items()}
 
 
-def _static_frames(robot: Robot, scene: Scene, base: NDArray[np.float64]) -> tuple[Frame, ...]:
-    """Return scene frames plus the robot's fixed joints, as robot_state_publisher would latch them."""
-    pin.framesForwardKinematics(robot.model, robot.data, base)
-    fixed = []
-    for joint in robot.config.urdf_joints.values():
-        if joint.type == "fixed":
-            fixed.append(Frame(joint.child, joint.parent, _relative(robot, base, joint.parent, joint.child)))
-    return (*fixed, *scene.frames)
-
-
-def _relative(robot: Robot, q: NDArray[np.float64], parent: str, child: str) -> NDArray[np.float64]:
-    data = robot.data
-    model = robot.model
-    return np.array((data.oMf[model.getFrameId(parent)].inverse() * data.oMf[model.getFrameId(child)]).homogeneous)
-
-
 def _tf_samples(robot: Robot, base: NDArray[np.float64], steps: list[StepResult]) -> TfSamples:
     """Return the moving joints' transforms along the whole plan, at a playback rate."""
-    moving = [j for j in robot.config.urdf_joints.values() if j.type != "fixed"]
-    times_all, rows = [], []
+    times, values = [], []
     offset = 0.0
     for step in steps:
         trajectory = step.trajectory
         count = max(2, int(np.ceil(trajectory.duration_s * _TF_RATE_HZ)) + 1)
-        times = np.linspace(0.0, trajectory.duration_s, count)
-        positions, _, _ = sample(trajectory, times)
-        for t, values in zip(times, positions, strict=True):
-            q = robot.configuration(values, base)
-            pin.framesForwardKinematics(robot.model, robot.data, q)
-            rows.append([_relative(robot, q, j.parent, j.child) for j in moving])
-            times_all.append(offset + t)
+        local = np.linspace(0.0, trajectory.duration_s, count)
+        values.append(sample(trajectory, local)[0])
+        times.append(offset + local)
         offset += trajectory.duration_s
-    return TfSamples(np.array(times_all), tuple(j.parent for j in moving), tuple(j.child for j in moving),
-                     np.array(rows).reshape(len(times_all), len(moving), 4, 4))
+    return robot.tf_samples(np.concatenate(times), np.concatenate(values), base)
 
 
 def _attachments(config: RobotConfig, request: PlanRequest) -> dict[str, bytes]:

@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from moveplan.core.config import Group, RobotConfig
 from moveplan.core.errors import ConfigError, UnknownName
+from moveplan.core.types import Frame, TfSamples
 
 __all__ = ["Robot"]
 
@@ -25,7 +26,7 @@ class Robot:
         self.config = config
         self.group: Group = config.group(group)
         try:
-            self.model = pin.buildModelFromUrdf(str(config.urdf_path))
+            self.model = pin.buildModelFromXML(config.urdf)
         except (RuntimeError, ValueError) as exc:
             raise ConfigError(f"{config.urdf_path}: pinocchio cannot load the URDF: {exc}") from None
         self.data = self.model.createData()
@@ -96,6 +97,26 @@ class Robot:
         fid = self.model.getFrameId(frame)
         pin.framesForwardKinematics(self.model, self.data, q)
         return np.array(self.data.oMf[fid].homogeneous)
+
+    def fixed_frames(self) -> tuple[Frame, ...]:
+        """Return `parent_T_child` of every fixed URDF joint, as robot_state_publisher latches them."""
+        pin.framesForwardKinematics(self.model, self.data, self.neutral())
+        joints = [j for j in self.config.urdf_joints.values() if j.type == "fixed"]
+        return tuple(Frame(j.child, j.parent, self._relative(j.parent, j.child)) for j in joints)
+
+    def tf_samples(self, times_s: npt.ArrayLike, values: NDArray[np.float64], base: NDArray[np.float64]) -> TfSamples:
+        """Return `parent_T_child` of every moving URDF joint for group values (M, dof) at `times_s`."""
+        moving = [j for j in self.config.urdf_joints.values() if j.type != "fixed"]
+        rows = np.empty((len(values), len(moving), 4, 4))
+        for k, q in enumerate(self.configurations(np.asarray(values, dtype=float), base).T):
+            pin.framesForwardKinematics(self.model, self.data, q)
+            rows[k] = [self._relative(j.parent, j.child) for j in moving]
+        return TfSamples(times_s, tuple(j.parent for j in moving), tuple(j.child for j in moving), rows)
+
+    def _relative(self, parent: str, child: str) -> NDArray[np.float64]:
+        """Return `parent_T_child` from the last forward kinematics."""
+        frames = self.data.oMf
+        return np.array((frames[self.model.getFrameId(parent)].inverse() * frames[self.model.getFrameId(child)]).homogeneous)
 
     @property
     def root_link(self) -> str:
