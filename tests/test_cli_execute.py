@@ -100,3 +100,14 @@ def test_execute_on_a_file_that_is_not_a_plan_exits_3(cli: Cli, tmp_path: Path) 
     result = cli("execute", bad, "--fake")
     assert result.exit_code == 3
     assert "bad.mcap" in result.stderr
+
+
+def test_pid_plant_passes_with_tuned_gains_and_fails_with_mistuned_ones(cli: Cli, plan_file: Path) -> None:
+    tuned, tuned_doc = cli.json("execute", plan_file, "--fake", "--plant", "pid",
+                                "--controllers", SAMPLES / "ur10e_velocity_controllers.yaml")
+    assert tuned == 0, tuned_doc["result"]
+    mistuned, mistuned_doc = cli.json("execute", plan_file, "--fake", "--plant", "pid",
+                                      "--controllers", SAMPLES / "ur10e_mistuned_controllers.yaml")
+    assert mistuned == 5
+    assert mistuned_doc["result"]["name"] == "PATH_TOLERANCE_VIOLATED"
+    assert mistuned_doc["violations"][0]["check"] == "path"
