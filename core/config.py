@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
+from importlib import resources
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +33,7 @@ __all__ = [
     "parse_controllers",
     "number",
     "resolve_config_path",
+    "shipped_configs",
 ]
 
 CONFIG_FILE = "moveplan.yaml"
@@ -218,11 +220,21 @@ _LIMIT_KEYS = {
 def resolve_config_path(robot: str | Path) -> Path:
     """Return the moveplan.yaml a --robot argument names (the file, or a folder holding one)."""
     path = Path(robot)
+    shipped = Path(str(resources.files("moveplan.configs"))) / str(robot)
+    if not path.exists() and path.name == str(robot) and (shipped / CONFIG_FILE).is_file():
+        path = shipped  # a bare name like "ur10e" names a config shipped with moveplan
     if path.is_dir():
         path = path / CONFIG_FILE
     if not path.is_file():
-        raise ConfigError(f"{robot}: robot config not found (expected a {CONFIG_FILE} or a folder holding one)")
+        raise ConfigError(f"{robot}: robot config not found (expected a {CONFIG_FILE} or a folder holding one, "
+                          f"or a shipped config: {known(shipped_configs())})")
     return path
+
+
+def shipped_configs() -> list[str]:
+    """Return the names of the robot configs shipped with moveplan."""
+    folder = Path(str(resources.files("moveplan.configs")))
+    return sorted(p.name for p in folder.iterdir() if (p / CONFIG_FILE).is_file())
 
 
 def load_robot_config(robot: str | Path, package_paths: tuple[Path, ...] = ()) -> RobotConfig:

@@ -38,3 +38,13 @@ def test_robot_on_missing_folder_exits_3_with_one_line(cli: Cli, tmp_path: Path)
     result = cli("robot", tmp_path)
     assert result.exit_code == 3
     assert result.stderr.count("\n") == 1 and "moveplan.yaml" in result.stderr
+
+
+def test_a_bare_name_finds_the_shipped_config(cli: Cli) -> None:
+    code, document = cli.json("robot", "ur10e")
+    assert code == 0 and document["name"] == "ur10e"
+
+
+def test_unknown_bare_name_lists_the_shipped_configs(cli: Cli) -> None:
+    result = cli("robot", "nope")
+    assert result.exit_code == 3 and "ur10e" in result.stderr
