@@ -182,6 +182,33 @@ def execute(
     raise typer.Exit(0 if outcome.ok else 5)
 
 
+@app.command("check-tolerances")
+def check_tolerances(
+    plan_file: Annotated[Path, typer.Argument(metavar="PLAN", help="Plan file written by moveplan plan.")],
+    recording_file: Annotated[Path, typer.Argument(metavar="RECORDING", help="MCAP with sensor_msgs/JointState.")],
+    topic: Annotated[str, typer.Option(help="JointState topic in the recording.")] = "/joint_states",
+    controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml overriding the plan's.")] = None,
+    start: Annotated[str, typer.Option(help="auto, a time [s] from the recording's start, or all.")] = "auto",
+    time_source: Annotated[str, typer.Option(help="header (message stamps) or log (receive times).")] = "header",
+    as_json: JsonOpt = False,
+    quiet: QuietOpt = False,
+    verbose: VerboseOpt = False,
+) -> None:
+    """Check a recording (a ros2 bag of a real robot, or an executed file) against a plan's tolerances."""
+    _logging(verbose, quiet)
+    with exit_codes(as_json):
+        from moveplan.cli import render
+        from moveplan.core.errors import UsageError
+        from moveplan.core.execution import CheckRequest, check
+
+        if time_source not in ("header", "log"):
+            raise UsageError(f"--time-source: expected header or log, got '{time_source}'")
+        when: str | float = start if start in ("auto", "all") else parse_number(start, "--start (auto, all or seconds)")
+        report = check(CheckRequest(plan_file, recording_file, topic, controllers, when, time_source))
+    render.check_summary(report, as_json, quiet)
+    raise typer.Exit(0 if report.ok else 5)
+
+
 @app.command("robot")
 def robot_info(
     config: Annotated[Path, typer.Argument(help="Robot config: a moveplan.yaml or a folder holding one.")],

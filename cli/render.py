@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 from pathlib import Path
 from typing import Any
 
@@ -10,15 +11,17 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from moveplan.core.checking import CheckReport
 from moveplan.core.config import RobotConfig
 from moveplan.core.execution import PlanExecution
 from moveplan.core.recording import BagSummary, PlanFile
 from moveplan.core.trajectory import peak_rates
 from moveplan.core.types import Plan
 
-__all__ = ["execution_summary", "inspect_summary", "plan_summary", "robot_summary"]
+__all__ = ["check_summary", "execution_summary", "inspect_summary", "plan_summary", "robot_summary"]
 
 _console = Console()
+logger = logging.getLogger("moveplan")
 
 
 def _emit(document: dict[str, Any]) -> None:
@@ -152,16 +155,21 @@ def inspect_summary(path: Path, summary: BagSummary, plan: PlanFile | None, as_j
         _console.print(table)
 
 
+def _result(result: Any) -> dict[str, Any]:
+    return {"code": result.code, "name": result.name, "message": result.message}
+
+
+def _violations(violations: Any) -> list[dict[str, Any]]:
+    return [{"check": v.check, "joint": v.joint, "time_s": v.time_s, "reference": v.reference, "actual": v.actual,
+             "error": v.error, "tolerance": v.tolerance, "step": step} for step, v in violations]
+
+
 def execution_document(outcome: PlanExecution) -> dict[str, Any]:
-    """Return the execute / check-tolerances JSON document of an execution."""
+    """Return the execute JSON document of an execution."""
     return {
         "ok": outcome.ok,
-        "result": {"code": outcome.result.code, "name": outcome.result.name, "message": outcome.result.message},
-        "violations": [
-            {"check": v.check, "joint": v.joint, "time_s": v.time_s, "reference": v.reference, "actual": v.actual,
-             "error": v.error, "tolerance": v.tolerance, "step": step}
-            for step, v in outcome.violations
-        ],
+        "result": _result(outcome.result),
+        "violations": _violations(outcome.violations),
         "margins": outcome.margins,
         "duration_s": outcome.duration_s,
         "controller": outcome.controller.name,
@@ -180,8 +188,46 @@ def execution_summary(outcome: PlanExecution, output: Path | None, as_json: bool
         return
     if quiet:
         return
-    colour = "green" if outcome.ok else "red"
-    _console.print(f"[{colour}]{outcome.result.name}[/{colour}] ({outcome.result.code}): {outcome.result.message}")
+    _verdict(document, f"smallest margin to tolerance ({outcome.controller.name})")
+    _console.print(f"executed {len(outcome.steps)} of {len(outcome.plan.steps)} steps in {outcome.duration_s:.3f} s")
+
+
+def check_summary(report: CheckReport, as_json: bool, quiet: bool) -> None:
+    """Print the verdict on a recording (per cycle with --start all), or its JSON document."""
+    for warning in report.warnings:
+        logger.warning("%s", warning)
+    document: dict[str, Any] = {
+        "ok": report.ok, "result": _result(report.result), "violations": _violations(report.violations),
+        "margins": report.margins, "duration_s": report.duration_s, "start_s": report.start_s,
+        "steps": [{"name": s.name, "ok": s.ok, "result": s.report.result.name, "start_s": s.start_s,
+                   "duration_s": s.duration_s, "aligned_by": s.aligned_by} for s in report.steps],
+        "gaps": [{"start_s": start, "length_s": length} for start, length in report.gaps],
+        "warnings": list(report.warnings),
+    }
+    if report.cycles:
+        document["cycles"] = [{"index": c.index, "start_s": c.start_s, "ok": c.ok, "result": _result(c.result),
+                               "worst_margin": c.worst_margin} for c in report.cycles]
+        document["failing_cycles"] = list(report.failing_cycles)
+    if as_json:
+        _emit(document)
+        return
+    if quiet:
+        return
+    _verdict(document, "smallest margin to tolerance")
+    if report.cycles:
+        failing = ", ".join(str(i) for i in report.failing_cycles) or "none"
+        _console.print(f"{len(report.cycles)} executions found; failing: {failing}")
+        for cycle in report.cycles:
+            if not cycle.ok:
+                _console.print(f"  cycle {cycle.index} at {cycle.start_s:.3f} s: {cycle.result.name}: "
+                               f"{cycle.result.message}")
+
+
+def _verdict(document: dict[str, Any], margins_title: str) -> None:
+    """Print a result line, the violations table and the margins table."""
+    result = document["result"]
+    colour = "green" if document["ok"] else "red"
+    _console.print(f"[{colour}]{result['name']}[/{colour}] ({result['code']}): {result['message']}")
     if document["violations"]:
         table = Table(title="violations")
         for column in ("step", "check", "joint", "time [s]", "reference", "actual", "error", "tolerance"):
@@ -191,10 +237,9 @@ def execution_summary(outcome: PlanExecution, output: Path | None, as_json: bool
                           f"{v['actual']:.4f}", f"{v['error']:.4f}", f"{v['tolerance']:.4f}")
         _console.print(table)
     if document["margins"]:
-        table = Table(title=f"smallest margin to tolerance ({outcome.controller.name})")
+        table = Table(title=margins_title)
         table.add_column("joint")
         table.add_column("margin [rad]")
         for joint, margin in document["margins"].items():
             table.add_row(joint, f"[{'red' if margin < 0 else 'green'}]{margin:.4f}[/]")
         _console.print(table)
-    _console.print(f"executed {len(outcome.steps)} of {len(outcome.plan.steps)} steps in {outcome.duration_s:.3f} s")

@@ -18,8 +18,10 @@ from numpy.typing import NDArray
 
 from moveplan.core import recording
 from moveplan.core.config import CONFIG_FILE, ControllerConfig, RobotConfig, load_robot_config, parse_controllers
+from moveplan.core.checking import CheckReport, check_recording
 from moveplan.core.controller import Disturbance, ExecutionReport, simulate
 from moveplan.core.errors import ConfigError, InputError, UnknownName
+from moveplan.core.jointstates import read_joint_states
 from moveplan.core.plants import make_plant
 from moveplan.core.robot import Robot
 from moveplan.core.tolerances import ExecutionResult, Violation
@@ -27,7 +29,10 @@ from moveplan.core.types import TfSamples
 
 _TF_RATE_HZ = 30.0
 
-__all__ = ["ExecuteRequest", "PlanExecution", "StepExecution", "execute", "plan_config", "pick_controller"]
+__all__ = [
+    "CheckRequest", "ExecuteRequest", "PlanExecution", "StepExecution", "check", "execute", "pick_controller",
+    "plan_config",
+]
 
 
 @dataclass(frozen=True)
@@ -41,6 +46,18 @@ class ExecuteRequest:
     start_joints: Mapping[str, float] | None = None
     controllers: Path | None = None
     seed: int = 0
+
+
+@dataclass(frozen=True)
+class CheckRequest:
+    """What `moveplan check-tolerances` was asked to check."""
+
+    plan: Path
+    recording: Path
+    topic: str = "/joint_states"
+    controllers: Path | None = None
+    start: str | float = "auto"
+    time_source: str = "header"
 
 
 @dataclass(frozen=True)
@@ -112,13 +129,7 @@ def execute(request: ExecuteRequest) -> PlanExecution:
     """Return what executing the plan through the simulated controller did."""
     plan = recording.read_plan(request.plan)
     config = plan_config(plan, request.plan)
-    controllers = config.controllers
-    source = str(config.root / "ros2_controllers.yaml")
-    if request.controllers is not None:
-        controllers = parse_controllers(request.controllers)
-        source = str(request.controllers)
-    joints = plan.steps[0].trajectory.joint_names
-    controller = pick_controller(controllers, joints, source)
+    controller = _controller(config, plan, request.controllers)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
     plant = make_plant(request.plant, dict(request.plant_params or {}), controller, continuous)
     start = _start_positions(request, plan, controller)
@@ -169,3 +180,22 @@ def _start_positions(
             raise UnknownName("joint", joint, "--start-joints", start)
         start[joint] = value
     return np.array([start[j] for j in controller.joints if j in start])
+
+
+def check(request: CheckRequest) -> CheckReport:
+    """Return the verdict of the controller's and MoveIt's rules on a recorded execution of a plan."""
+    plan = recording.read_plan(request.plan)
+    config = plan_config(plan, request.plan)
+    controller = _controller(config, plan, request.controllers)
+    series = read_joint_states(request.recording, request.topic, joints=controller.joints,
+                               time_source=request.time_source)
+    continuous = [j for j, lim in config.limits.items() if lim.continuous]
+    return check_recording(plan, series, controller, config.execution, continuous, request.start)
+
+
+def _controller(config: RobotConfig, plan: recording.PlanFile, override: Path | None) -> ControllerConfig:
+    """Return the controller driving the plan's joints, from `override` or the plan's own config."""
+    controllers, source = config.controllers, str(config.root / "ros2_controllers.yaml")
+    if override is not None:
+        controllers, source = parse_controllers(override), str(override)
+    return pick_controller(controllers, plan.steps[0].trajectory.joint_names, source)

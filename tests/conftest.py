@@ -6,10 +6,12 @@ import json
 import subprocess
 import sys
 from pathlib import Path
+from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
 import pytest
+from mcap.writer import CompressionType, Writer
 from typer.testing import CliRunner
 
 from moveplan.cli.app import app
@@ -67,3 +69,28 @@ def dense_peaks(trajectory: JointTrajectory, per_segment: int = 64) -> tuple[np.
     times = np.unique((knots[:-1, None] + np.diff(knots)[:, None] * fractions).ravel())
     _, velocities, accelerations = sample(trajectory, times)
     return np.abs(velocities).max(axis=0), np.abs(accelerations).max(axis=0)
+
+
+MSGS = ROOT / "core" / "msgs" / "jazzy"
+SCHEMAS = {
+    "sensor_msgs/msg/JointState": (MSGS / "sensor_msgs__msg__JointState.msg").read_bytes(),
+    "std_msgs/msg/String": (MSGS / "std_msgs__msg__String.msg").read_bytes(),
+}
+
+
+def write_bag(path: Path, messages: Iterable[tuple[str, str, int, bytes]], *,
+              compression: CompressionType = CompressionType.ZSTD, chunk_size: int = 4096,
+              use_chunking: bool = True) -> Path:
+    """Write (topic, type, log time [ns], payload) messages as a ros2 MCAP file."""
+    with path.open("wb") as stream:
+        writer = Writer(stream, chunk_size=chunk_size, compression=compression,
+                        use_chunking=use_chunking)
+        writer.start("ros2", "test")
+        channels: dict[str, int] = {}
+        for topic, msgtype, log_time, data in messages:
+            if topic not in channels:
+                schema = writer.register_schema(msgtype, "ros2msg", SCHEMAS[msgtype])
+                channels[topic] = writer.register_channel(topic, "cdr", schema)
+            writer.add_message(channels[topic], log_time, data, log_time)
+        writer.finish()
+    return path
