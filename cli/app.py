@@ -69,6 +69,7 @@ def plan(
     velocity_scaling: Annotated[str | None, typer.Option(help="Fraction of the velocity limits, in (0, 1].")] = None,
     acceleration_scaling: Annotated[str | None, typer.Option(help="Fraction of the acceleration limits.")] = None,
     package_path: Annotated[list[Path] | None, typer.Option(help="Folder searched for package:// URIs.")] = None,
+    xacro_arg: Annotated[list[str] | None, typer.Option(help="xacro argument name:=value; repeatable.")] = None,
     ros_distro: Annotated[str, typer.Option(help="Message layout to write: jazzy or humble.")] = "jazzy",
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
@@ -92,6 +93,7 @@ def _plan_flags(args: dict[str, Any]) -> dict[str, Any]:
     """Return the plan flags as typed values, None where not given."""
     from moveplan.core.errors import UsageError
     from moveplan.core.tasks import StepSpec
+    from moveplan.core.xacro import parse_xacro_args
 
     starts = [k for k in ("start_joints", "start_named", "start_from") if args[k] is not None]
     goals = [k for k in ("joints", "named", "pose", "shift") if args[k] is not None]
@@ -136,6 +138,7 @@ def _plan_flags(args: dict[str, Any]) -> dict[str, Any]:
         "velocity_scaling": parse_scaling(args["velocity_scaling"], "--velocity-scaling"),
         "acceleration_scaling": parse_scaling(args["acceleration_scaling"], "--acceleration-scaling"),
         "package_paths": tuple(args["package_path"] or ()), "min_fraction": min_fraction,
+        "xacro_args": parse_xacro_args(args["xacro_arg"] or ()),
     }
 
 
@@ -211,7 +214,10 @@ def check_tolerances(
 
 @app.command("robot")
 def robot_info(
-    config: Annotated[Path, typer.Argument(help="Robot config: a moveplan.yaml or a folder holding one.")],
+    config: Annotated[Path, typer.Argument(
+        help="Robot config: a moveplan.yaml or its folder, a MoveIt config package, or a shipped name.")],
+    package_path: Annotated[list[Path] | None, typer.Option(help="Folder searched for packages.")] = None,
+    xacro_arg: Annotated[list[str] | None, typer.Option(help="xacro argument name:=value; repeatable.")] = None,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
 ) -> None:
@@ -220,8 +226,10 @@ def robot_info(
     with exit_codes(as_json):
         from moveplan.cli import render
         from moveplan.core.config import load_robot_config
+        from moveplan.core.xacro import parse_xacro_args
 
-        loaded = load_robot_config(config)
+        loaded = load_robot_config(config, tuple(package_path or ()), parse_xacro_args(xacro_arg or ()))
+        loaded.collision_meshes()  # a missing mesh is reported here too, not only when planning
     render.robot_summary(loaded, as_json, quiet)
 
 

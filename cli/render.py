@@ -86,6 +86,10 @@ def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
             for n, c in config.controllers.items()
         },
         "initial_positions": config.initial_positions,
+        "sources": {k: str(v) for k, v in config.sources.items()},
+        "kinematics": config.kinematics,
+        "xacro_args": config.xacro_args,
+        "missing_acceleration": list(config.missing_acceleration_limits()),
     }
     if as_json:
         _emit(document)
@@ -109,6 +113,10 @@ def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
     for name, controller in document["controllers"].items():
         _console.print(f"controller {name} @ {controller['update_rate']:g} Hz: {controller['constraints']}")
     _console.print(f"frames: {', '.join(links)}")
+    for setting, source in document["sources"].items():
+        _console.print(f"{setting} from {source}")
+    if document["missing_acceleration"]:
+        _console.print(f"[red]no acceleration limit[/red] for {', '.join(document['missing_acceleration'])}")
 
 
 def inspect_summary(path: Path, summary: BagSummary, plan: PlanFile | None, as_json: bool, quiet: bool) -> None:

@@ -16,6 +16,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from moveplan.core.config import RobotConfig
 from moveplan.core.errors import ConfigError, StartInCollision, UnknownName
 from moveplan.core.robot import Robot
 from moveplan.core.types import CollisionObject, Shape
@@ -41,6 +42,21 @@ def coal_geometry(shape: Shape, source: str = "scene") -> coal.CollisionGeometry
         raise ConfigError(f"{source}: cannot read mesh {path}: {exc}") from None
 
 
+def _geometry_error(config: RobotConfig, exc: Exception) -> ConfigError:
+    """Return a one-line error naming the mesh pinocchio (through coal and assimp) could not read."""
+    text = str(exc)
+    # coal's message: "From file: ... message: Could not load resource <path>\n<assimp reason>\nHint: ..."
+    lines = [line.strip() for line in text.split("message:", 1)[-1].splitlines() if line.strip()]
+    reason = "; ".join(line for line in lines if not line.startswith(("Could not load", "Hint:")))
+    reason = reason or (lines[0] if lines else type(exc).__name__)
+    for mesh in config.collision_meshes():
+        if str(mesh.path.resolve()) in text:
+            package = f" (package '{mesh.package}')" if mesh.package else ""
+            return ConfigError(f"{config.urdf_path}: link '{mesh.link}': cannot read collision mesh "
+                               f"{mesh.path}{package} for {mesh.uri}: {reason}")
+    return ConfigError(f"{config.urdf_path}: cannot load collision geometry: {' '.join(text.split())}")
+
+
 class CollisionChecker:
     """Answers whether robot configurations collide, and which pair collides."""
 
@@ -48,13 +64,13 @@ class CollisionChecker:
         self.robot = robot
         model = robot.model
         config = robot.config
+        # Mesh files are resolved (and a missing one reported) by the config, which knows the
+        # package path; pinocchio gets the expanded URDF text with absolute mesh paths.
+        urdf = config.collision_urdf()
         try:
-            geom = pin.buildGeomFromUrdf(
-                model, str(config.urdf_path), pin.GeometryType.COLLISION,
-                package_dirs=[str(p) for p in config.package_paths],
-            )
+            geom = pin.buildGeomFromUrdfString(model, urdf, pin.GeometryType.COLLISION)
         except (RuntimeError, ValueError, OSError) as exc:
-            raise ConfigError(f"{config.urdf_path}: cannot load collision geometry: {exc}") from None
+            raise _geometry_error(config, exc) from None
         owner = [str(model.frames[g.parentFrame].name) for g in geom.geometryObjects]
         touch: list[frozenset[str]] = [frozenset() for _ in owner]
         for obj in objects:

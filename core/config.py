@@ -1,25 +1,46 @@
-"""Robot configuration: reads moveplan.yaml and the MoveIt / ros2_control files it names.
+"""Robot configuration: reads moveplan.yaml or a MoveIt config package, and the files they name.
 
 This is the one place that parses YAML and XML into typed values; every error
 names the file and key path. Limits are merged as MoveIt does: URDF limits,
 overridden by joint_limits.yaml.
+
+Where a config's files come from (`RobotConfig.sources` records each):
+
+- A moveplan.yaml names them (relative to itself, or `package://pkg/...`); a URDF or
+  SRDF ending in .xacro is expanded with its `xacro_args`, overridden by --xacro-arg.
+- A folder without moveplan.yaml is a MoveIt config package (or a plain folder): the
+  SRDF is the one *.srdf(.xacro) in the first of config/, srdf/, the folder that has
+  any; the URDF the one *.urdf(.xacro) in the first of config/, urdf/, the folder
+  (several: the one named like the SRDF); joint_limits.yaml, kinematics.yaml,
+  ros2_controllers.yaml, moveit_controllers.yaml, initial_positions.yaml and
+  ompl_planning.yaml by name, in config/ before the folder. More than one candidate
+  is an error that asks for a moveplan.yaml.
+- Planning defaults: moveplan.yaml `planning` > ompl_planning.yaml's first group
+  and its default planner > the SRDF's first group and RRTConnect.
+- `$(find pkg)` and `package://pkg` search, in order: the config folder,
+  moveplan.yaml `package_paths`, --package-path, ROS_PACKAGE_PATH, AMENT_PREFIX_PATH
+  shares, and Python-installed (cmeel) package shares (core/xacro.py finds them).
 """
 
 from __future__ import annotations
 
 import math
+import os
+import sys
 import xml.etree.ElementTree as ET
-from importlib import resources
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-from moveplan.core.errors import ConfigError, UnknownName, known
+from moveplan.core.errors import ConfigError, UnknownName, UsageError, known
+from moveplan.core.xacro import PackagePath, process_xacro
 
 __all__ = [
+    "CollisionMesh",
     "ControllerConfig",
     "ExecutionConfig",
     "Group",
@@ -33,6 +54,7 @@ __all__ = [
     "parse_controllers",
     "number",
     "resolve_config_path",
+    "search_path",
     "shipped_configs",
 ]
 
@@ -159,6 +181,16 @@ class ExecutionConfig:
 
 
 @dataclass(frozen=True)
+class CollisionMesh:
+    """A collision mesh of a link: the URI the URDF gives and the file it resolves to."""
+
+    link: str
+    uri: str
+    path: Path
+    package: str = ""
+
+
+@dataclass(frozen=True)
 class RobotConfig:
     """A robot config folder, parsed: file paths, texts and typed settings.
 
@@ -174,8 +206,15 @@ class RobotConfig:
         execution: MoveIt's trajectory_execution settings.
         initial_positions: Where the fake hardware starts (joint -> value).
         planning: moveplan.yaml `planning` defaults: group, planner, planning_time.
-        files: File name -> bytes of every config file, to embed in plan files.
-        package_paths: Folders searched for `package://` URIs.
+        files: File name -> bytes of every config file, to embed in plan files; laid out in
+            one folder they load again as this config (expanded URDF, generated moveplan.yaml).
+        package_paths: Folders searched for `$(find pkg)` and `package://` URIs, in order.
+        sources: Setting -> the file it came from: urdf, srdf, joint_limits, kinematics,
+            controllers, moveit_controllers, initial_positions, ompl_planning, moveplan (the
+            moveplan.yaml), planning (the file that chose the default group). Absent: not given.
+        urdf_includes: Every file the URDF was made of (the .urdf, or the xacro and its includes).
+        kinematics: kinematics.yaml's settings per group (reported; moveplan solves IK itself).
+        xacro_args: The xacro args the URDF and SRDF were expanded with.
     """
 
     name: str
@@ -194,6 +233,10 @@ class RobotConfig:
     planning: dict[str, Any]
     files: dict[str, bytes] = field(default_factory=dict)
     package_paths: tuple[Path, ...] = ()
+    sources: dict[str, Path] = field(default_factory=dict)
+    urdf_includes: tuple[Path, ...] = ()
+    kinematics: dict[str, dict[str, Any]] = field(default_factory=dict)
+    xacro_args: dict[str, str] = field(default_factory=dict)
 
     def group(self, name: str | None = None) -> Group:
         """Return the named planning group, or the config's default one."""
@@ -202,32 +245,72 @@ class RobotConfig:
             raise UnknownName("group", name, str(self.srdf_path), self.srdf.groups)
         return self.srdf.groups[name]
 
+    def missing_acceleration_limits(self, group: str | None = None) -> tuple[str, ...]:
+        """Return the group's joints without an acceleration limit (planning needs one for each)."""
+        return tuple(j for j in self.group(group).joints if math.isnan(self.limits[j].max_acceleration))
+
+    def collision_meshes(self) -> tuple[CollisionMesh, ...]:
+        """Return every collision mesh of the URDF with the file it resolves to.
+
+        Raises:
+            ConfigError: A mesh whose package cannot be found or whose file does not exist;
+                names the URDF, the link, the URI, the package and the search path.
+        """
+        return _collision_meshes(self)[1]
+
+    def collision_urdf(self) -> str:
+        """Return the URDF with every collision mesh's filename replaced by its absolute path."""
+        return _collision_meshes(self)[0]
+
 
 # --- loading --------------------------------------------------------------------------------
 
 _MOVEPLAN_KEYS = {
-    "name", "urdf", "srdf", "joint_limits", "controllers", "moveit_controllers",
-    "initial_positions", "planning", "package_paths",
+    "name", "urdf", "srdf", "joint_limits", "kinematics", "controllers", "moveit_controllers",
+    "initial_positions", "planning", "package_paths", "xacro_args",
 }
+_FILE_KEYS = ("urdf", "srdf", "joint_limits", "kinematics", "controllers", "moveit_controllers", "initial_positions")
 _PLANNING_KEYS = {"group", "planner", "planning_time"}
 _LIMIT_KEYS = {
     "has_position_limits", "min_position", "max_position", "has_velocity_limits", "max_velocity",
     "has_acceleration_limits", "max_acceleration", "has_deceleration_limits", "max_deceleration",
     "has_jerk_limits", "max_jerk", "has_effort_limits", "max_effort", "angle_wraparound",
 }
+# A folder without moveplan.yaml: a MoveIt config package keeps these in config/, a plain folder
+# beside the URDF; config/ is searched first.
+_PACKAGE_FILES = {
+    "joint_limits": "joint_limits.yaml",
+    "kinematics": "kinematics.yaml",
+    "controllers": "ros2_controllers.yaml",
+    "moveit_controllers": "moveit_controllers.yaml",
+    "initial_positions": "initial_positions.yaml",
+    "ompl_planning": "ompl_planning.yaml",
+}
+_SRDF_FOLDERS = ("config", "srdf", ".")
+_URDF_FOLDERS = ("config", "urdf", ".")
 
 
 def resolve_config_path(robot: str | Path) -> Path:
-    """Return the moveplan.yaml a --robot argument names (the file, or a folder holding one)."""
+    """Return what a --robot argument names: a moveplan.yaml, or a folder to read without one.
+
+    A bare name such as `ur10e` names a config shipped with moveplan. A folder holding a
+    moveplan.yaml means that file; a folder without one is read as a MoveIt config package
+    (or a plain folder holding a URDF and an SRDF) if it holds an SRDF.
+    """
     path = Path(robot)
     shipped = Path(str(resources.files("moveplan.configs"))) / str(robot)
     if not path.exists() and path.name == str(robot) and (shipped / CONFIG_FILE).is_file():
-        path = shipped  # a bare name like "ur10e" names a config shipped with moveplan
+        path = shipped
     if path.is_dir():
-        path = path / CONFIG_FILE
+        if (path / CONFIG_FILE).is_file():
+            return path / CONFIG_FILE
+        if any(_candidates(path / sub, (".srdf", ".srdf.xacro")) for sub in _SRDF_FOLDERS):
+            return path
+        raise ConfigError(f"{robot}: no robot config: no {CONFIG_FILE}, and no *.srdf in config/, srdf/ "
+                          "or the folder itself (a MoveIt config package)")
     if not path.is_file():
-        raise ConfigError(f"{robot}: robot config not found (expected a {CONFIG_FILE} or a folder holding one, "
-                          f"or a shipped config: {known(shipped_configs())})")
+        raise ConfigError(f"{robot}: robot config not found (expected a {CONFIG_FILE}, a folder holding one, "
+                          f"a MoveIt config package, or a shipped config: {known(shipped_configs())})")
     return path
 
 
@@ -237,55 +320,76 @@ def shipped_configs() -> list[str]:
     return sorted(p.name for p in folder.iterdir() if (p / CONFIG_FILE).is_file())
 
 
-def load_robot_config(robot: str | Path, package_paths: tuple[Path, ...] = ()) -> RobotConfig:
-    """Return the parsed robot config at `robot` (a moveplan.yaml or its folder)."""
+def search_path(root: Path, package_paths: Sequence[Path] = (), extra: Sequence[Path] = ()) -> tuple[Path, ...]:
+    """Return the folders searched for ROS packages, in order (first match wins).
+
+    The config folder, moveplan.yaml's `package_paths` (`extra`), --package-path, then
+    ROS_PACKAGE_PATH, then the `share` folder of each AMENT_PREFIX_PATH entry (a sourced
+    ROS 2 workspace), then the share folders of Python-installed (cmeel) packages such as
+    example-robot-data.
+    """
+    env = [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
+    ament = [Path(p) / "share" for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
+    cmeel = [Path(p) / "cmeel.prefix" / "share" for p in sys.path if p]
+    cmeel = [p for p in cmeel if p.is_dir()]
+    return tuple(dict.fromkeys((root, *extra, *package_paths, *env, *ament, *cmeel)))
+
+
+def load_robot_config(
+    robot: str | Path,
+    package_paths: Sequence[Path] = (),
+    xacro_args: Mapping[str, str] | None = None,
+) -> RobotConfig:
+    """Return the parsed robot config at `robot`.
+
+    Args:
+        robot: A moveplan.yaml, a folder holding one, a MoveIt config package folder, a plain
+            folder with a URDF and an SRDF, or the name of a shipped config.
+        package_paths: --package-path folders, searched for `$(find pkg)` and `package://`
+            after the config folder and before ROS_PACKAGE_PATH.
+        xacro_args: --xacro-arg values; they override moveplan.yaml's `xacro_args`.
+
+    Raises:
+        ConfigError: A file is missing or malformed; the message names file and key.
+        UsageError: A --xacro-arg the xacro files do not declare.
+    """
     path = resolve_config_path(robot)
-    root = path.parent
-    top = mapping(load_yaml(path), str(path))
-    check_keys(top, _MOVEPLAN_KEYS, str(path))
-    files: dict[str, bytes] = {CONFIG_FILE: path.read_bytes()}
+    manifest = path if path.is_file() else None
+    root = path.parent if manifest else path
+    top: dict[str, Any] = {}
+    extra: tuple[Path, ...] = ()
+    if manifest is not None:
+        top = mapping(load_yaml(manifest), str(manifest))
+        check_keys(top, _MOVEPLAN_KEYS, str(manifest))
+        extra = tuple(root / p for p in _strings(top.get("package_paths"), f"{manifest}: package_paths"))
+    packages = PackagePath(search_path(root, tuple(package_paths), extra))
+    paths = _manifest_files(manifest, top, packages) if manifest else _discover(root)
+    args, flag_args = _xacro_args(manifest, top, xacro_args or {})
 
-    def named_file(key: str, required: bool = True) -> Path | None:
-        if key not in top:
-            if required:
-                raise ConfigError(f"{path}: missing key '{key}'")
-            return None
-        if not isinstance(top[key], str):
-            raise ConfigError(f"{path}: {key}: expected a file name, got {top[key]!r}")
-        file = root / top[key]
-        if not file.is_file():
-            raise ConfigError(f"{path}: {key}: file not found: {file}")
-        # Keyed by the path moveplan.yaml names, so the files can be laid out again as a config.
-        files[top[key]] = file.read_bytes()
-        return file
+    urdf_path, srdf_path = paths["urdf"], paths["srdf"]
+    urdf_text, urdf_includes, declared = _expand(urdf_path, root, args, packages)
+    srdf_text, _, srdf_declared = _expand(srdf_path, root, args, packages)
+    _check_xacro_args(args, flag_args, declared | srdf_declared, urdf_path, manifest)
+    urdf_joints = _parse_urdf(urdf_text, urdf_path)
+    srdf = _parse_srdf(srdf_text, srdf_path, urdf_joints)
 
-    urdf_path = named_file("urdf")
-    srdf_path = named_file("srdf")
-    assert urdf_path is not None and srdf_path is not None
-    urdf_text, urdf_joints = _parse_urdf(urdf_path)
-    srdf = _parse_srdf(srdf_path, urdf_joints)
-
-    limits_path = named_file("joint_limits", required=False)
+    limits_path = paths.get("joint_limits")
     limit_overrides, v_scale, a_scale = _parse_joint_limits(limits_path)
     limits = _merge_limits(urdf_path, urdf_joints, limits_path, limit_overrides)
+    controllers = parse_controllers(paths["controllers"]) if "controllers" in paths else {}
+    execution = _parse_execution(paths["moveit_controllers"]) if "moveit_controllers" in paths else ExecutionConfig()
+    initial = _parse_initial_positions(paths["initial_positions"], limits) if "initial_positions" in paths else {}
+    kinematics = _parse_kinematics(paths["kinematics"], srdf) if "kinematics" in paths else {}
+    planning, planning_source = _planning(manifest, top, paths.get("ompl_planning"), srdf, srdf_path)
 
-    controllers_path = named_file("controllers", required=False)
-    controllers = parse_controllers(controllers_path) if controllers_path else {}
-    moveit_path = named_file("moveit_controllers", required=False)
-    execution = _parse_execution(moveit_path) if moveit_path else ExecutionConfig()
-    initial_path = named_file("initial_positions", required=False)
-    initial = _parse_initial_positions(initial_path, limits) if initial_path else {}
-
-    planning = mapping(top.get("planning"), f"{path}: planning")
-    check_keys(planning, _PLANNING_KEYS, f"{path}: planning")
-    planning.setdefault("group", next(iter(srdf.groups), ""))
-    planning.setdefault("planner", "RRTConnect")
-    planning["planning_time"] = number(
-        planning.get("planning_time", 1.0), f"{path}: planning.planning_time", positive=True
-    )
-    extra_paths = tuple(root / p for p in top.get("package_paths", []) or [])
+    sources = dict(paths)
+    if manifest is not None:
+        sources["moveplan"] = manifest
+    sources["planning"] = planning_source
+    name = str(top.get("name") or srdf.name)
+    texts = {"urdf": urdf_text, "srdf": srdf_text}
     config = RobotConfig(
-        name=str(top.get("name") or srdf.name),
+        name=name,
         root=root,
         urdf_path=urdf_path,
         urdf=urdf_text,
@@ -299,16 +403,248 @@ def load_robot_config(robot: str | Path, package_paths: tuple[Path, ...] = ()) -
         execution=execution,
         initial_positions=initial,
         planning=planning,
-        files=files,
-        package_paths=(root, *extra_paths, *package_paths),
+        files=_embedded(manifest, top, root, paths, texts, name, planning),
+        package_paths=packages.folders,
+        sources=sources,
+        urdf_includes=urdf_includes,
+        kinematics=kinematics,
+        xacro_args=dict(args),
     )
     config.group()  # an unknown default group is a config error, found at load time
     return config
 
 
-def _xml_root(path: Path) -> ET.Element:
+def _strings(value: Any, where: str) -> list[str]:
+    if value is None:
+        return []
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise ConfigError(f"{where}: expected a list of folder names, got {value!r}")
+    return value
+
+
+def _manifest_files(manifest: Path, top: dict[str, Any], packages: PackagePath) -> dict[str, Path]:
+    """Return setting -> file for the files moveplan.yaml names (relative to it, or package://)."""
+    root = manifest.parent
+    paths: dict[str, Path] = {}
+    for key in _FILE_KEYS:
+        if key not in top:
+            if key in ("urdf", "srdf"):
+                raise ConfigError(f"{manifest}: missing key '{key}'")
+            continue
+        value = top[key]
+        if not isinstance(value, str):
+            raise ConfigError(f"{manifest}: {key}: expected a file name, got {value!r}")
+        file = packages.resolve_uri(value, root, f"{manifest}: {key}")[0] if "://" in value else root / value
+        if not file.is_file():
+            raise ConfigError(f"{manifest}: {key}: file not found: {file}")
+        paths[key] = file
+    return paths
+
+
+def _candidates(folder: Path, suffixes: tuple[str, ...]) -> list[Path]:
+    if not folder.is_dir():
+        return []
+    return sorted(p for p in folder.iterdir() if p.is_file() and p.name.endswith(suffixes))
+
+
+def _stem(path: Path) -> str:
+    """Return a robot file's name without .xacro and its format suffix: panda.urdf.xacro -> panda."""
+    name = path.name.removesuffix(".xacro")
+    return name.rsplit(".", 1)[0]
+
+
+def _one(root: Path, folders: tuple[str, ...], suffixes: tuple[str, str], kind: str, prefer: str = "") -> Path:
+    """Return the one `kind` file in the first of `folders` that has any; `prefer` breaks ties by stem."""
+    for sub in folders:
+        found = _candidates(root / sub, suffixes)
+        if len(found) > 1:
+            found = [p for p in found if _stem(p) == prefer] or found
+        if len(found) == 1:
+            return found[0]
+        if found:
+            raise ConfigError(f"{root / sub}: several {kind} files ({', '.join(p.name for p in found)}); "
+                              f"write a {CONFIG_FILE} that names one")
+    where = ", ".join(f"{s}/" for s in folders if s != ".")
+    raise ConfigError(f"{root}: no {kind} file (*{suffixes[0]} or *{suffixes[1]}) in {where} or the folder "
+                      f"itself; write a {CONFIG_FILE} that names one (urdf: package://pkg/urdf/robot.urdf.xacro)")
+
+
+def _discover(root: Path) -> dict[str, Path]:
+    """Return setting -> file for a folder without moveplan.yaml (see the module's loading rules)."""
+    paths = {"srdf": _one(root, _SRDF_FOLDERS, (".srdf", ".srdf.xacro"), "SRDF")}
+    paths["urdf"] = _one(root, _URDF_FOLDERS, (".urdf", ".urdf.xacro"), "URDF", prefer=_stem(paths["srdf"]))
+    for setting, name in _PACKAGE_FILES.items():
+        for sub in ("config", "."):
+            if (root / sub / name).is_file():
+                paths[setting] = root / sub / name
+                break
+    return paths
+
+
+def _xacro_args(
+    manifest: Path | None, top: dict[str, Any], flags: Mapping[str, str]
+) -> tuple[dict[str, str], frozenset[str]]:
+    """Return the xacro args in force (flag > moveplan.yaml) and the names set by flag."""
+    args: dict[str, str] = {}
+    for key, value in mapping(top.get("xacro_args"), f"{manifest}: xacro_args").items():
+        if isinstance(value, bool):
+            value = "true" if value else "false"
+        if not isinstance(value, str | int | float):
+            raise ConfigError(f"{manifest}: xacro_args.{key}: expected a string or number, got {value!r}")
+        args[key] = str(value)
+    args.update(flags)
+    return args, frozenset(flags)
+
+
+def _expand(
+    path: Path, root: Path, args: Mapping[str, str], packages: PackagePath
+) -> tuple[str, tuple[Path, ...], frozenset[str]]:
+    """Return a URDF or SRDF file's XML text (through xacro for *.xacro), the files it read, its args."""
+    if path.name.endswith(".xacro"):
+        shown = path.relative_to(root) if path.is_relative_to(root) else Path(path.name)
+        result = process_xacro(path, args, packages, str(shown))
+        return result.text, (path, *(p for p in result.includes if p != path)), result.declared
     try:
-        return ET.parse(path).getroot()
+        return path.read_text(encoding="utf-8"), (path,), frozenset()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"{path}: cannot read: {exc}") from None
+
+
+def _check_xacro_args(
+    args: Mapping[str, str], flags: frozenset[str], declared: frozenset[str], urdf: Path, manifest: Path | None
+) -> None:
+    """Raise for a xacro arg no xacro file declares (a typo must not pass silently)."""
+    for name in args:
+        if name in declared:
+            continue
+        what = f"xacro arg '{name}' is not declared by {urdf} or the files it includes; declared: {known(declared)}"
+        if not urdf.name.endswith(".xacro"):
+            what = f"xacro arg '{name}' given, but {urdf} is not a .xacro file"
+        if name in flags:
+            raise UsageError(f"--xacro-arg {name}: {what}")
+        raise ConfigError(f"{manifest}: xacro_args: {what}")
+
+
+def _embedded(
+    manifest: Path | None,
+    top: dict[str, Any],
+    root: Path,
+    paths: dict[str, Path],
+    texts: dict[str, str],
+    name: str,
+    planning: dict[str, Any],
+) -> dict[str, bytes]:
+    """Return the config files to embed in plan files, laid out so they load again as a config.
+
+    A moveplan.yaml whose files all lie in its folder is embedded as it is, with the files
+    under the names it gives them. Otherwise (a MoveIt package, xacro, package:// files) the
+    expanded URDF and SRDF and the other files are embedded side by side, with a generated
+    moveplan.yaml naming them.
+    """
+    embed = [k for k in _FILE_KEYS if k in paths]
+    if manifest is not None and not any(paths[k].name.endswith(".xacro") for k in ("urdf", "srdf")):
+        written = {k: str(top[k]) for k in embed}
+        if all("://" not in v and (root / v).resolve().is_relative_to(root.resolve()) for v in written.values()):
+            files = {CONFIG_FILE: manifest.read_bytes()}
+            files.update({written[k]: paths[k].read_bytes() for k in embed})
+            return files
+    files = {}
+    generated: dict[str, Any] = {"name": name}
+    for key in embed:
+        path = paths[key]
+        file_name = f"{_stem(path)}.{key}" if key in ("urdf", "srdf") else path.name
+        if file_name in files or file_name == CONFIG_FILE:
+            file_name = f"{key}_{file_name}"
+        files[file_name] = texts[key].encode("utf-8") if key in texts else path.read_bytes()
+        generated[key] = file_name
+    generated["planning"] = dict(planning)
+    origin = f"{root.name}/{CONFIG_FILE}" if manifest is not None else f"the config folder {root.name}"
+    header = f"# Generated by moveplan from {origin}: names the files embedded beside it, as loaded.\n"
+    files[CONFIG_FILE] = (header + yaml.safe_dump(generated, sort_keys=False)).encode("utf-8")
+    return files
+
+
+def _planning(
+    manifest: Path | None, top: dict[str, Any], ompl: Path | None, srdf: Srdf, srdf_path: Path
+) -> tuple[dict[str, Any], Path]:
+    """Return the planning defaults and the file that chose the group.
+
+    Precedence: moveplan.yaml `planning` > ompl_planning.yaml (its first group section, and
+    that group's `default_planner_config`) > the SRDF's first group, RRTConnect, 1 s.
+    """
+    planning = mapping(top.get("planning"), f"{manifest}: planning")
+    check_keys(planning, _PLANNING_KEYS, f"{manifest}: planning")
+    source = manifest if manifest is not None and "group" in planning else srdf_path
+    if ompl is not None:
+        group, planner = _ompl_defaults(ompl, srdf)
+        if group and "group" not in planning:
+            planning["group"], source = group, ompl
+        if planner and "planner" not in planning and planning.get("group") == group:
+            planning["planner"] = planner
+    planning.setdefault("group", next(iter(srdf.groups), ""))
+    planning.setdefault("planner", "RRTConnect")
+    planning["planning_time"] = number(
+        planning.get("planning_time", 1.0), f"{manifest}: planning.planning_time", positive=True
+    )
+    return planning, source
+
+
+def _ompl_defaults(path: Path, srdf: Srdf) -> tuple[str | None, str | None]:
+    """Return the first SRDF group ompl_planning.yaml configures and its default planner (or None).
+
+    MoveIt gives a group without a (known) `default_planner_config` RRTConnect; so does this.
+    """
+    top = mapping(load_yaml(path), str(path))
+    group = next((key for key in top if key in srdf.groups), None)
+    if group is None:
+        return None, None
+    section = mapping(top[group], f"{path}: {group}")
+    default = section.get("default_planner_config")
+    configs = mapping(top.get("planner_configs"), f"{path}: planner_configs")
+    if not isinstance(default, str) or default not in configs:
+        return group, None
+    kind = mapping(configs[default], f"{path}: planner_configs.{default}").get("type", "")
+    if not isinstance(kind, str) or not kind.startswith("geometric::"):
+        raise ConfigError(f"{path}: planner_configs.{default}.type: expected geometric::<Planner>, got {kind!r}")
+    return group, kind.removeprefix("geometric::")
+
+
+def _parse_kinematics(path: Path, srdf: Srdf) -> dict[str, dict[str, Any]]:
+    """Return kinematics.yaml's settings per group (moveplan solves IK itself; they are reported)."""
+    top = mapping(load_yaml(path), str(path))
+    if "/**" in top:  # written as ROS 2 parameters: /**: ros__parameters: robot_description_kinematics:
+        top = mapping(mapping(top["/**"], f"{path}: /**").get("ros__parameters"), f"{path}: /**.ros__parameters")
+    if "robot_description_kinematics" in top:
+        top = mapping(top["robot_description_kinematics"], f"{path}: robot_description_kinematics")
+    result = {}
+    for group, entry in top.items():
+        if group not in srdf.groups:
+            raise UnknownName("group", group, f"{path} (groups of {srdf.name})", srdf.groups)
+        result[group] = mapping(entry, f"{path}: {group}")
+    return result
+
+
+def _collision_meshes(config: RobotConfig) -> tuple[str, tuple[CollisionMesh, ...]]:
+    """Return the URDF with collision mesh files resolved to absolute paths, and the meshes."""
+    root = _xml_root(config.urdf, config.urdf_path)
+    packages = PackagePath(config.package_paths)
+    meshes = []
+    for link in root.findall("link"):
+        for mesh in link.findall("collision/geometry/mesh"):
+            uri = mesh.get("filename", "")
+            where = f"{config.urdf_path}: link '{link.get('name', '')}': collision mesh {uri}"
+            path, package = packages.resolve_uri(uri, config.urdf_path.parent, where)
+            if not path.is_file():
+                inside = f" (package '{package}' is {packages.find(package, where)})" if package else ""
+                raise ConfigError(f"{where}: file not found: {path}{inside}; search path: {packages.describe()}")
+            mesh.set("filename", str(path.resolve()))
+            meshes.append(CollisionMesh(link.get("name", ""), uri, path, package))
+    return ET.tostring(root, encoding="unicode"), tuple(meshes)
+
+
+def _xml_root(text: str, path: Path) -> ET.Element:
+    try:
+        return ET.fromstring(text)
     except ET.ParseError as exc:
         raise ConfigError(f"{path}: malformed XML: {exc}") from None
 
@@ -323,8 +659,8 @@ def _float_attr(element: ET.Element, name: str, path: Path, default: float = mat
         raise ConfigError(f"{path}: <{element.tag}> {name}='{text}' is not a number") from None
 
 
-def _parse_urdf(path: Path) -> tuple[str, dict[str, UrdfJoint]]:
-    root = _xml_root(path)
+def _parse_urdf(text: str, path: Path) -> dict[str, UrdfJoint]:
+    root = _xml_root(text, path)
     if root.tag != "robot":
         raise ConfigError(f"{path}: not a URDF (root element is <{root.tag}>, expected <robot>)")
     links = {link.get("name", "") for link in root.findall("link")}
@@ -347,7 +683,7 @@ def _parse_urdf(path: Path) -> tuple[str, dict[str, UrdfJoint]]:
             name, element.get("type", ""), parent.get("link", ""), child.get("link", ""),
             lower, upper, velocity,
         )
-    return path.read_text(encoding="utf-8"), joints
+    return joints
 
 
 def _chain(path: Path, joints: dict[str, UrdfJoint], base: str, tip: str) -> list[str]:
@@ -368,8 +704,8 @@ def _chain(path: Path, joints: dict[str, UrdfJoint], base: str, tip: str) -> lis
     return chain[::-1]
 
 
-def _parse_srdf(path: Path, joints: dict[str, UrdfJoint]) -> Srdf:
-    root = _xml_root(path)
+def _parse_srdf(text: str, path: Path, joints: dict[str, UrdfJoint]) -> Srdf:
+    root = _xml_root(text, path)
     if root.tag != "robot":
         raise ConfigError(f"{path}: not an SRDF (root element is <{root.tag}>, expected <robot>)")
     movable = [j.name for j in joints.values() if j.type in ("revolute", "continuous", "prismatic")]

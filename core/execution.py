@@ -195,7 +195,8 @@ def check(request: CheckRequest) -> CheckReport:
 
 def _controller(config: RobotConfig, plan: recording.PlanFile, override: Path | None) -> ControllerConfig:
     """Return the controller driving the plan's joints, from `override` or the plan's own config."""
-    controllers, source = config.controllers, str(config.root / "ros2_controllers.yaml")
+    controllers = config.controllers
+    source = str(config.sources.get("controllers", config.root / "ros2_controllers.yaml"))
     if override is not None:
         controllers, source = parse_controllers(override), str(override)
     return pick_controller(controllers, plan.steps[0].trajectory.joint_names, source)

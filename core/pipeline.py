@@ -68,6 +68,7 @@ class PlanRequest:
     seed: int = 0
     min_fraction: float = 1.0
     package_paths: tuple[Path, ...] = ()
+    xacro_args: dict[str, str] = field(default_factory=dict)
     task: TaskFile | None = None
 
 
@@ -93,14 +94,16 @@ def resolve_request(task: TaskFile | None, flags: dict[str, Any]) -> PlanRequest
         robot=Path(merged["robot"]), steps=steps, scene=merged.get("scene"), group=merged.get("group"),
         start=start, planner=merged.get("planner"), planning_time=merged.get("planning_time"),
         velocity_scaling=merged.get("velocity_scaling"), acceleration_scaling=merged.get("acceleration_scaling"),
-        seed=int(merged.get("seed") or 0), min_fraction=float(merged.get("min_fraction", 1.0)), package_paths=tuple(flags.get("package_paths") or ()), task=task,
+        seed=int(merged.get("seed") or 0), min_fraction=float(merged.get("min_fraction", 1.0)),
+        package_paths=tuple(flags.get("package_paths") or ()),
+        xacro_args=dict(flags.get("xacro_args") or {}), task=task,
     )
 
 
 def plan(request: PlanRequest) -> Plan:
     """Return the timed, collision-free plan for every step of `request`, in order."""
     seed_planner(request.seed)
-    config = load_robot_config(request.robot, request.package_paths)
+    config = load_robot_config(request.robot, request.package_paths, request.xacro_args)
     robot = Robot(config, request.group)
     scene = load_scene(request.scene, robot) if request.scene else empty_scene()
     checker = CollisionChecker(robot, scene.objects, scene.source)
