@@ -5,18 +5,20 @@ from __future__ import annotations
 import json
 import logging
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from rich.console import Console
 from rich.table import Table
 
-from moveplan.core.checking import CheckReport
-from moveplan.core.config import RobotConfig
-from moveplan.core.execution import PlanExecution
-from moveplan.core.recording import BagSummary, PlanFile
 from moveplan.core.trajectory import peak_rates
-from moveplan.core.types import Plan
+
+if TYPE_CHECKING:  # each command imports only the core modules it runs
+    from moveplan.core.checking import CheckReport
+    from moveplan.core.config import RobotConfig
+    from moveplan.core.execution import PlanExecution
+    from moveplan.core.recording import BagSummary, PlanFile
+    from moveplan.core.types import Plan
 
 __all__ = ["check_summary", "execution_summary", "inspect_summary", "plan_summary", "robot_summary"]
 
