@@ -1,4 +1,4 @@
-"""Value types shared across core: trajectories, scene geometry and plans.
+"""Value types shared across core: trajectories, scene geometry, plans and recorded joint states.
 
 Arrays are copied, shape-checked and made read-only on construction, so a value
 cannot change after it has been checked.
@@ -16,11 +16,13 @@ from numpy.typing import NDArray
 __all__ = [
     "CollisionObject",
     "Frame",
+    "JointStateSeries",
     "JointTrajectory",
     "Plan",
     "Shape",
     "StepResult",
     "TfSamples",
+    "TimeSource",
     "frozen_array",
 ]
 
@@ -71,6 +73,63 @@ class JointTrajectory:
     def duration_s(self) -> float:
         """Return the time of the last point in [s]."""
         return float(self.times_s[-1])
+
+
+TimeSource = Literal["header", "log"]
+
+
+@dataclass(frozen=True)
+class JointStateSeries:
+    """Joint positions (and velocities) recorded on one topic, in a chosen joint order.
+
+    Arrays are read-only. Read-only float64 arrays given to the constructor are kept as
+    they are (an hour at 1 kHz is 170 MB per array); any other input is copied.
+
+    Attributes:
+        names: Joint order of the columns.
+        times_s: Sample times in [s] from the first sample, non-decreasing, shape (N,).
+        positions: In [rad] or [m], shape (N, n).
+        velocities: In [rad]/[s] or [m]/[s], shape (N, n); None when the messages carry none.
+        start_ns: Time of the first sample in [ns] (header stamp or log time), so
+            `start_ns + times_s * 1e9` are the recorded times.
+        time_source: "header" (the messages' header.stamp) or "log" (MCAP log time).
+        source: The file or folder read, for messages.
+
+    """
+
+    names: tuple[str, ...]
+    times_s: NDArray[np.float64]
+    positions: NDArray[np.float64]
+    velocities: NDArray[np.float64] | None
+    start_ns: int
+    time_source: TimeSource = "header"
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        """Check shapes and order, and freeze the arrays."""
+        object.__setattr__(self, "names", tuple(self.names))
+        times = _kept_frozen(self.times_s, (None,), "times_s")
+        object.__setattr__(self, "times_s", times)
+        shape = (len(times), len(self.names))
+        object.__setattr__(self, "positions", _kept_frozen(self.positions, shape, "positions"))
+        if self.velocities is not None:
+            velocities = _kept_frozen(self.velocities, shape, "velocities")
+            object.__setattr__(self, "velocities", velocities)
+        if np.any(np.diff(times) < 0.0):
+            raise ValueError("times_s must be non-decreasing")
+
+
+def _kept_frozen(
+    value: npt.ArrayLike, shape: tuple[int | None, ...], name: str
+) -> NDArray[np.float64]:
+    """Return `value` itself if it is a read-only float64 array of `shape`, else frozen_array's."""
+    if (
+        isinstance(value, np.ndarray) and value.dtype == np.float64 and not value.flags.writeable
+        and value.ndim == len(shape)
+        and all(want in (None, got) for got, want in zip(value.shape, shape, strict=True))
+    ):
+        return value
+    return frozen_array(value, shape, name)
 
 
 @dataclass(frozen=True)
