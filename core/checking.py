@@ -35,7 +35,7 @@ from moveplan.core.alignment import (
     next_start,
 )
 from moveplan.core.config import ControllerConfig, ExecutionConfig
-from moveplan.core.errors import InputError, UnknownName, UsageError
+from moveplan.core.errors import InputError, UsageError
 from moveplan.core.tolerances import (
     SUCCESSFUL,
     TIMED_OUT,
@@ -46,6 +46,7 @@ from moveplan.core.tolerances import (
     Violation,
     check_start_state,
     expected_duration_s,
+    in_controller_order,
     judge,
     segment_tolerances,
     velocity_error_computable,
@@ -257,7 +258,7 @@ class _Context:
         samples = Samples.build(series, controller.joints, continuous_joints)
         zone = max(ZONE_RAD, 2.0 * execution.allowed_start_tolerance)
         profiles = tuple(
-            StepProfile.build(step.name, _in_controller_order(step.trajectory, controller),
+            StepProfile.build(step.name, in_controller_order(step.trajectory, controller),
                               samples.continuous, zone)
             for step in plan.steps
         )
@@ -275,23 +276,6 @@ class _Context:
         return _Context(samples, profiles, series.velocities,
                         computable and series.velocities is not None, controller, execution,
                         segment_tolerances(controller), tuple(warnings))
-
-
-def _in_controller_order(
-    trajectory: JointTrajectory, controller: ControllerConfig
-) -> JointTrajectory:
-    """Return the trajectory's columns in the controller's joint order, as JTC sorts goals."""
-    for joint in trajectory.joint_names:
-        if joint not in controller.joints:
-            raise UnknownName("joint", joint, f"controller '{controller.name}'", controller.joints)
-    missing = [j for j in controller.joints if j not in trajectory.joint_names]
-    if missing:
-        raise InputError(
-            f"Joints on incoming trajectory don't match the controller joints: controller "
-            f"'{controller.name}' also has {', '.join(missing)} (partial goals are not allowed)")
-    order = [trajectory.joint_names.index(j) for j in controller.joints]
-    return JointTrajectory(controller.joints, trajectory.times_s, trajectory.positions[:, order],
-                           trajectory.velocities[:, order], trajectory.accelerations[:, order])
 
 
 # --- judging ------------------------------------------------------------------------------

@@ -21,7 +21,7 @@ import numpy.typing as npt
 from numpy.typing import NDArray
 
 from moveplan.core.config import ControllerConfig, ExecutionConfig
-from moveplan.core.errors import InputError, UnknownName, UsageError, known
+from moveplan.core.errors import UsageError, known
 from moveplan.core.plants import Plant
 from moveplan.core.tolerances import (
     GOAL_TOLERANCE_VIOLATED,
@@ -33,6 +33,7 @@ from moveplan.core.tolerances import (
     Violation,
     check_start_state,
     expected_duration_s,
+    in_controller_order,
     judge,
     position_error,
     segment_tolerances,
@@ -136,7 +137,7 @@ def simulate(
         disturbances: Bumps applied to the actual positions during the execution.
         seed: Seeds the plant's randomness (measurement noise).
     """
-    trajectory = _in_controller_order(trajectory, controller)
+    trajectory = in_controller_order(trajectory, controller)
     joints = trajectory.joint_names
     names = set(continuous_joints)
     continuous = np.array([j in names for j in joints])
@@ -241,28 +242,6 @@ def _time_grid(
         horizon_s = min(horizon_s, duration_s + goal_time_s)
     # Two cycles past the deciding time, so rounding never cuts the cycle that decides.
     return np.asarray(np.arange(math.floor(horizon_s / dt) + 3) * dt, dtype=np.float64)
-
-
-def _in_controller_order(
-    trajectory: JointTrajectory, controller: ControllerConfig
-) -> JointTrajectory:
-    """Return the trajectory with columns in the controller's joint order, as JTC sorts goals."""
-    for joint in trajectory.joint_names:
-        if joint not in controller.joints:
-            raise UnknownName("joint", joint, f"controller '{controller.name}'", controller.joints)
-    missing = [j for j in controller.joints if j not in trajectory.joint_names]
-    if missing:
-        raise InputError(
-            f"Joints on incoming trajectory don't match the controller joints: controller "
-            f"'{controller.name}' also has {', '.join(missing)} (partial goals are not allowed)"
-        )
-    if trajectory.joint_names == controller.joints:
-        return trajectory
-    order = [trajectory.joint_names.index(j) for j in controller.joints]
-    return JointTrajectory(
-        controller.joints, trajectory.times_s, trajectory.positions[:, order],
-        trajectory.velocities[:, order], trajectory.accelerations[:, order],
-    )
 
 
 def _timeout(

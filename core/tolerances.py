@@ -17,10 +17,12 @@ import numpy.typing as npt
 from numpy.typing import NDArray
 
 from moveplan.core.config import ControllerConfig, ExecutionConfig
+from moveplan.core.errors import InputError, UnknownName
 from moveplan.core.trajectory import shortest_angular_distance
-from moveplan.core.types import frozen_array
+from moveplan.core.types import JointTrajectory, frozen_array
 
 __all__ = [
+    "in_controller_order",
     "GOAL_TOLERANCE_VIOLATED",
     "PATH_TOLERANCE_VIOLATED",
     "START_STATE_INVALID",
@@ -444,3 +446,25 @@ def _goal_details(violations: Sequence[Violation]) -> str:
 def _path_message(violations: Sequence[Violation]) -> str:
     details = ", ".join(f"{v.joint} error {v.error:.6g} > {v.tolerance:g}" for v in violations)
     return f"Aborted due to path tolerance violation at {violations[0].time_s:.4f} s: {details}"
+
+
+def in_controller_order(
+    trajectory: JointTrajectory, controller: ControllerConfig
+) -> JointTrajectory:
+    """Return the trajectory with columns in the controller's joint order, as JTC sorts goals."""
+    for joint in trajectory.joint_names:
+        if joint not in controller.joints:
+            raise UnknownName("joint", joint, f"controller '{controller.name}'", controller.joints)
+    missing = [j for j in controller.joints if j not in trajectory.joint_names]
+    if missing:
+        raise InputError(
+            f"Joints on incoming trajectory don't match the controller joints: controller "
+            f"'{controller.name}' also has {', '.join(missing)} (partial goals are not allowed)"
+        )
+    if trajectory.joint_names == controller.joints:
+        return trajectory
+    order = [trajectory.joint_names.index(j) for j in controller.joints]
+    return JointTrajectory(
+        controller.joints, trajectory.times_s, trajectory.positions[:, order],
+        trajectory.velocities[:, order], trajectory.accelerations[:, order],
+    )
