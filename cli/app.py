@@ -50,19 +50,19 @@ def plan(
     robot: Annotated[Path | None, typer.Option(help="Robot config: a moveplan.yaml or a folder holding one.")] = None,
     scene: Annotated[Path | None, typer.Option(help="Scene file: frames and collision objects.")] = None,
     group: Annotated[str | None, typer.Option(help="Planning group (default: the config's).")] = None,
-    start_joints: Annotated[str | None, typer.Option(help="Start joint values, '0,-1.57,...' or 'joint=value'.")] = None,
+    start_joints: Annotated[str | None, typer.Option(help="Start joints: '0,-1.57,...' or 'joint=value'.")] = None,
     start_named: Annotated[str | None, typer.Option(help="Start at an SRDF group_state.")] = None,
     start_from: Annotated[Path | None, typer.Option(help="Start where a previous plan file ends.")] = None,
     joints: Annotated[str | None, typer.Option(help="Joint goal: 'q1,...,qn' or 'elbow_joint=1.2,...'.")] = None,
     named: Annotated[str | None, typer.Option(help="Goal: an SRDF group_state.")] = None,
-    pose: Annotated[str | None, typer.Option(help="Goal pose of the tip: 'x,y,z[,roll,pitch,yaw | ,qx,qy,qz,qw]'.")] = None,
+    pose: Annotated[str | None, typer.Option(help="Tip goal: 'x,y,z[,roll,pitch,yaw | ,qx,qy,qz,qw]'.")] = None,
     frame: Annotated[str | None, typer.Option(help="Frame --pose is given in: a scene frame or robot link.")] = None,
     link: Annotated[str | None, typer.Option(help="Link --pose moves (default: the group's tip).")] = None,
-    shift: Annotated[str | None, typer.Option(help="Move the tip from where it is: 'z=0.1' or 'x=0.05,yaw=0.3'.")] = None,
+    shift: Annotated[str | None, typer.Option(help="Move the tip from here: 'z=0.1' or 'x=0.05,yaw=0.3'.")] = None,
     shift_frame: Annotated[str | None, typer.Option(
         help="Axes of --shift: tool (default), base, moveit (shift_pose_target) or any frame.")] = None,
     linear: Annotated[bool, typer.Option("--linear", help="Move the tip along a straight line.")] = False,
-    min_fraction: Annotated[str | None, typer.Option(help="With --linear: fail below this fraction (default 1).")] = None,
+    min_fraction: Annotated[str | None, typer.Option(help="With --linear: fail below this fraction (1).")] = None,
     planner: Annotated[str | None, typer.Option(help="OMPL geometric planner (default RRTConnect).")] = None,
     planning_time: Annotated[str | None, typer.Option(help="Seconds the planner may search per step.")] = None,
     seed: Annotated[int | None, typer.Option(min=0, help="Random seed: same seed, same plan.")] = None,
@@ -98,7 +98,8 @@ def _plan_flags(args: dict[str, Any]) -> dict[str, Any]:
     starts = [k for k in ("start_joints", "start_named", "start_from") if args[k] is not None]
     goals = [k for k in ("joints", "named", "pose", "shift") if args[k] is not None]
     if len(starts) > 1 or len(goals) > 1:
-        raise UsageError(f"give one start flag and one goal flag, got {', '.join('--' + k.replace('_', '-') for k in starts + goals)}")
+        given = ", ".join("--" + k.replace("_", "-") for k in starts + goals)
+        raise UsageError(f"give one start flag and one goal flag, got {given}")
     start: dict[str, Any] = {}
     if args["start_joints"] is not None:
         start = parse_joints(args["start_joints"], "--start-joints")
@@ -150,7 +151,7 @@ def execute(
     plant: Annotated[str, typer.Option(help="Hardware model: mirror, lag or pid.")] = "mirror",
     plant_param: Annotated[list[str] | None, typer.Option(help="Plant parameter k=v, e.g. tau=0.05.")] = None,
     disturb: Annotated[list[str] | None, typer.Option(help="Fault: 't=1.2,joint=elbow_joint,delta=0.05'.")] = None,
-    start_joints: Annotated[str | None, typer.Option(help="Robot not where the plan starts: 'joint=value,...'.")] = None,
+    start_joints: Annotated[str | None, typer.Option(help="Robot away from the plan start: 'joint=value'.")] = None,
     controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml overriding the plan's.")] = None,
     seed: Annotated[int, typer.Option(min=0, help="Seed for plant noise.")] = 0,
     ros_distro: Annotated[str, typer.Option(help="Controller-state layout to write: jazzy or humble.")] = "jazzy",
@@ -166,7 +167,8 @@ def execute(
         if not fake:
             raise UsageError("only fake execution exists yet: add --fake to replay through a simulated controller")
         from moveplan.cli import render
-        from moveplan.core.execution import ExecuteRequest, execute as run
+        from moveplan.core.execution import ExecuteRequest
+        from moveplan.core.execution import execute as run
 
         request = ExecuteRequest(
             plan=plan_file, plant=plant, plant_params=parse_params(plant_param or [], "--plant-param"),

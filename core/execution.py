@@ -17,8 +17,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from moveplan.core import recording
-from moveplan.core.config import CONFIG_FILE, ControllerConfig, RobotConfig, load_robot_config, parse_controllers
 from moveplan.core.checking import CheckReport, check_recording
+from moveplan.core.config import CONFIG_FILE, ControllerConfig, RobotConfig, load_robot_config, parse_controllers
 from moveplan.core.controller import Disturbance, ExecutionReport, simulate
 from moveplan.core.errors import ConfigError, InputError, UnknownName
 from moveplan.core.jointstates import read_joint_states
@@ -116,7 +116,9 @@ def plan_config(plan: recording.PlanFile, source: Path) -> RobotConfig:
             raise InputError(f"{source}: embedded config: {exc}") from None
 
 
-def pick_controller(controllers: Mapping[str, ControllerConfig], joints: Sequence[str], source: str) -> ControllerConfig:
+def pick_controller(
+    controllers: Mapping[str, ControllerConfig], joints: Sequence[str], source: str
+) -> ControllerConfig:
     """Return the JointTrajectoryController that drives all of `joints`."""
     fitting = [c for c in controllers.values() if set(joints) <= set(c.joints)]
     if not fitting:
@@ -136,8 +138,9 @@ def execute(request: ExecuteRequest) -> PlanExecution:
     steps = []
     for step in plan.steps:
         end = step.start_s + step.trajectory.duration_s
+        last = step is plan.steps[-1]
         bumps = [Disturbance(d.time_s - step.start_s, d.joint, d.delta)
-                 for d in request.disturbances if step.start_s <= d.time_s < end or (d.time_s >= end and step is plan.steps[-1])]
+                 for d in request.disturbances if step.start_s <= d.time_s < end or (d.time_s >= end and last)]
         report = simulate(step.trajectory, controller, config.execution, plant, continuous_joints=continuous,
                           start_positions=start, disturbances=bumps, seed=request.seed)
         steps.append(StepExecution(step.name, report))
@@ -156,7 +159,8 @@ def _executed_tf(robot: Robot, steps: list[StepExecution]) -> TfSamples | None:
     for step in steps:
         report = step.report
         if len(report.times_s):
-            every = max(1, int(round(1.0 / (_TF_RATE_HZ * np.median(np.diff(report.times_s)))))) if len(report.times_s) > 1 else 1
+            period = float(np.median(np.diff(report.times_s))) if len(report.times_s) > 1 else 1.0
+            every = max(1, int(round(1.0 / (_TF_RATE_HZ * period))))
             rows = np.unique(np.append(np.arange(0, len(report.times_s), every), len(report.times_s) - 1))
             columns = [report.joint_names.index(j) for j in robot.joint_names]
             times.append(offset + report.times_s[rows])

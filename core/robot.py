@@ -52,7 +52,9 @@ class Robot:
         """Return the pinocchio configuration with the group at `values`, other joints from `base`."""
         return self.configurations(np.asarray(values, dtype=float)[None, :], base)[:, 0]
 
-    def configurations(self, values: NDArray[np.float64], base: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+    def configurations(
+        self, values: NDArray[np.float64], base: NDArray[np.float64] | None = None
+    ) -> NDArray[np.float64]:
         """Return configurations, shape (nq, k), for group values of shape (k, dof)."""
         base = self.neutral() if base is None else base
         q = np.repeat(base[:, None], len(values), axis=1)
@@ -116,7 +118,8 @@ class Robot:
     def _relative(self, parent: str, child: str) -> NDArray[np.float64]:
         """Return `parent_T_child` from the last forward kinematics."""
         frames = self.data.oMf
-        return np.array((frames[self.model.getFrameId(parent)].inverse() * frames[self.model.getFrameId(child)]).homogeneous)
+        root_T_parent, root_T_child = frames[self.model.getFrameId(parent)], frames[self.model.getFrameId(child)]
+        return np.array((root_T_parent.inverse() * root_T_child).homogeneous)
 
     @property
     def root_link(self) -> str:
