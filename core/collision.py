@@ -5,11 +5,18 @@ world objects (on the universe joint) and attached objects (on their link's
 joint). Only pairs whose distance can change with the joints are checked per
 state; pairs that never move relative to each other are checked once, at
 construction. A batch of states is checked in one C++ call.
+
+The robot's meshes are checked as they are (`exact`, triangle BVHs) or as their
+convex hulls (`convex`). A hull encloses its mesh, so a state free under hulls is
+free under the meshes: convex mode is conservative, and what it certifies holds
+for the real geometry.
 """
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
+from typing import Literal
 
 import coal
 import numpy as np
@@ -21,7 +28,15 @@ from moveplan.core.errors import ConfigError, StartInCollision, UnknownName
 from moveplan.core.robot import Robot
 from moveplan.core.types import CollisionObject, Shape
 
-__all__ = ["CollisionChecker", "coal_geometry"]
+__all__ = ["CollisionChecker", "GeometryMode", "coal_geometry", "convex_hull"]
+
+GeometryMode = Literal["exact", "convex"]
+
+logger = logging.getLogger(__name__)
+
+# Hulls by (mesh file, scale), built once per process: qhull costs ~1 ms a mesh, and every
+# CollisionChecker of a run (IK, tests, benchmarks) loads the same robot meshes.
+_HULLS: dict[tuple[str, tuple[float, ...]], coal.ConvexBase] = {}
 
 
 def coal_geometry(shape: Shape, source: str = "scene") -> coal.CollisionGeometry:
@@ -42,6 +57,42 @@ def coal_geometry(shape: Shape, source: str = "scene") -> coal.CollisionGeometry
         raise ConfigError(f"{source}: cannot read mesh {path}: {exc}") from None
 
 
+def convex_hull(mesh: coal.BVHModelBase, key: tuple[str, tuple[float, ...]], source: str) -> coal.ConvexBase:
+    """Return the convex hull of a triangle mesh, cached per process under `key` (file, scale).
+
+    Raises:
+        ConfigError: The mesh is flat (no hull; names `source`), or qhull fails on it.
+    """
+    if key not in _HULLS:
+        if _is_flat(mesh):
+            raise ConfigError(f"{source}: mesh {key[0]} is flat, so it has no convex hull")
+        try:
+            # keepTriangle=True keeps qhull's (triangulated, "Qt") facets with the hull: a coal.Convex,
+            # whose volume can be compared with the mesh's (benchmarks/panda_meshes.py does).
+            convex = mesh.buildConvexHull(True, "Qt")  # True: every vertex is on the hull
+        except (RuntimeError, ValueError) as exc:
+            raise ConfigError(f"{source}: cannot build the convex hull of mesh {key[0]}: "
+                              f"{' '.join(str(exc).split())}; use planning: {{collision: exact}}") from None
+        if mesh.convex is None:
+            raise ConfigError(f"{source}: cannot build the convex hull of mesh {key[0]}; "
+                              "use planning: {collision: exact}")
+        if not convex:
+            logger.info("%s: mesh %s is not convex; its hull encloses more", source, key[0])
+        hull = mesh.convex
+        hull.computeLocalAABB()
+        _HULLS[key] = hull
+    return _HULLS[key]
+
+
+def _is_flat(mesh: coal.BVHModelBase) -> bool:
+    """Return True if a mesh's vertices span no volume (fewer than 4, or all on a plane or line)."""
+    points = np.asarray(mesh.vertices(), dtype=float).reshape(-1, 3)
+    if len(points) < 4:
+        return True
+    spread = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)
+    return bool(spread[2] <= 1e-6 * spread[0])
+
+
 def _geometry_error(config: RobotConfig, exc: Exception) -> ConfigError:
     """Return a one-line error naming the mesh pinocchio (through coal and assimp) could not read."""
     text = str(exc)
@@ -60,8 +111,31 @@ def _geometry_error(config: RobotConfig, exc: Exception) -> ConfigError:
 class CollisionChecker:
     """Answers whether robot configurations collide, and which pair collides."""
 
-    def __init__(self, robot: Robot, objects: tuple[CollisionObject, ...] = (), source: str = "scene") -> None:
+    def __init__(
+        self,
+        robot: Robot,
+        objects: tuple[CollisionObject, ...] = (),
+        source: str = "scene",
+        geometry: GeometryMode = "exact",
+    ) -> None:
+        """Build the geometry model of `robot` and `objects` and decide which pairs to check.
+
+        Args:
+            robot: The robot, with its config's URDF collision geometry.
+            objects: World and attached scene objects.
+            source: The scene file, for messages.
+            geometry: `exact` checks the URDF's meshes as triangle BVHs; `convex` checks each
+                robot mesh's convex hull instead (faster; conservative, since a hull encloses
+                its mesh). Scene objects are checked as given in both modes.
+
+        Raises:
+            ConfigError: A mesh cannot be read, or (convex) qhull fails on one.
+            StartInCollision: Objects that never move relative to each other touch.
+        """
+        if geometry not in ("exact", "convex"):
+            raise ValueError(f"collision geometry '{geometry}': expected exact or convex")
         self.robot = robot
+        self.mode: GeometryMode = geometry
         model = robot.model
         config = robot.config
         # Mesh files are resolved (and a missing one reported) by the config, which knows the
@@ -71,6 +145,19 @@ class CollisionChecker:
             geom = pin.buildGeomFromUrdfString(model, urdf, pin.GeometryType.COLLISION)
         except (RuntimeError, ValueError, OSError) as exc:
             raise _geometry_error(config, exc) from None
+        if geometry == "convex":
+            # Only the robot's meshes: scene meshes are the world, checked exactly. A hull
+            # there would block space the robot may use (a bin's inside, a shelf's bays).
+            for obj in geom.geometryObjects:
+                if not isinstance(obj.geometry, coal.BVHModelBase):
+                    continue
+                if _is_flat(obj.geometry):
+                    # No hull, and coal 3.0.3's qhull crashes the process (SIGSEGV) on coplanar
+                    # points. Kept as a mesh, it is checked as it really is: still conservative.
+                    logger.info("%s: mesh %s is flat; checked as a mesh", obj.name, obj.meshPath)
+                else:
+                    key = (str(obj.meshPath), tuple(float(v) for v in obj.meshScale))
+                    obj.geometry = convex_hull(obj.geometry, key, f"{config.urdf_path}: {obj.name}")
         owner = [str(model.frames[g.parentFrame].name) for g in geom.geometryObjects]
         touch: list[frozenset[str]] = [frozenset() for _ in owner]
         for obj in objects:

@@ -40,6 +40,7 @@ from moveplan.core.errors import ConfigError, UnknownName, UsageError, known
 from moveplan.core.xacro import PackagePath, process_xacro
 
 __all__ = [
+    "COLLISION_MODES",
     "CollisionMesh",
     "ControllerConfig",
     "ExecutionConfig",
@@ -205,7 +206,8 @@ class RobotConfig:
         controllers: JointTrajectoryControllers from ros2_controllers.yaml.
         execution: MoveIt's trajectory_execution settings.
         initial_positions: Where the fake hardware starts (joint -> value).
-        planning: moveplan.yaml `planning` defaults: group, planner, planning_time.
+        planning: moveplan.yaml `planning` defaults: group, planner, planning_time, and
+            collision (`exact`: the URDF's meshes; `convex`: their convex hulls).
         files: File name -> bytes of every config file, to embed in plan files; laid out in
             one folder they load again as this config (expanded URDF, generated moveplan.yaml).
         package_paths: Folders searched for `$(find pkg)` and `package://` URIs, in order.
@@ -270,7 +272,8 @@ _MOVEPLAN_KEYS = {
     "initial_positions", "planning", "package_paths", "xacro_args",
 }
 _FILE_KEYS = ("urdf", "srdf", "joint_limits", "kinematics", "controllers", "moveit_controllers", "initial_positions")
-_PLANNING_KEYS = {"group", "planner", "planning_time"}
+_PLANNING_KEYS = {"group", "planner", "planning_time", "collision"}
+COLLISION_MODES = ("exact", "convex")  # robot meshes as triangle BVHs, or as their convex hulls
 _LIMIT_KEYS = {
     "has_position_limits", "min_position", "max_position", "has_velocity_limits", "max_velocity",
     "has_acceleration_limits", "max_acceleration", "has_deceleration_limits", "max_deceleration",
@@ -570,7 +573,8 @@ def _planning(
     """Return the planning defaults and the file that chose the group.
 
     Precedence: moveplan.yaml `planning` > ompl_planning.yaml (its first group section, and
-    that group's `default_planner_config`) > the SRDF's first group, RRTConnect, 1 s.
+    that group's `default_planner_config`) > the SRDF's first group, RRTConnect, 1 s, and
+    `exact` collision geometry.
     """
     planning = mapping(top.get("planning"), f"{manifest}: planning")
     check_keys(planning, _PLANNING_KEYS, f"{manifest}: planning")
@@ -586,6 +590,10 @@ def _planning(
     planning["planning_time"] = number(
         planning.get("planning_time", 1.0), f"{manifest}: planning.planning_time", positive=True
     )
+    planning.setdefault("collision", "exact")
+    if planning["collision"] not in COLLISION_MODES:
+        raise ConfigError(f"{manifest}: planning.collision: expected one of {', '.join(COLLISION_MODES)}, "
+                          f"got {planning['collision']!r}")
     return planning, source
 
 

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from moveplan.core import recording
+from moveplan.core.cartesian import straight_line
 from moveplan.core.collision import CollisionChecker
 from moveplan.core.config import RobotConfig, load_robot_config
 from moveplan.core.errors import (
@@ -29,16 +30,15 @@ from moveplan.core.errors import (
     StartInCollision,
     UsageError,
 )
-from moveplan.core.cartesian import straight_line
 from moveplan.core.goals import check_limits, joint_target, pose_error, tip_target
 from moveplan.core.kinematics import solve_ik
-from moveplan.core.planning import interpolate, plan_path, seed_planner
+from moveplan.core.planning import plan_path, seed_planner
 from moveplan.core.robot import Robot
 from moveplan.core.scene import Scene, empty_scene, load_scene
 from moveplan.core.tasks import StepSpec, TaskFile
 from moveplan.core.timing import time_parameterize
 from moveplan.core.trajectory import sample
-from moveplan.core.types import Frame, JointTrajectory, Plan, StepResult, TfSamples
+from moveplan.core.types import JointTrajectory, Plan, StepResult, TfSamples
 
 __all__ = ["PlanRequest", "plan", "resolve_request"]
 
@@ -106,7 +106,7 @@ def plan(request: PlanRequest) -> Plan:
     config = load_robot_config(request.robot, request.package_paths, request.xacro_args)
     robot = Robot(config, request.group)
     scene = load_scene(request.scene, robot) if request.scene else empty_scene()
-    checker = CollisionChecker(robot, scene.objects, scene.source)
+    checker = CollisionChecker(robot, scene.objects, scene.source, geometry=config.planning["collision"])
     base = robot.neutral()
     current = _start_values(request, robot, base)
     pair = checker.colliding_pair(robot.configuration(current, base))

@@ -107,7 +107,8 @@ def test_xacro_arg_flags_parse_as_ros2_launch_writes_them() -> None:
 
 def test_plain_folder_with_urdf_srdf_and_joint_limits_loads(tmp_path: Path) -> None:
     config = load_robot_config(plain(tmp_path, **{"joint_limits.yaml": LIMITS}))
-    assert config.name == "arm" and config.planning == {"group": "arm", "planner": "RRTConnect", "planning_time": 1.0}
+    assert config.name == "arm"
+    assert config.planning == {"group": "arm", "planner": "RRTConnect", "planning_time": 1.0, "collision": "exact"}
     assert config.limits["j1"].max_acceleration == 3.0
     assert config.sources["planning"] == tmp_path / "arm.srdf"
     assert "moveplan" not in config.sources and "controllers" not in config.sources

@@ -47,7 +47,8 @@ def no_ros_environment(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_a_moveit_package_loads_without_moveplan_yaml(ur10e_package: RobotConfig) -> None:
     config = ur10e_package
     assert config.name == "ur10e" and config.root == PACKAGE
-    assert config.planning == {"group": "ur_manipulator", "planner": "RRTConnect", "planning_time": 1.0}
+    assert config.planning == {"group": "ur_manipulator", "planner": "RRTConnect", "planning_time": 1.0,
+                               "collision": "exact"}
     assert config.group().joints[0] == "shoulder_pan_joint" and config.group().tip == "tool0"
     assert config.limits["elbow_joint"].max_acceleration == 5.0
     assert config.controllers["joint_trajectory_controller"].goal_tolerance["elbow_joint"] == 0.1
