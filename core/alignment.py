@@ -87,7 +87,7 @@ class StepProfile:
         duration = trajectory.duration_s
         count = int(min(200_000, max(2, math.ceil(duration / 1e-3) + 1)))
         times = np.linspace(0.0, duration, count)
-        positions, _, _ = sample(trajectory, times)
+        positions, _, _ = sample(trajectory, times, derivatives=0)
         error = position_error(positions, trajectory.positions[0], continuous)
         distance = np.abs(error).max(axis=1)
         extent = float(distance.max(initial=0.0))

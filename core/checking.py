@@ -349,7 +349,8 @@ def _judge_step(
         stop = min(max(stop, first + 1), end)
         since = times[first:stop] - start
         reference, reference_v, _ = sample(trajectory, since, point_before=point_before,
-                                           continuous=samples.continuous)
+                                           continuous=samples.continuous,
+                                           derivatives=1 if context.check_velocities else 0)
         report = judge(
             context.tolerances, since, reference, samples.rows(first, stop),
             # As the simulation: JTC takes the segment from the command's time, one period on.

@@ -67,6 +67,7 @@ def sample(
     has_accelerations: bool = True,
     point_before: PointBefore | None = None,
     continuous: npt.ArrayLike | None = None,
+    derivatives: int = 2,
 ) -> Samples:
     """Return positions, velocities and accelerations, each (len(times), n), at `times_s` in [s].
 
@@ -83,6 +84,8 @@ def sample(
             give the first point.
         continuous: Per joint, True for URDF continuous joints: the point before is shifted by
             whole turns towards the first point (JTC `wraparound_joint`).
+        derivatives: 2 for velocities and accelerations, 1 for velocities only, 0 for neither;
+            what is not computed is returned as zeros (checks of long recordings need less).
     """
     knots = trajectory.times_s
     positions = trajectory.positions
@@ -100,7 +103,7 @@ def sample(
         has_v = np.concatenate(([point_before.velocities is not None], has_v))
         has_a = np.concatenate(([point_before.accelerations is not None and has_v[0]], has_a))
     t = np.atleast_1d(np.asarray(times_s, dtype=np.float64))
-    return _sample_points(knots, positions, velocities, accelerations, has_v, has_a, t)
+    return _sample_points(knots, positions, velocities, accelerations, has_v, has_a, t, derivatives)
 
 
 def peak_rates(trajectory: JointTrajectory) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -176,6 +179,7 @@ def _sample_points(
     has_v: NDArray[np.bool_],
     has_a: NDArray[np.bool_],
     t: NDArray[np.float64],
+    derivatives: int = 2,
 ) -> Samples:
     """Return samples of the spline through the points; `has_v`/`has_a`: fields each point has."""
     count, n = p.shape
@@ -186,14 +190,25 @@ def _sample_points(
     c0, c1, c2, c3, c4, c5 = np.take(_coefficients(knots, p, v, a, has_v, has_a), seg, axis=1)
     h = (knots[seg + 1] - knots[seg])[:, None]
     x = np.clip(t[:, None] - knots[seg][:, None], 0.0, h)
-    pos = c0 + x * (c1 + x * (c2 + x * (c3 + x * (c4 + x * c5))))
-    vel = c1 + x * (2 * c2 + x * (3 * c3 + x * (4 * c4 + x * 5 * c5)))
-    acc = 2 * c2 + x * (6 * c3 + x * (12 * c4 + x * 20 * c5))
+    pos = _horner((c0, c1, c2, c3, c4, c5), x)
+    # Zeros from calloc cost nothing until written: long recordings need positions only.
+    vel = _horner((c1, 2 * c2, 3 * c3, 4 * c4, 5 * c5), x) if derivatives >= 1 else np.zeros_like(pos)
+    acc = _horner((2 * c2, 6 * c3, 12 * c4, 20 * c5), x) if derivatives >= 2 else np.zeros_like(pos)
     after = t >= knots[-1]
-    pos[after], vel[after], acc[after] = p[-1], v[-1], a[-1]
+    pos[after], vel[after], acc[after] = p[-1], v[-1] if derivatives >= 1 else 0.0, a[-1] if derivatives >= 2 else 0.0
     before = t < knots[0]
     pos[before], vel[before], acc[before] = p[0], 0.0, 0.0
     return pos, vel, acc
+
+
+def _horner(coefficients: tuple[NDArray[np.float64], ...], x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Return sum_k coefficients[k] x^k, evaluated in place (one array, no temporaries per term)."""
+    result = coefficients[-1] * x
+    for coefficient in coefficients[-2:0:-1]:
+        result += coefficient
+        result *= x
+    result += coefficients[0]
+    return result
 
 
 def _hold(
