@@ -12,6 +12,7 @@ import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -23,9 +24,11 @@ from moveplan.core.controller import Disturbance, ExecutionReport, simulate
 from moveplan.core.errors import ConfigError, InputError, UnknownName
 from moveplan.core.jointstates import read_joint_states
 from moveplan.core.plants import make_plant
-from moveplan.core.robot import Robot
 from moveplan.core.tolerances import ExecutionResult, Violation
 from moveplan.core.types import TfSamples
+
+if TYPE_CHECKING:
+    from moveplan.core.robot import Robot
 
 _TF_RATE_HZ = 30.0
 
@@ -148,6 +151,9 @@ def execute(request: ExecuteRequest) -> PlanExecution:
             break
         start = report.actual_positions[-1] if len(report.times_s) else start
     last = steps[-1].report
+    # pinocchio is imported here, not at the top: check-tolerances shares this module and needs no kinematics.
+    from moveplan.core.robot import Robot
+
     tf = _executed_tf(Robot(config, plan.group), steps)
     return PlanExecution(last.ok, last.result, tuple(steps), controller, plan, tf)
 
