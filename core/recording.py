@@ -39,6 +39,7 @@ from numpy.typing import NDArray
 
 from moveplan.core import ros_messages as msgs
 from moveplan.core.errors import InputError
+from moveplan.core.jointstate_cdr import encode_joint_states
 from moveplan.core.tolerances import velocity_error_computable
 from moveplan.core.types import JointTrajectory, Plan, TfSamples
 
@@ -218,7 +219,7 @@ def write_execution(
         report = step.report
         times_ns = _seconds_to_ns(report.times_s)
         stamps_ns = start_ns + times_ns
-        joint_states = msgs.joint_states_cdr(
+        joint_states = encode_joint_states(
             report.joint_names, stamps_ns, report.actual_positions, report.actual_velocities
         )
         states = _controller_states(report, controller, stamps_ns, times_ns)

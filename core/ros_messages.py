@@ -38,7 +38,6 @@ __all__ = [
     "display_trajectory_cdr",
     "durability",
     "joint_state",
-    "joint_states_cdr",
     "joint_trajectory",
     "joint_trajectory_cdr",
     "marker_array",
@@ -364,30 +363,6 @@ def tf_messages_cdr(
     patches += [(start, poses[:, child]) for child, start in enumerate(pose_at)]
     messages = patched_copies(template.data(), len(stamps), patches)
     return [message.tobytes() for message in messages]
-
-
-def joint_states_cdr(
-    names: Sequence[str],
-    stamps_ns: NDArray[np.int64],
-    positions: NDArray[np.float64],
-    velocities: NDArray[np.float64],
-    frame_id: str = "",
-) -> list[bytes]:
-    """Return one CDR `joint_state` per stamp; `positions` and `velocities` are (stamps, joints)."""
-    template = CdrWriter()
-    stamp_at = template.time(0)
-    template.string(frame_id)
-    template.strings(names)
-    zeros = np.zeros(len(names))
-    position_at = template.float64_sequence(zeros)
-    velocity_at = template.float64_sequence(zeros)
-    template.uint32(0)  # effort[]
-    patches: list[tuple[int, NDArray[np.generic]]] = [
-        (stamp_at, time_array(stamps_ns)),
-        (position_at, _column(positions)),
-        (velocity_at, _column(velocities)),
-    ]
-    return _copies(template.data(), len(stamps_ns), patches)
 
 
 def controller_states_cdr(states: ControllerStates, distro: str) -> list[bytes]:

@@ -24,6 +24,7 @@ from moveplan.core.config import ControllerConfig, ExecutionConfig
 from moveplan.core.controller import ExecutionReport, simulate
 from moveplan.core.errors import InputError, UsageError
 from moveplan.core.execution import PlanExecution, StepExecution
+from moveplan.core.jointstate_cdr import encode_joint_states
 from moveplan.core.plants import FrozenPlant, MirrorPlant, make_plant
 from moveplan.core.tolerances import Violation
 from moveplan.core.types import JointTrajectory, Plan, StepResult, TfSamples
@@ -552,7 +553,7 @@ def test_fast_joint_states_match_the_generic_encoder(
     names = ODD_NAMES[:joints]
     stamps = np.cumsum(rng.integers(1, 1_500_000_000, count))
     positions, velocities = rng.normal(size=(count, joints)), rng.normal(size=(count, joints))
-    encoded = msgs.joint_states_cdr(names, stamps, positions, velocities, frame_id)
+    encoded = encode_joint_states(names, stamps, positions, velocities, frame_id=frame_id)
     assert len(encoded) == count
     for data, stamp, q, v in zip(encoded, stamps.tolist(), positions, velocities, strict=True):
         message = msgs.joint_state(names, stamp, q, v, frame_id)
