@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 
 from moveplan.core.config import ControllerConfig, ExecutionConfig
 from moveplan.core.jointstates import JOINT_STATE_TYPE, encode_joint_states
+from moveplan.core.recording import PlanStepRecord
 from moveplan.core.trajectory import sample
 from moveplan.core.types import JointTrajectory
 
@@ -48,19 +49,10 @@ QOS = ("- history: 3\n  depth: 0\n  reliability: 1\n  durability: 2\n  deadline:
 
 
 @dataclass(frozen=True)
-class Step:
-    """A plan step, as core.recording.PlanStepRecord holds one."""
-
-    name: str
-    start_s: float
-    trajectory: JointTrajectory
-
-
-@dataclass(frozen=True)
 class Plan:
     """The steps of the cycle."""
 
-    steps: tuple[Step, ...]
+    steps: tuple[PlanStepRecord, ...]
 
 
 def minimum_jerk(
@@ -79,8 +71,8 @@ def minimum_jerk(
 
 def cycle_plan() -> Plan:
     """Return the plan the robot repeats: out to the pick pose and back home."""
-    return Plan((Step("out", 0.0, minimum_jerk(HOME, PICK, MOVE_S)),
-                 Step("back", MOVE_S, minimum_jerk(PICK, HOME, MOVE_S))))
+    return Plan((PlanStepRecord("out", 0.0, minimum_jerk(HOME, PICK, MOVE_S)),
+                 PlanStepRecord("back", MOVE_S, minimum_jerk(PICK, HOME, MOVE_S))))
 
 
 def controller() -> ControllerConfig:

@@ -20,6 +20,7 @@ from moveplan.core.jointstates import (
     read_joint_states,
 )
 from moveplan.core.plants import MirrorPlant
+from moveplan.core.recording import PlanStepRecord
 from moveplan.core.trajectory import sample
 from moveplan.core.types import JointTrajectory
 
@@ -33,15 +34,8 @@ SCHEMA = (Path(__file__).resolve().parents[1] / "core/msgs/jazzy/sensor_msgs__ms
 
 
 @dataclass(frozen=True)
-class Step:
-    name: str
-    start_s: float
-    trajectory: JointTrajectory
-
-
-@dataclass(frozen=True)
 class Plan:
-    steps: tuple[Step, ...]
+    steps: tuple[PlanStepRecord, ...]
 
 
 def minimum_jerk(start, goal, duration: float) -> JointTrajectory:
@@ -57,8 +51,8 @@ def minimum_jerk(start, goal, duration: float) -> JointTrajectory:
 
 OUT = minimum_jerk(HOME, PICK, 2.0)
 BACK = minimum_jerk(PICK, HOME, 2.0)
-ONE_STEP = Plan((Step("out", 0.0, OUT),))
-CYCLE = Plan((Step("out", 0.0, OUT), Step("back", 2.0, BACK)))
+ONE_STEP = Plan((PlanStepRecord("out", 0.0, OUT),))
+CYCLE = Plan((PlanStepRecord("out", 0.0, OUT), PlanStepRecord("back", 2.0, BACK)))
 
 
 def jtc(commands=("position",), goal_time: float = 0.5, joints=JOINTS) -> ControllerConfig:
