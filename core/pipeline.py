@@ -105,6 +105,10 @@ def plan(request: PlanRequest) -> Plan:
     seed_planner(request.seed)
     config = load_robot_config(request.robot, request.package_paths, request.xacro_args)
     robot = Robot(config, request.group)
+    missing = config.missing_acceleration_limits(robot.group.name)
+    if missing:
+        raise ConfigError(f"{config.root}: no acceleration limit for joints {', '.join(missing)} "
+                          "(joint_limits.yaml: has_acceleration_limits, max_acceleration)")
     scene = load_scene(request.scene, robot) if request.scene else empty_scene()
     checker = CollisionChecker(robot, scene.objects, scene.source, geometry=config.planning["collision"])
     base = robot.neutral()
@@ -178,10 +182,6 @@ def _plan_step(
 ) -> StepResult:
     began = time.perf_counter()
     source = str(request.task.source) if request.task else "flags"
-    missing = [j for i, j in enumerate(robot.joint_names) if not np.isfinite(robot.max_acceleration[i])]
-    if missing:
-        raise ConfigError(f"{robot.config.root}: no acceleration limit for joints {', '.join(missing)} "
-                          "(joint_limits.yaml: has_acceleration_limits, max_acceleration)")
 
     def free_batch(values: NDArray[np.float64]) -> NDArray[np.bool_]:
         return checker.free_batch(robot.configurations(values, base))
