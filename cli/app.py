@@ -50,7 +50,10 @@ def plan(
     task: Annotated[Path | None, typer.Argument(help="Task file (DESIGN section 4).", show_default=False)] = None,
     output: Annotated[Path, typer.Option("--output", "-o", help="Plan file to write (.mcap).")] = Path("plan.mcap"),
     robot: Annotated[Path | None, typer.Option(help="Robot config: a moveplan.yaml or a folder holding one.")] = None,
-    scene: Annotated[Path | None, typer.Option(help="Scene file: frames and collision objects.")] = None,
+    scene: Annotated[Path | None, typer.Option(
+        help="Scene file: frames and collision objects, or a MoveIt PlanningScene YAML.")] = None,
+    motion_request: Annotated[Path | None, typer.Option(
+        "--request", help="MoveIt MotionPlanRequest YAML: start state, goal, group, planner, scaling.")] = None,
     group: Annotated[str | None, typer.Option(help="Planning group (default: the config's).")] = None,
     start_joints: Annotated[str | None, typer.Option(help="Start joints: '0,-1.57,...' or 'joint=value'.")] = None,
     start_named: Annotated[str | None, typer.Option(help="Start at an SRDF group_state.")] = None,
@@ -136,7 +139,8 @@ def _plan_flags(args: dict[str, Any]) -> dict[str, Any]:
         if planning_time <= 0:
             raise UsageError(f"--planning-time: expected a positive number of seconds, got '{args['planning_time']}'")
     return {
-        "robot": args["robot"], "scene": args["scene"], "group": args["group"], "start": start, "steps": steps,
+        "robot": args["robot"], "scene": args["scene"], "request": args["motion_request"], "group": args["group"],
+        "start": start, "steps": steps,
         "planner": args["planner"], "planning_time": planning_time, "seed": args["seed"],
         "velocity_scaling": parse_scaling(args["velocity_scaling"], "--velocity-scaling"),
         "acceleration_scaling": parse_scaling(args["acceleration_scaling"], "--acceleration-scaling"),

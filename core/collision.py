@@ -48,6 +48,13 @@ def coal_geometry(shape: Shape, source: str = "scene") -> coal.CollisionGeometry
         return coal.Cylinder(radius, length)
     if shape.kind == "sphere":
         return coal.Sphere(shape.dims[0])
+    if shape.vertices is not None and shape.triangles is not None:
+        mesh = coal.BVHModelOBBRSS()
+        mesh.beginModel(len(shape.triangles), len(shape.vertices))
+        mesh.addVertices(np.asarray(shape.vertices) * np.array(shape.scale))
+        mesh.addTriangles(np.asarray(shape.triangles))
+        mesh.endModel()
+        return mesh
     path = Path(shape.mesh_path)
     if not path.is_file():
         raise ConfigError(f"{source}: mesh file not found: {path}")
@@ -117,6 +124,7 @@ class CollisionChecker:
         objects: tuple[CollisionObject, ...] = (),
         source: str = "scene",
         geometry: GeometryMode = "exact",
+        allowed: frozenset[frozenset[str]] = frozenset(),
     ) -> None:
         """Build the geometry model of `robot` and `objects` and decide which pairs to check.
 
@@ -127,6 +135,8 @@ class CollisionChecker:
             geometry: `exact` checks the URDF's meshes as triangle BVHs; `convex` checks each
                 robot mesh's convex hull instead (faster; conservative, since a hull encloses
                 its mesh). Scene objects are checked as given in both modes.
+            allowed: Pairs of link or object names allowed to touch (a scene's allowed
+                collision matrix), in addition to the SRDF's disabled pairs.
 
         Raises:
             ConfigError: A mesh cannot be read, or (convex) qhull fails on one.
@@ -167,7 +177,7 @@ class CollisionChecker:
         self.owner = tuple(owner)
         robot_count = len(owner) - len(objects)
         joint_of = [g.parentJoint for g in geom.geometryObjects]
-        disabled = config.srdf.disabled_pairs
+        disabled = config.srdf.disabled_pairs | allowed
         fixed_pairs: list[tuple[int, int]] = []
         for i in range(len(owner)):
             for j in range(i + 1, len(owner)):

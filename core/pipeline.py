@@ -2,7 +2,7 @@
 
 Data flows one way; this module is the only one that composes planning,
 timing and recording. Precedence of settings lives in `resolve_request`:
-flag > task file > robot config > built-in default.
+flag > MoveIt request > task file > robot config > built-in default.
 """
 
 from __future__ import annotations
@@ -28,11 +28,14 @@ from moveplan.core.errors import (
     GoalUnreachable,
     PlanningFailed,
     StartInCollision,
+    UnknownName,
     UsageError,
 )
 from moveplan.core.goals import check_limits, joint_target, pose_error, tip_target
 from moveplan.core.kinematics import solve_ik
-from moveplan.core.planning import interpolate, plan_path, seed_planner
+from moveplan.core.moveit_messages import known_joints
+from moveplan.core.moveit_request import MotionPlanRequest, load_motion_plan_request
+from moveplan.core.planning import Validity, interpolate, plan_path, seed_planner
 from moveplan.core.robot import Robot
 from moveplan.core.scene import Scene, empty_scene, load_scene
 from moveplan.core.tasks import StepSpec, TaskFile
@@ -70,33 +73,53 @@ class PlanRequest:
     package_paths: tuple[Path, ...] = ()
     xacro_args: dict[str, str] = field(default_factory=dict)
     task: TaskFile | None = None
+    motion_request: MotionPlanRequest | None = None
 
 
 def resolve_request(task: TaskFile | None, flags: dict[str, Any]) -> PlanRequest:
-    """Return the request that flags and task give together: a flag wins over the task."""
+    """Return the request that flags, a MoveIt request (flags["request"]) and task give together.
+
+    A flag wins over the MoveIt request, which wins over the task. A goal by flag replaces the
+    request's goal; a request's goal and a task's steps conflict, as a flag goal and task steps do.
+    The request's start state, when it has one, replaces the task's start.
+    """
+    motion = load_motion_plan_request(Path(flags["request"])) if flags.get("request") else None
     task_values: dict[str, Any] = {}
     if task is not None:
         task_values = {"robot": task.robot, "scene": task.scene, "group": task.group, "seed": task.seed,
                        **task.defaults}
+    request_values: dict[str, Any] = {}
+    if motion is not None:
+        request_values = {"group": motion.group_name, "planner": motion.planner,
+                          "planning_time": motion.planning_time, "velocity_scaling": motion.velocity_scaling,
+                          "acceleration_scaling": motion.acceleration_scaling}
     merged = {k: v for k, v in task_values.items() if v is not None}
-    merged.update({k: v for k, v in flags.items() if v is not None and k not in ("steps", "start")})
+    merged.update({k: v for k, v in request_values.items() if v is not None})
+    merged.update({k: v for k, v in flags.items() if v is not None and k not in ("steps", "start", "request")})
     steps = tuple(flags.get("steps") or ())
     if steps and task is not None and task.steps:
         raise UsageError(f"{task.source} has steps; give a goal by flag or by task, not both")
+    if not steps and motion is not None and motion.goal is not None:
+        if task is not None and task.steps:
+            raise UsageError(f"{task.source} has steps and {motion.source} has goal_constraints; give one of them")
+        steps = (motion.goal,)
     if task is not None and not steps:
         steps = task.steps
     if not steps:
-        raise UsageError("no goal: give --joints, --named, --pose, --shift, or a task file with steps")
+        raise UsageError("no goal: give --joints, --named, --pose, --shift, a --request with goal_constraints, "
+                         "or a task file with steps")
     if "robot" not in merged:
         raise UsageError("no robot: give --robot or a task file naming one")
-    start = flags.get("start") or (task.start if task is not None else {})
+    start = flags.get("start") or {}
+    if not start and task is not None and not (motion is not None and motion.start):
+        start = task.start
     return PlanRequest(
         robot=Path(merged["robot"]), steps=steps, scene=merged.get("scene"), group=merged.get("group"),
         start=start, planner=merged.get("planner"), planning_time=merged.get("planning_time"),
         velocity_scaling=merged.get("velocity_scaling"), acceleration_scaling=merged.get("acceleration_scaling"),
         seed=int(merged.get("seed") or 0), min_fraction=float(merged.get("min_fraction", 1.0)),
         package_paths=tuple(flags.get("package_paths") or ()),
-        xacro_args=dict(flags.get("xacro_args") or {}), task=task,
+        xacro_args=dict(flags.get("xacro_args") or {}), task=task, motion_request=motion,
     )
 
 
@@ -104,15 +127,24 @@ def plan(request: PlanRequest) -> Plan:
     """Return the timed, collision-free plan for every step of `request`, in order."""
     seed_planner(request.seed)
     config = load_robot_config(request.robot, request.package_paths, request.xacro_args)
+    motion = request.motion_request
+    if motion is not None and motion.group_name and request.group == motion.group_name:
+        if motion.group_name not in config.srdf.groups:
+            raise UnknownName("group", motion.group_name, f"{motion.source}: group_name", config.srdf.groups)
     robot = Robot(config, request.group)
+    if motion is not None and motion.goal is not None and any(s is motion.goal for s in request.steps):
+        for joint in motion.goal.goal.get("joints", {}):
+            if joint not in robot.joint_names:
+                raise UnknownName("joint", joint, f"{motion.source}: goal_constraints[0].joint_constraints "
+                                  f"(group '{robot.group.name}')", robot.joint_names)
     missing = config.missing_acceleration_limits(robot.group.name)
     if missing:
         raise ConfigError(f"{config.root}: no acceleration limit for joints {', '.join(missing)} "
                           "(joint_limits.yaml: has_acceleration_limits, max_acceleration)")
     scene = load_scene(request.scene, robot) if request.scene else empty_scene()
-    checker = CollisionChecker(robot, scene.objects, scene.source, geometry=config.planning["collision"])
-    base = robot.neutral()
-    current = _start_values(request, robot, base)
+    checker = CollisionChecker(robot, scene.objects, scene.source, geometry=config.planning["collision"],
+                               allowed=scene.allowed)
+    base, current = _start_values(request, robot, scene)
     pair = checker.colliding_pair(robot.configuration(current, base))
     if pair:
         raise StartInCollision(pair)
@@ -150,18 +182,33 @@ def _in_step(exc: Exception, step: str) -> Exception:
     return exc
 
 
-def _start_values(request: PlanRequest, robot: Robot, base: NDArray[np.float64]) -> NDArray[np.float64]:
+def _start_values(
+    request: PlanRequest, robot: Robot, scene: Scene
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Return the start configuration (all joints) and the group's start values.
+
+    Every joint starts at the initial positions, overridden by the scene's robot state, then
+    by the MoveIt request's start state (MoveIt applies a request's start state on top of the
+    scene's). The group's joints then take a start flag or the task's start, if given.
+    """
+    base = robot.neutral()
+    states = [scene.robot_state]
+    if request.motion_request is not None:
+        motion = request.motion_request
+        states.append(known_joints(motion.start, robot, f"{motion.source}: start_state.joint_state.name"))
+    for state in states:
+        for joint, value in state.items():
+            base = robot.set_joint(base, joint, value)
     start = request.start
     neutral = robot.values(base)
     if not start:
-        return neutral
+        return base, neutral
     if "from" in start:
         last = recording.read_plan(Path(start["from"])).steps[-1].trajectory
         values = dict(zip(last.joint_names, last.positions[-1], strict=True))
         start = {"joints": {j: float(v) for j, v in values.items() if j in robot.joint_names}}
     source = str(request.task.source) if request.task else "--start-joints"
-    values = joint_target(robot, start, neutral, source)
-    return values
+    return base, joint_target(robot, start, neutral, source)
 
 
 def _scaling(robot: Robot, request: PlanRequest, spec: StepSpec) -> tuple[float, float]:
@@ -217,7 +264,7 @@ def _plan_step(
         search = lambda resolution: np.asarray(line.waypoints)  # noqa: E731 - the line is already checked
     else:
         search = lambda resolution: plan_path(  # noqa: E731
-            start, goal, robot.lower, robot.upper, free_batch, planner, planning_time, resolution).waypoints
+            start, goal, robot.lower, robot.upper, _validity(free_batch, resolution), planner, planning_time).waypoints
     v_scale, a_scale = _scaling(robot, request, spec)
     max_velocity, max_acceleration = robot.max_velocity * v_scale, robot.max_acceleration * a_scale
     for resolution, max_step in _ATTEMPTS:
@@ -258,6 +305,14 @@ def _plan_step(
         trajectory=trajectory,
         fraction=fraction,
         residual=residual,
+    )
+
+
+def _validity(free_batch: Callable[[NDArray[np.float64]], NDArray[np.bool_]], resolution: float) -> Validity:
+    """Return the search's checks: states, and edges interpolated at `resolution` [rad] in one batch."""
+    return Validity(
+        state_free=lambda values: bool(free_batch(values[None, :])[0]),
+        edge_free=lambda a, b: bool(free_batch(interpolate(a, b, resolution)[1:]).all()),
     )
 
 
@@ -322,4 +377,6 @@ def _attachments(config: RobotConfig, request: PlanRequest) -> dict[str, bytes]:
         files[f"scene{Path(request.scene).suffix}"] = Path(request.scene).read_bytes()
     if request.task is not None:
         files["task.yaml"] = request.task.raw
+    if request.motion_request is not None:
+        files["request.yaml"] = request.motion_request.raw
     return files

@@ -1,10 +1,10 @@
 """Joint-space path planning with OMPL's geometric planners.
 
-The planner sees the group's joint values in a box of joint limits. Every edge
-it tries is checked by interpolating it at `resolution` and testing all those
-states in one batch call; the returned path is simplified with OMPL's own
-simplifier under the same checks, or replaced by the straight segment from start
-to goal when that is free.
+The planner sees the group's joint values in a box of joint limits. States and
+whole edges are checked by the caller's `Validity` (one call per edge, so the
+caller can check all its states in one batch); the returned path is simplified
+with OMPL's own simplifier under the same checks, or replaced by the straight
+segment from start to goal when that is free.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from ompl import util as ou
 from moveplan.core.errors import PlanningFailed, UsageError, known
 from moveplan.core.types import frozen_array
 
-__all__ = ["PLANNERS", "PathResult", "interpolate", "plan_path", "seed_planner"]
+__all__ = ["PLANNERS", "PathResult", "Validity", "interpolate", "plan_path", "seed_planner"]
 
 logger = logging.getLogger(__name__)
 ou.setLogLevel(ou.LOG_ERROR)
@@ -33,7 +33,6 @@ PLANNERS = tuple(
     if name[0].isupper() and isinstance(getattr(og, name), type) and issubclass(getattr(og, name), ob.Planner)
 )
 
-FreeBatch = Callable[[NDArray[np.float64]], NDArray[np.bool_]]
 _seeded: list[int] = []
 
 
@@ -45,6 +44,14 @@ def seed_planner(seed: int) -> None:
         return
     ou.RNG.setSeed(seed + 1)  # OMPL refuses 0 as a seed
     _seeded.append(seed)
+
+
+@dataclass(frozen=True)
+class Validity:
+    """The search's collision checks on group joint values: one state, and the straight edge between two."""
+
+    state_free: Callable[[NDArray[np.float64]], bool]
+    edge_free: Callable[[NDArray[np.float64], NDArray[np.float64]], bool]
 
 
 @dataclass(frozen=True)
@@ -78,19 +85,17 @@ def plan_path(
     goal: NDArray[np.float64],
     lower: NDArray[np.float64],
     upper: NDArray[np.float64],
-    free_batch: FreeBatch,
+    validity: Validity,
     planner: str = "RRTConnect",
     time_s: float = 1.0,
-    resolution: float = 0.01,
 ) -> PathResult:
     """Return a collision-free path from `start` to `goal`, both given as group joint values.
 
-    `free_batch` answers, for states of shape (k, dof), which are collision-free.
     Raises PlanningFailed when no path is found within `time_s` seconds.
     """
     if planner not in PLANNERS:
         raise UsageError(f"unknown planner '{planner}'; OMPL geometric planners: {known(PLANNERS)}")
-    return _plan(start, goal, lower, upper, free_batch, planner, time_s, resolution)
+    return _plan(start, goal, lower, upper, validity, planner, time_s)
 
 
 def _plan(
@@ -98,10 +103,9 @@ def _plan(
     goal: NDArray[np.float64],
     lower: NDArray[np.float64],
     upper: NDArray[np.float64],
-    free_batch: FreeBatch,
+    validity: Validity,
     planner: str,
     time_s: float,
-    resolution: float,
 ) -> PathResult:
     dof = len(start)
     space = ob.RealVectorStateSpace(dof)
@@ -115,17 +119,16 @@ def _plan(
     def values(state: ob.State) -> NDArray[np.float64]:
         return np.array([state[i] for i in range(dof)])
 
-    setup.setStateValidityChecker(lambda state: bool(free_batch(values(state)[None, :])[0]))
+    setup.setStateValidityChecker(lambda state: validity.state_free(values(state)))
 
-    class BatchMotionValidator(ob.MotionValidator):  # type: ignore[misc]
-        """Checks a whole edge in one batch call."""
+    class EdgeValidator(ob.MotionValidator):  # type: ignore[misc]
+        """Checks a whole edge in one call."""
 
         def checkMotion(self, s1: ob.State, s2: ob.State, *rest: object) -> bool:  # noqa: N802 - OMPL's name
-            return bool(free_batch(interpolate(values(s1), values(s2), resolution)[1:]).all())
+            return validity.edge_free(values(s1), values(s2))
 
     info = setup.getSpaceInformation()
-    info.setMotionValidator(BatchMotionValidator(info))
-    info.setStateValidityCheckingResolution(resolution / space.getMaximumExtent())
+    info.setMotionValidator(EdgeValidator(info))
     endpoints = []
     for point in (start, goal):
         state = space.allocState()
@@ -141,7 +144,7 @@ def _plan(
     if not setup.haveExactSolutionPath():
         raise PlanningFailed(f"{planner} found no path in {time_s:g} s ({status})")
     began = time.perf_counter()
-    if free_batch(interpolate(start, goal, resolution)).all():
+    if validity.edge_free(start, goal):
         # The straight segment is what shortcutting converges to; checking it first saves
         # the simplifier's many edge checks (3/4 of the planning time on easy problems).
         waypoints = np.array([start, goal])

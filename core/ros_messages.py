@@ -54,6 +54,7 @@ __all__ = [
 Message = dict[str, Any]
 
 _MARKER_TYPES = {"box": 1, "sphere": 2, "cylinder": 3, "mesh": 10}  # CUBE, SPHERE, CYLINDER, ...
+_TRIANGLE_LIST = 11
 # MoveIt's RViz defaults: scene objects green, attached objects purple.
 _SCENE_COLOR = {"r": 0.2, "g": 0.9, "b": 0.2, "a": 0.9}
 _ATTACHED_COLOR = {"r": 0.6, "g": 0.2, "b": 0.6, "a": 0.9}
@@ -415,11 +416,17 @@ def _marker(obj: CollisionObject, marker_id: int, planning_frame: str) -> Messag
     mesh_path = shape.mesh_path
     if mesh_path and "://" not in mesh_path:
         mesh_path = Path(mesh_path).absolute().as_uri()
+    marker_type, points = _MARKER_TYPES[shape.kind], []
+    if shape.vertices is not None and shape.triangles is not None:
+        # An inline mesh has no file for mesh_resource: draw its triangles, three points each.
+        marker_type = _TRIANGLE_LIST
+        corners = shape.vertices[shape.triangles.ravel()]
+        points = [{"x": float(x), "y": float(y), "z": float(z)} for x, y, z in corners]
     return {
         "header": {"stamp": time_msg(0), "frame_id": obj.link or planning_frame},
         "ns": "moveplan",
         "id": marker_id,
-        "type": _MARKER_TYPES[shape.kind],
+        "type": marker_type,
         "action": 0,  # ADD
         "pose": {"position": _xyz(obj.transform), "orientation": _quaternion(obj.transform)},
         "scale": dict(zip("xyz", map(float, scale), strict=True)),
@@ -429,6 +436,7 @@ def _marker(obj: CollisionObject, marker_id: int, planning_frame: str) -> Messag
         # Only TEXT markers show `text`; it names the object for anyone reading the message.
         "text": obj.name,
         "mesh_resource": mesh_path,
+        "points": points,
     }
 
 

@@ -3,12 +3,16 @@
 Frames may chain and may hang off robot links. Everything is resolved to the
 planning frame (the URDF root) with the robot at its neutral configuration,
 so world objects must sit in frames that do not move with the arm.
+
+A scene file is either moveplan's own format (frames, objects, attached) or a
+moveit_msgs/PlanningScene written as YAML, which core/moveit_scene.py reads (it places
+objects with the robot in the scene's own robot state, as MoveIt does).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -21,12 +25,17 @@ from moveplan.core.errors import ConfigError, FrameNotFound
 from moveplan.core.robot import Robot
 from moveplan.core.types import CollisionObject, Frame, Shape
 
-__all__ = ["Scene", "empty_scene", "load_scene", "pose_matrix"]
+__all__ = ["PLANNING_SCENE_KEYS", "Scene", "empty_scene", "load_scene", "pose_matrix", "resolve_frames"]
 
 _FRAME_KEYS = {"name", "parent", "xyz", "rpy", "quat"}
 _SHAPE_KEYS = {"box", "cylinder", "sphere", "mesh", "scale"}
 _OBJECT_KEYS = {"name", "frame", "xyz", "rpy", "quat"} | _SHAPE_KEYS
 _ATTACHED_KEYS = {"name", "link", "xyz", "rpy", "quat", "touch_links"} | _SHAPE_KEYS
+# The fields of moveit_msgs/PlanningScene: a scene file with any of them is one.
+PLANNING_SCENE_KEYS = {
+    "name", "robot_state", "robot_model_name", "fixed_frame_transforms", "allowed_collision_matrix",
+    "link_padding", "link_scale", "object_colors", "world", "is_diff",
+}
 
 
 @dataclass(frozen=True)
@@ -38,12 +47,18 @@ class Scene:
         frames: Scene frames as written (`parent_T_frame`).
         objects: World objects placed in the planning frame, then attached objects.
         anchors: Frame name -> (robot link, `link_T_frame`).
+        allowed: Pairs of link or object names allowed to touch (a PlanningScene's allowed
+            collision matrix; the SRDF's disabled pairs come on top).
+        robot_state: Joint name -> position in [rad] or [m], the robot state a PlanningScene
+            carries (empty for moveplan scenes).
     """
 
     source: str
     frames: tuple[Frame, ...]
     objects: tuple[CollisionObject, ...]
     anchors: dict[str, tuple[str, NDArray[np.float64]]]
+    allowed: frozenset[frozenset[str]] = frozenset()
+    robot_state: dict[str, float] = field(default_factory=dict)
 
     def anchor(self, frame: str, robot: Robot) -> tuple[str, NDArray[np.float64]]:
         """Return (robot link, `link_T_frame`) for a scene frame or robot link."""
@@ -108,9 +123,14 @@ def _shape(entry: dict[str, Any], where: str, folder: Path) -> Shape:
 
 
 def load_scene(path: Path, robot: Robot) -> Scene:
-    """Return the scene in a moveplan scene file, resolved against `robot`'s links."""
+    """Return the scene in a moveplan scene file or a PlanningScene YAML, resolved against `robot`'s links."""
     source = str(path)
     top = mapping(load_yaml(path), source)
+    if PLANNING_SCENE_KEYS & set(top):
+        # Imported here: moveit_scene builds on this module's helpers.
+        from moveplan.core.moveit_scene import planning_scene
+
+        return planning_scene(top, path, robot)
     check_keys(top, {"frames", "objects", "attached"}, source)
     frames: list[Frame] = []
     for k, entry in enumerate(top.get("frames") or []):
@@ -122,7 +142,7 @@ def load_scene(path: Path, robot: Robot) -> Scene:
                 raise ConfigError(f"{where}: '{key}' must be a frame name")
         transform = pose_matrix(entry.get("xyz"), entry.get("rpy"), entry.get("quat"), where)
         frames.append(Frame(entry["name"], entry["parent"], transform))
-    anchors = _resolve_frames(frames, robot, source)
+    anchors = resolve_frames(frames, robot, source)
 
     root_q = robot.neutral()
     objects: list[CollisionObject] = []
@@ -159,7 +179,7 @@ def load_scene(path: Path, robot: Robot) -> Scene:
     return Scene(source, tuple(frames), tuple(objects), anchors)
 
 
-def _resolve_frames(
+def resolve_frames(
     frames: list[Frame], robot: Robot, source: str
 ) -> dict[str, tuple[str, NDArray[np.float64]]]:
     """Return each frame's robot link and `link_T_frame`, following parent chains."""

@@ -149,13 +149,33 @@ class Shape:
     """Collision shape in its own frame, sizes in [m].
 
     box: dims = (x, y, z) full sizes; cylinder: dims = (radius, length) along local z;
-    sphere: dims = (radius,); mesh: `mesh_path` with `scale` (sx, sy, sz).
+    sphere: dims = (radius,); mesh: `mesh_path` with `scale` (sx, sy, sz), or, for a mesh
+    given inline (a shape_msgs/Mesh), `vertices` (N, 3) in [m] and `triangles` (M, 3),
+    indices into `vertices`, with `mesh_path` empty. Both arrays are read-only.
     """
 
     kind: Literal["box", "cylinder", "sphere", "mesh"]
     dims: tuple[float, ...] = ()
     mesh_path: str = ""
     scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    vertices: NDArray[np.float64] | None = None
+    triangles: NDArray[np.int64] | None = None
+
+    def __post_init__(self) -> None:
+        """Check and freeze an inline mesh's arrays."""
+        if self.vertices is None and self.triangles is None:
+            return
+        if self.kind != "mesh" or self.mesh_path or self.vertices is None or self.triangles is None:
+            raise ValueError("an inline mesh is kind 'mesh' with vertices and triangles and no mesh_path")
+        vertices = frozen_array(self.vertices, (None, 3), "vertices")
+        triangles = np.array(self.triangles, dtype=np.int64)
+        if triangles.ndim != 2 or triangles.shape[1] != 3 or len(triangles) == 0:
+            raise ValueError(f"triangles: expected shape (M, 3) with M > 0, got {triangles.shape}")
+        if triangles.min() < 0 or triangles.max() >= len(vertices):
+            raise ValueError(f"triangles: indices must lie in [0, {len(vertices) - 1}]")
+        triangles.setflags(write=False)
+        object.__setattr__(self, "vertices", vertices)
+        object.__setattr__(self, "triangles", triangles)
 
 
 @dataclass(frozen=True)
