@@ -20,6 +20,7 @@ from moveplan.cli.parsing import (
     parse_params,
     parse_pose,
     parse_scaling,
+    parse_seeds,
     parse_shift,
 )
 
@@ -256,6 +257,45 @@ def inspect(
         summary = recording.summarize(file)
         plan_file = recording.read_plan(file) if "moveplan" in summary.metadata else None
     render.inspect_summary(file, summary, plan_file, as_json, quiet)
+
+
+@app.command()
+def benchmark(
+    problems: Annotated[list[Path], typer.Argument(
+        help="Folders of sceneNNNN.yaml/requestNNNN.yaml pairs (searched recursively), or task files.")],
+    robot: Annotated[Path, typer.Option(help="Robot config the problems are for.")],
+    planner: Annotated[list[str] | None, typer.Option(
+        help="OMPL planner; repeatable or comma-separated (default: the config's).")] = None,
+    seeds: Annotated[str, typer.Option(help="Seeds: '0-4' or '0,3,7'.")] = "0",
+    count: Annotated[int | None, typer.Option(min=1, help="Only the first N problems of each folder.")] = None,
+    planning_time: Annotated[str, typer.Option(help="Seconds each planner may search per problem.")] = "1.0",
+    jobs: Annotated[int, typer.Option(min=1, help="Planner/seed processes run at a time (1: cleanest times).")] = 1,
+    csv: Annotated[Path | None, typer.Option(help="Write one CSV row per run here.")] = None,
+    plot: Annotated[Path | None, typer.Option(help="Write a PNG of the time distributions here.")] = None,
+    as_json: JsonOpt = False,
+    quiet: QuietOpt = False,
+) -> None:
+    """Plan many problems with several planners and seeds; report success, times, path quality, exact validity."""
+    _logging(False, quiet)
+    with exit_codes(as_json):
+        from moveplan.cli import render
+        from moveplan.core import benchmark as bench
+        from moveplan.core.config import load_robot_config
+
+        seed_list = parse_seeds(seeds)
+        time_s = parse_number(planning_time, "--planning-time")
+        if time_s <= 0:
+            raise typer.BadParameter(f"expected a positive number of seconds, got '{planning_time}'")
+        found = bench.find_problems(problems, count)
+        config = load_robot_config(robot)
+        planners = [p.strip() for text in planner or [config.planning["planner"]] for p in text.split(",")]
+        with render.benchmark_progress(len(found) * len(planners) * len(seed_list), quiet) as advance:
+            runs = bench.run_benchmark(config.root, found, planners, seed_list, time_s, jobs, advance)
+        if csv is not None:
+            bench.write_csv(runs, csv)
+        if plot is not None:
+            bench.plot(runs, plot)
+    render.benchmark_summary(runs, bench.summarize(runs), as_json, quiet)
 
 
 def main() -> None:

@@ -11,7 +11,8 @@ from typing import Any
 from moveplan.core.errors import UsageError
 
 __all__ = [
-    "parse_disturbance", "parse_joints", "parse_number", "parse_params", "parse_pose", "parse_scaling", "parse_shift",
+    "parse_disturbance", "parse_joints", "parse_number", "parse_params", "parse_pose", "parse_scaling", "parse_seeds",
+    "parse_shift",
 ]
 
 _BINARY: dict[type, Callable[[float, float], float]] = {
@@ -117,3 +118,18 @@ def parse_disturbance(text: str) -> Any:
     if time_s < 0:
         raise UsageError(f"--disturb: t must not be negative, got '{fields['t']}'")
     return Disturbance(time_s, fields["joint"], parse_number(fields["delta"], "--disturb delta"))
+
+
+def parse_seeds(text: str) -> list[int]:
+    """Return the seeds `text` lists: '0-4' (inclusive), '0,3,7', or a mix of both."""
+    seeds: list[int] = []
+    try:
+        for part in text.split(","):
+            low, _, high = part.strip().partition("-")
+            first, last = int(low), int(high or low)
+            if first < 0 or last < first:
+                raise ValueError
+            seeds.extend(range(first, last + 1))
+    except ValueError:
+        raise UsageError(f"--seeds: expected '0-4' or '0,3,7' (non-negative), got '{text}'") from None
+    return list(dict.fromkeys(seeds))

@@ -4,23 +4,30 @@ from __future__ import annotations
 
 import json
 import logging
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from moveplan.core.trajectory import peak_rates
 
 if TYPE_CHECKING:  # each command imports only the core modules it runs
+    from moveplan.core.benchmark import Run
     from moveplan.core.checking import CheckReport
     from moveplan.core.config import RobotConfig
     from moveplan.core.execution import PlanExecution
     from moveplan.core.recording import BagSummary, PlanFile
     from moveplan.core.types import Plan
 
-__all__ = ["check_summary", "execution_summary", "inspect_summary", "plan_summary", "robot_summary"]
+__all__ = [
+    "benchmark_progress", "benchmark_summary", "check_summary", "execution_summary", "inspect_summary", "plan_summary",
+    "robot_summary",
+]
 
 _console = Console()
 logger = logging.getLogger("moveplan")
@@ -253,3 +260,47 @@ def _verdict(document: dict[str, Any], margins_title: str) -> None:
         for joint, margin in document["margins"].items():
             table.add_row(joint, f"[{'red' if margin < 0 else 'green'}]{margin:.4f}[/]")
         _console.print(table)
+
+
+@contextmanager
+def benchmark_progress(total: int, quiet: bool) -> Iterator[Callable[[Run], None]]:
+    """Yield a callback that advances a progress bar on stderr by one run (no bar when quiet or not a terminal)."""
+    progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                        console=Console(stderr=True), disable=quiet, transient=True)
+    with progress:
+        task = progress.add_task("planning", total=total)
+        failed = 0
+
+        def advance(run: Run) -> None:
+            nonlocal failed
+            failed += not run.ok
+            progress.update(task, advance=1, description=f"planning ({failed} failed)" if failed else "planning")
+
+        yield advance
+
+
+def benchmark_summary(runs: list[Run], rows: list[dict[str, Any]], as_json: bool, quiet: bool) -> None:
+    """Print one row per scenario and planner, or the benchmark JSON document."""
+    if as_json:
+        _emit({"ok": True, "runs": [r.as_dict() for r in runs], "summary": rows, "error": None})
+        return
+    if quiet:
+        return
+    table = Table(title=f"{len(runs)} runs; times in ms (median / p95)")
+    for column in ("scenario", "planner", "solved", "plan", "simplify", "plan+simplify", "timing", "path [rad]",
+                   "duration [s]", "exact-valid"):
+        table.add_column(column, justify="left" if column in ("scenario", "planner") else "right")
+
+    def ms(row: dict[str, Any], key: str) -> str:
+        median, p95 = row[f"{key}_median_s"], row[f"{key}_p95_s"]
+        return "-" if median is None else f"{1e3 * median:.3g} / {1e3 * p95:.3g}"
+
+    def number(value: float | None, digits: int) -> str:
+        return "-" if value is None else f"{value:.{digits}f}"
+
+    for row in sorted(rows, key=lambda r: (r["scenario"] == "all", r["scenario"], r["planner"])):
+        table.add_row(row["scenario"], row["planner"], f"{row['succeeded']}/{row['runs']}", ms(row, "plan"),
+                      ms(row, "simplify"), ms(row, "total"), ms(row, "timing"), number(row["path_length_median"], 2),
+                      number(row["duration_median_s"], 2), f"{row['exact_valid']}/{row['succeeded']}")
+    # Piped to a file, rich would fold the table into 80 columns.
+    _console.print(table, width=None if _console.is_terminal else 160)

@@ -11,6 +11,7 @@ import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from importlib.metadata import version
 from pathlib import Path
 from typing import Any
@@ -35,23 +36,24 @@ from moveplan.core.goals import check_limits, joint_target, pose_error, tip_targ
 from moveplan.core.kinematics import solve_ik
 from moveplan.core.moveit_messages import known_joints
 from moveplan.core.moveit_request import MotionPlanRequest, load_motion_plan_request
-from moveplan.core.planning import Validity, interpolate, plan_path, seed_planner
+from moveplan.core.planning import PathResult, Validity, plan_path, seed_planner
 from moveplan.core.robot import Robot
 from moveplan.core.scene import Scene, empty_scene, load_scene
 from moveplan.core.tasks import StepSpec, TaskFile
 from moveplan.core.timing import time_parameterize
 from moveplan.core.trajectory import sample
 from moveplan.core.types import JointTrajectory, Plan, StepResult, TfSamples
+from moveplan.core.validity import MotionChecker
 
 __all__ = ["PlanRequest", "plan", "resolve_request"]
 
 logger = logging.getLogger(__name__)
 
-# The search checks edges every 0.02 rad; what is written is certified much finer, at
-# 0.0025 rad as the controller interpolates it. A trajectory that fails certification is
-# planned again with fine edge checks and a closer-following time parameterisation.
+# The search checks edges every 0.02 rad; what is written is certified as the controller
+# interpolates it, with no robot point moving more than 5 mm between checked states. A
+# trajectory that fails certification is planned again with fine edge checks and a
+# closer-following time parameterisation.
 _ATTEMPTS = ((0.02, 0.05), (0.005, 0.01))  # (edge check resolution [rad], timing resample step [rad])
-_CHECK_RESOLUTION = 0.005
 _TF_RATE_HZ = 30.0
 
 
@@ -123,10 +125,17 @@ def resolve_request(task: TaskFile | None, flags: dict[str, Any]) -> PlanRequest
     )
 
 
-def plan(request: PlanRequest) -> Plan:
-    """Return the timed, collision-free plan for every step of `request`, in order."""
+def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: bool = False) -> Plan:
+    """Return the timed, collision-free plan for every step of `request`, in order.
+
+    `config` is the loaded `request.robot` when the caller has it (a benchmark plans many
+    problems with one robot). With `exact_check`, each step's `stats["exact_valid"]` says
+    whether its trajectory is free under the URDF's exact meshes, checked independently of
+    the planner's geometry (1.0 or 0.0).
+    """
     seed_planner(request.seed)
-    config = load_robot_config(request.robot, request.package_paths, request.xacro_args)
+    if config is None:
+        config = load_robot_config(request.robot, request.package_paths, request.xacro_args)
     motion = request.motion_request
     if motion is not None and motion.group_name and request.group == motion.group_name:
         if motion.group_name not in config.srdf.groups:
@@ -145,18 +154,25 @@ def plan(request: PlanRequest) -> Plan:
     checker = CollisionChecker(robot, scene.objects, scene.source, geometry=config.planning["collision"],
                                allowed=scene.allowed)
     base, current = _start_values(request, robot, scene)
-    pair = checker.colliding_pair(robot.configuration(current, base))
+    checks = MotionChecker(robot, checker, base)
+    pair = checks.colliding_pair(current)
     if pair:
         raise StartInCollision(pair)
 
     steps: list[StepResult] = []
     for spec in request.steps:
         try:
-            step = _plan_step(spec, request, robot, scene, checker, base, current)
+            step = _plan_step(spec, request, robot, scene, checks, current)
         except (PlanningFailed, GoalUnreachable, StartInCollision, ConfigError) as exc:
             raise _in_step(exc, spec.name) from None
         steps.append(step)
         current = step.trajectory.positions[-1].copy()
+    if exact_check:
+        exact = checker if checker.mode == "exact" else CollisionChecker(
+            robot, scene.objects, scene.source, geometry="exact", allowed=scene.allowed)
+        referee = MotionChecker(robot, exact, base)
+        for step in steps:
+            step.stats["exact_valid"] = float(referee.first_collision_on_trajectory(step.trajectory) is None)
     return Plan(
         robot_name=config.name,
         group=robot.group.name,
@@ -223,26 +239,19 @@ def _plan_step(
     request: PlanRequest,
     robot: Robot,
     scene: Scene,
-    checker: CollisionChecker,
-    base: NDArray[np.float64],
+    checks: MotionChecker,
     start: NDArray[np.float64],
 ) -> StepResult:
     began = time.perf_counter()
     source = str(request.task.source) if request.task else "flags"
-
-    def free_batch(values: NDArray[np.float64]) -> NDArray[np.bool_]:
-        return checker.free_batch(robot.configurations(values, base))
-
-    def colliding_pair(q: NDArray[np.float64]) -> tuple[str, str] | None:
-        return checker.colliding_pair(q)
-
+    base = checks.base
     planner = spec.planner or request.planner or robot.config.planning["planner"]
     planning_time = spec.planning_time or request.planning_time or robot.config.planning["planning_time"]
     fraction, target_pose, link = 1.0, None, robot.group.tip
-    search: Callable[[float], NDArray[np.float64]]
+    search: Callable[[Validity], PathResult]
     if "joints" in spec.goal or "named" in spec.goal:
         goal = joint_target(robot, spec.goal, start, "--joints" if request.task is None else source)
-        pair = checker.colliding_pair(robot.configuration(goal, base))
+        pair = checks.colliding_pair(goal)
         if pair:
             raise GoalInCollision(pair)
     else:
@@ -250,44 +259,51 @@ def _plan_step(
         if not spec.linear:
             # Exhaustive: the first valid solution from a far start is not always the nearest one.
             goal = solve_ik(robot, target_pose, link, start, base=base, seed=request.seed, exhaustive=True,
-                            is_free=lambda v: bool(free_batch(v[None, :])[0]),
-                            colliding_pair=checker.colliding_pair).values
+                            is_free=checks.state_free, colliding_pair=checks.checker.colliding_pair).values
     if spec.linear:
         planner = "linear"
-        line = straight_line(robot, link, start, target_pose, base, free_batch, colliding_pair)
+        line = straight_line(robot, link, start, target_pose, base, checks.free, checks.checker.colliding_pair)
         fraction = line.fraction
         minimum = spec.min_fraction if spec.min_fraction is not None else request.min_fraction
         if fraction < minimum:
             x, y, z = line.stopped_at
             raise PlanningFailed(f"straight line achieved {fraction:.1%} of the way (minimum {minimum:.0%}): "
                                  f"{line.reason}; stopped at [{x:.4f}, {y:.4f}, {z:.4f}] in {robot.root_link}")
-        search = lambda resolution: np.asarray(line.waypoints)  # noqa: E731 - the line is already checked
+        line_path = PathResult(np.asarray(line.waypoints), planner, 0.0, 0.0)
+        search = lambda validity: line_path  # noqa: E731 - the line is already checked
     else:
-        search = lambda resolution: plan_path(  # noqa: E731
-            start, goal, robot.lower, robot.upper, _validity(free_batch, resolution), planner, planning_time).waypoints
+        search = lambda validity: plan_path(  # noqa: E731
+            start, goal, robot.lower, robot.upper, validity, planner, planning_time)
     v_scale, a_scale = _scaling(robot, request, spec)
     max_velocity, max_acceleration = robot.max_velocity * v_scale, robot.max_acceleration * a_scale
+    stats = {"plan_s": 0.0, "simplify_s": 0.0, "timing_s": 0.0, "certify_s": 0.0}
     for resolution, max_step in _ATTEMPTS:
-        waypoints = search(resolution)
-        trajectory = time_parameterize(robot.joint_names, waypoints, max_velocity, max_acceleration, max_step=max_step)
-        states = _dense_states(trajectory)
-        free = free_batch(states)
-        if free.all():
+        path = search(Validity(checks.state_free, partial(checks.edge_free, resolution=resolution)))
+        mark = time.perf_counter()
+        trajectory = time_parameterize(robot.joint_names, path.waypoints, max_velocity, max_acceleration,
+                                       max_step=max_step)
+        timed = time.perf_counter()
+        hit = checks.first_collision_on_trajectory(trajectory)
+        _add(stats, path, timed - mark, time.perf_counter() - timed)
+        if hit is None:
             break
-        logger.debug("trajectory planned at %.3f rad collides when checked densely; planning finer", resolution)
+        logger.debug("trajectory planned at %.3f rad collides when certified; planning finer", resolution)
     else:
         # A path hugging an obstacle defeats smoothing, and one through a thin obstacle can pass
-        # coarse edge checks. Last resort: plan with edges checked at the certification resolution
+        # coarse edge checks. Last resort: plan with edges checked at the certification states
         # and stop at each waypoint, so every joint, the controller's quintics included, stays on
-        # the straight segments exactly; certify those segments with the planner's own states.
-        waypoints = search(_CHECK_RESOLUTION / 2)
-        trajectory = _rest_to_rest(robot.joint_names, waypoints, max_velocity, max_acceleration)
-        segments = zip(waypoints[:-1], waypoints[1:], strict=True)
-        states = np.concatenate([interpolate(a, b, _CHECK_RESOLUTION / 2) for a, b in segments])
-        free = free_batch(states)
-        if not free.all():
-            pair = checker.colliding_pair(robot.configuration(states[int(np.argmin(free))], base)) or ("?", "?")
+        # the straight segments exactly; certify those segments.
+        path = search(Validity(checks.state_free, checks.edge_free_certified))
+        mark = time.perf_counter()
+        trajectory = _rest_to_rest(robot.joint_names, path.waypoints, max_velocity, max_acceleration)
+        timed = time.perf_counter()
+        hit = checks.first_collision_on_path(path.waypoints)
+        _add(stats, path, timed - mark, time.perf_counter() - timed)
+        if hit is not None:
+            pair = checks.colliding_pair(hit) or ("?", "?")
             raise PlanningFailed(f"the timed trajectory collides ({pair[0]} touches {pair[1]}) where the path did not")
+    waypoints = path.waypoints
+    stats["path_length"] = float(np.sum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1)))
     check_limits(robot, trajectory.positions.max(axis=0))
     check_limits(robot, trajectory.positions.min(axis=0))
     end = trajectory.positions[-1]
@@ -305,15 +321,16 @@ def _plan_step(
         trajectory=trajectory,
         fraction=fraction,
         residual=residual,
+        stats=stats,
     )
 
 
-def _validity(free_batch: Callable[[NDArray[np.float64]], NDArray[np.bool_]], resolution: float) -> Validity:
-    """Return the search's checks: states, and edges interpolated at `resolution` [rad] in one batch."""
-    return Validity(
-        state_free=lambda values: bool(free_batch(values[None, :])[0]),
-        edge_free=lambda a, b: bool(free_batch(interpolate(a, b, resolution)[1:]).all()),
-    )
+def _add(stats: dict[str, float], path: PathResult, timing_s: float, certify_s: float) -> None:
+    """Add one attempt's times to a step's statistics."""
+    stats["plan_s"] += path.planning_s
+    stats["simplify_s"] += path.simplify_s
+    stats["timing_s"] += timing_s
+    stats["certify_s"] += certify_s
 
 
 def _rest_to_rest(
@@ -335,21 +352,6 @@ def _rest_to_rest(
     rest = [[r.positions[1:], r.velocities[1:], r.accelerations[1:]] for r in rows[1:]]
     columns = [np.concatenate([first[i], *(r[i] for r in rest)]) for i in range(3)]
     return JointTrajectory(joint_names, np.round(np.concatenate(times) * 1e9) / 1e9, *columns)
-
-
-def _dense_states(trajectory: JointTrajectory) -> NDArray[np.float64]:
-    """Return states along the interpolated trajectory no more than the check resolution apart."""
-    knots = trajectory.times_s
-    if len(knots) == 1:
-        return np.asarray(trajectory.positions)
-    step = np.max(np.abs(np.diff(trajectory.positions, axis=0)), axis=1)
-    times = [knots[:1]]
-    for k in range(len(knots) - 1):
-        # Quintic segments can bulge slightly past the chord: sample with a safety factor of 2.
-        count = max(1, int(np.ceil(2 * step[k] / _CHECK_RESOLUTION)))
-        times.append(knots[k] + (knots[k + 1] - knots[k]) * np.arange(1, count + 1) / count)
-    positions, _, _ = sample(trajectory, np.concatenate(times))
-    return positions
 
 
 def _describe(goal: dict[str, Any]) -> dict[str, Any]:

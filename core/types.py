@@ -230,6 +230,7 @@ class StepResult:
     trajectory: JointTrajectory
     fraction: float = 1.0
     residual: dict[str, float] | None = None
+    stats: dict[str, float] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,85 @@
+"""`moveplan benchmark`: problems found, every planner and seed run, statistics, files, bad input."""
+
+from __future__ import annotations
+
+import csv
+import shutil
+from pathlib import Path
+
+import pytest
+from conftest import ROOT, Cli
+
+from moveplan.core.benchmark import Run, find_problems, summarize
+
+MBM = ROOT / "tests" / "data" / "mbm"
+
+
+@pytest.fixture()
+def problems(tmp_path: Path) -> Path:
+    """Return a scenario folder holding the sample MotionBenchMaker problem twice."""
+    folder = tmp_path / "problems" / "box_panda"
+    folder.mkdir(parents=True)
+    for number in ("0001", "0002"):
+        shutil.copy(MBM / "scene0001.yaml", folder / f"scene{number}.yaml")
+        shutil.copy(MBM / "request0001.yaml", folder / f"request{number}.yaml")
+    return tmp_path / "problems"
+
+
+def test_problems_are_scene_request_pairs_named_by_folder_and_number(problems: Path) -> None:
+    found = find_problems([problems])
+    assert [p.name for p in found] == ["box_panda/0001", "box_panda/0002"]
+    assert found[0].request == problems / "box_panda" / "request0001.yaml"
+    assert [p.name for p in find_problems([problems], count=1)] == ["box_panda/0001"]
+
+
+def test_benchmark_runs_every_problem_with_every_seed_and_writes_csv_and_plot(
+    cli: Cli, problems: Path, tmp_path: Path
+) -> None:
+    table, plot = tmp_path / "runs.csv", tmp_path / "times.png"
+    code, document = cli.json("benchmark", problems, "--robot", "panda", "--planner", "RRTConnect",
+                              "--seeds", "0-1", "--csv", table, "--plot", plot)
+    assert code == 0, document
+    runs = document["runs"]
+    assert [(r["problem"], r["seed"]) for r in runs] == [
+        ("box_panda/0001", 0), ("box_panda/0002", 0), ("box_panda/0001", 1), ("box_panda/0002", 1)]
+    for run in runs:
+        assert run["ok"] and run["exact_valid"], run
+        assert 0 < run["plan_s"] <= run["total_s"] and run["duration_s"] > 0 and run["path_length"] > 0
+    overall = next(r for r in document["summary"] if r["scenario"] == "all")
+    assert overall["runs"] == 4 and overall["success_rate"] == 1.0 and overall["exact_valid"] == 4
+    with table.open() as stream:
+        assert len(list(csv.DictReader(stream))) == 4
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_failed_runs_count_against_success_and_not_in_times() -> None:
+    runs = [Run("s/1", "s", "RRTConnect", 0, True, plan_s=0.001, simplify_s=0.001, total_s=0.002),
+            Run("s/2", "s", "RRTConnect", 0, False, error="no path")]
+    [row, _] = summarize(runs)
+    assert row["success_rate"] == 0.5 and row["total_median_s"] == pytest.approx(0.002)
+
+
+@pytest.mark.parametrize(("args", "code", "message"), [
+    (["--seeds", "3-1"], 2, "--seeds"),
+    (["--seeds", "a"], 2, "--seeds"),
+    (["--planning-time", "0"], 2, "planning-time"),
+])
+def test_bad_flags_are_usage_errors(cli: Cli, problems: Path, args: list[str], code: int, message: str) -> None:
+    result = cli("benchmark", problems, "--robot", "panda", *args)
+    assert result.exit_code == code and message in result.output
+
+
+def test_bad_problem_folders_name_the_file(cli: Cli, problems: Path, tmp_path: Path) -> None:
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    (problems / "box_panda" / "request0002.yaml").unlink()
+    for folder, message in ((tmp_path / "missing", "no such problem folder"), (empty, "no sceneNNNN.yaml"),
+                            (problems, "no matching request0002.yaml")):
+        code, document = cli.json("benchmark", folder, "--robot", "panda")
+        assert code == 3 and message in document["error"]["message"], document
+
+
+def test_a_malformed_request_stops_the_benchmark_with_exit_3_naming_it(cli: Cli, problems: Path) -> None:
+    (problems / "box_panda" / "request0002.yaml").write_text("group_name: [unclosed\n")
+    code, document = cli.json("benchmark", problems, "--robot", "panda", "--planner", "RRTConnect")
+    assert code == 3 and "request0002.yaml" in document["error"]["message"], document
