@@ -281,11 +281,12 @@ def benchmark(
         from moveplan.cli import render
         from moveplan.core import benchmark as bench
         from moveplan.core.config import load_robot_config
+        from moveplan.core.errors import UsageError
 
         seed_list = parse_seeds(seeds)
         time_s = parse_number(planning_time, "--planning-time")
         if time_s <= 0:
-            raise typer.BadParameter(f"expected a positive number of seconds, got '{planning_time}'")
+            raise UsageError(f"--planning-time: expected a positive number of seconds, got '{planning_time}'")
         found = bench.find_problems(problems, count)
         config = load_robot_config(robot)
         planners = [p.strip() for text in planner or [config.planning["planner"]] for p in text.split(",")]
