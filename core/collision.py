@@ -37,6 +37,9 @@ logger = logging.getLogger(__name__)
 # Hulls by (mesh file, scale), built once per process: qhull costs ~1 ms a mesh, and every
 # CollisionChecker of a run (IK, tests, benchmarks) loads the same robot meshes.
 _HULLS: dict[tuple[str, tuple[float, ...]], coal.ConvexBase] = {}
+# The robot's own geometry by (URDF, config folder, package path, mode): reading its meshes costs
+# ~80 ms, and a benchmark builds a checker per problem for one robot.
+_ROBOT_GEOMETRY: dict[tuple[str, str, tuple[Path, ...], str], pin.GeometryModel] = {}
 
 
 def coal_geometry(shape: Shape, source: str = "scene") -> coal.CollisionGeometry:
@@ -100,6 +103,35 @@ def _is_flat(mesh: coal.BVHModelBase) -> bool:
     return bool(spread[2] <= 1e-6 * spread[0])
 
 
+def _robot_geometry(robot: Robot, mode: GeometryMode) -> pin.GeometryModel:
+    """Return the robot's own collision geometry in `mode`, built once per process and config."""
+    config = robot.config
+    key = (config.urdf, str(config.root), config.package_paths, mode)
+    if key in _ROBOT_GEOMETRY:
+        return _ROBOT_GEOMETRY[key]
+    # Mesh files are resolved (and a missing one reported) by the config, which knows the
+    # package path; pinocchio gets the expanded URDF text with absolute mesh paths.
+    try:
+        geom = pin.buildGeomFromUrdfString(robot.model, config.collision_urdf(), pin.GeometryType.COLLISION)
+    except (RuntimeError, ValueError, OSError) as exc:
+        raise _geometry_error(config, exc) from None
+    if mode == "convex":
+        # Only the robot's meshes: scene meshes are the world, checked exactly. A hull
+        # there would block space the robot may use (a bin's inside, a shelf's bays).
+        for obj in geom.geometryObjects:
+            if not isinstance(obj.geometry, coal.BVHModelBase):
+                continue
+            if _is_flat(obj.geometry):
+                # No hull, and coal 3.0.3's qhull crashes the process (SIGSEGV) on coplanar
+                # points. Kept as a mesh, it is checked as it really is: still conservative.
+                logger.info("%s: mesh %s is flat; checked as a mesh", obj.name, obj.meshPath)
+            else:
+                hull_key = (str(obj.meshPath), tuple(float(v) for v in obj.meshScale))
+                obj.geometry = convex_hull(obj.geometry, hull_key, f"{config.urdf_path}: {obj.name}")
+    _ROBOT_GEOMETRY[key] = geom
+    return geom
+
+
 def _geometry_error(config: RobotConfig, exc: Exception) -> ConfigError:
     """Return a one-line error naming the mesh pinocchio (through coal and assimp) could not read."""
     text = str(exc)
@@ -148,26 +180,7 @@ class CollisionChecker:
         self.mode: GeometryMode = geometry
         model = robot.model
         config = robot.config
-        # Mesh files are resolved (and a missing one reported) by the config, which knows the
-        # package path; pinocchio gets the expanded URDF text with absolute mesh paths.
-        urdf = config.collision_urdf()
-        try:
-            geom = pin.buildGeomFromUrdfString(model, urdf, pin.GeometryType.COLLISION)
-        except (RuntimeError, ValueError, OSError) as exc:
-            raise _geometry_error(config, exc) from None
-        if geometry == "convex":
-            # Only the robot's meshes: scene meshes are the world, checked exactly. A hull
-            # there would block space the robot may use (a bin's inside, a shelf's bays).
-            for obj in geom.geometryObjects:
-                if not isinstance(obj.geometry, coal.BVHModelBase):
-                    continue
-                if _is_flat(obj.geometry):
-                    # No hull, and coal 3.0.3's qhull crashes the process (SIGSEGV) on coplanar
-                    # points. Kept as a mesh, it is checked as it really is: still conservative.
-                    logger.info("%s: mesh %s is flat; checked as a mesh", obj.name, obj.meshPath)
-                else:
-                    key = (str(obj.meshPath), tuple(float(v) for v in obj.meshScale))
-                    obj.geometry = convex_hull(obj.geometry, key, f"{config.urdf_path}: {obj.name}")
+        geom = _robot_geometry(robot, geometry).copy()
         owner = [str(model.frames[g.parentFrame].name) for g in geom.geometryObjects]
         touch: list[frozenset[str]] = [frozenset() for _ in owner]
         for obj in objects:
