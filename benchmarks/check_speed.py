@@ -26,7 +26,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import make_recording  # noqa: E402  (the cycle, controller and joints the file was made with)
 
-from moveplan.core.checking import check_recording  # noqa: E402
+from moveplan.core.checking import check_recording, uses_velocities  # noqa: E402
 from moveplan.core.jointstates import read_joint_states  # noqa: E402
 
 
@@ -37,11 +37,14 @@ def peak_rss_mb() -> float:
 
 def moveplan_check(path: Path) -> tuple[float, float, int]:
     """Return read and check wall times in [s] and the message count; prints the verdict."""
+    plan, controller = make_recording.cycle_plan(), make_recording.controller()
     began = time.perf_counter()
-    series = read_joint_states(path, joints=make_recording.JOINTS)
+    # As check-tolerances reads it: velocities only where the check uses them.
+    series = read_joint_states(path, joints=make_recording.JOINTS,
+                               velocities=uses_velocities(plan, controller))
     read = time.perf_counter()
-    report = check_recording(make_recording.cycle_plan(), series, make_recording.controller(),
-                             make_recording.execution(), (), start="all")
+    report = check_recording(plan, series, controller, make_recording.execution(), (),
+                             start="all")
     checked = time.perf_counter()
     print(f"moveplan: {len(report.cycles)} cycles, failing {list(report.failing_cycles)}: "
           f"{report.result.name}")

@@ -60,6 +60,7 @@ _MAX_GAPS = 1000
 # Several cycles of the same plan cannot overlap: the controller follows the plan's timing.
 _MIN_CYCLE_FRACTION = 0.9
 _LOOKBACK_PAD_S = 0.05
+_DISTANCE_BLOCK = 16384
 
 
 @dataclass(frozen=True)
@@ -150,16 +151,28 @@ class Samples:
         """Return the positions of samples [begin, end) in controller order."""
         return self.positions[begin:end][:, self.columns]
 
+    def spans(self, begins: Sequence[int], ends: Sequence[int]) -> NDArray[np.float64]:
+        """Return the positions of samples [begins[i], ends[i]) end to end, in controller order."""
+        block = np.concatenate([self.positions[b:e] for b, e in zip(begins, ends, strict=True)])
+        if np.array_equal(self.columns, np.arange(self.positions.shape[1])):
+            return block
+        return block[:, self.columns]
+
     def distance(self, begin: int, end: int, point: NDArray[np.float64]) -> NDArray[np.float64]:
         """Return per sample in [begin, end) the largest joint distance to `point` in [rad]."""
         result = np.zeros(end - begin)
-        for j, column in enumerate(self.columns):
-            values = self.positions[begin:end, column]
-            if self.continuous[j]:
-                gap = np.abs(shortest_angular_distance(point[j], values))
-            else:
-                gap = np.abs(values - point[j])
-            np.maximum(result, gap, out=result)
+        # Block by block: a block's columns stay in cache, where the columns of an hour-long
+        # recording would be read from memory once per joint.
+        for at in range(begin, end, _DISTANCE_BLOCK):
+            block = self.positions[at : min(at + _DISTANCE_BLOCK, end)]
+            out = result[at - begin : at - begin + len(block)]
+            for j, column in enumerate(self.columns):
+                values = block[:, column]
+                if self.continuous[j]:
+                    gap = np.abs(shortest_angular_distance(point[j], values))
+                else:
+                    gap = np.abs(values - point[j])
+                np.maximum(out, gap, out=out)
         return result
 
 
@@ -266,8 +279,12 @@ def _median_period(times: NDArray[np.float64]) -> float:
     """Return the median time between samples in [s], over up to 100 000 spread intervals."""
     every = max(1, len(times) // 100_000)
     steps = times[every::every] - times[every - 1 : -1 : every]
-    steps = steps[steps > 0.0]
-    return float(np.median(steps)) if len(steps) else 0.0
+    steps = np.sort(steps[steps > 0.0])
+    if len(steps) == 0:
+        return 0.0
+    # np.median's rule: np.median itself imports numpy.ma, 40 ms of every command's start-up.
+    middle = len(steps) // 2
+    return float(steps[middle] if len(steps) % 2 else (steps[middle - 1] + steps[middle]) / 2)
 
 
 def _crossing(
@@ -293,16 +310,20 @@ def _exits(
     Hysteresis: inside is within `zone_in`, outside beyond `zone_out`; in between the
     previous state holds, so noise at the boundary does not count as many departures.
     """
-    count = len(distance)
-    event = np.zeros(count, dtype=np.int8)
+    event = np.zeros(len(distance), dtype=np.int8)
     event[distance <= zone_in] = 1
     event[distance > zone_out] = -1
-    last = np.where(event != 0, np.arange(count), -1)
-    np.maximum.accumulate(last, out=last)
-    state = np.where(last >= 0, event[np.maximum(last, 0)], 1 if inside_at_first else 0)
-    before = np.concatenate(([1 if inside_at_first else 0], state[:-1]))
-    exits = np.flatnonzero((state == -1) & (before == 1))
-    entries = np.flatnonzero((state == 1) & (before != 1))
+    # The state changes only where a run of samples inside (1) or outside (-1) begins:
+    # each such run is compared with the one before it, not each sample (an hour-long
+    # recording holds millions of samples and a few thousand runs).
+    runs = np.flatnonzero(event[1:] != event[:-1]) + 1
+    if len(event):
+        runs = np.concatenate(([0], runs))
+    changes = runs[event[runs] != 0]
+    now = event[changes]
+    before = np.concatenate(([1 if inside_at_first else 0], now[:-1]))
+    exits = changes[(now == -1) & (before == 1)]
+    entries = changes[(now == 1) & (before != 1)]
     dwell = np.zeros(len(exits), dtype=np.intp)
     if len(entries):
         found = np.searchsorted(entries, exits, side="right") - 1

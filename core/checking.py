@@ -47,14 +47,14 @@ from moveplan.core.tolerances import (
     check_start_state,
     expected_duration_s,
     in_controller_order,
-    judge,
+    judge_spans,
     segment_tolerances,
     velocity_error_computable,
 )
 from moveplan.core.trajectory import PointBefore, sample
 from moveplan.core.types import JointStateSeries, JointTrajectory
 
-__all__ = ["CheckReport", "CycleCheck", "StepCheck", "check_recording"]
+__all__ = ["CheckReport", "CycleCheck", "StepCheck", "check_recording", "uses_velocities"]
 
 Start = float | Literal["auto", "all"]
 
@@ -212,7 +212,7 @@ def check_recording(
         first, aligned_by = float(start), "given"
         if not math.isfinite(first):
             raise UsageError(f"start must be a finite time in seconds, got {start}")
-    steps = _execution(context, first, aligned_by, len(series.times_s), "recording")
+    (steps,) = _executions(context, [first], [aligned_by], [len(series.times_s)], ["recording"])
     for step in steps:
         if step.aligned_by in ("first departure", "first sample", "previous step"):
             warnings.append(f"step '{step.name}': start at {step.start_s:.3f} s found by "
@@ -232,6 +232,17 @@ def check_recording(
         warnings=tuple(warnings),
         recording_start_ns=series.start_ns,
     )
+
+
+def uses_velocities(plan: _Plan, controller: ControllerConfig) -> bool:
+    """Return True if `check_recording` reads the recorded velocities for this plan and controller.
+
+    JTC computes velocity errors only with some interfaces, and blends from the velocity it
+    read only into a first point after time 0.
+    """
+    blends = any(step.trajectory.times_s[0] > 0.0 for step in plan.steps)
+    return velocity_error_computable(controller) or (
+        blends and "velocity" in controller.state_interfaces)
 
 
 # --- preparation ----------------------------------------------------------------------------
@@ -280,52 +291,98 @@ class _Context:
 
 # --- judging ------------------------------------------------------------------------------
 
+# Samples judged in one stacked pass: enough to spread numpy's per-call cost over a few
+# executions, few enough to keep each array of a pass at a megabyte or two.
+_BATCH_ROWS = 1 << 15
+
+
+@dataclass(frozen=True)
+class _Window:
+    """A step's goal sent at `start` [s]: judged from sample `first` on, never at or past `end`."""
+
+    start: float
+    first: int
+    end: int
+    at_send: int
+    current: NDArray[np.float64]
+    timeout: Timeout
+
 
 def _all_cycles(context: _Context) -> tuple[CycleCheck, ...]:
     """Return every execution of the plan found in the recording, judged."""
     starts = cycle_starts(context.samples, context.profiles)
-    times = context.samples.times
-    cycles = []
-    for index, start in enumerate(starts):
-        end = len(times)
-        reason = "recording"
-        if index + 1 < len(starts):
-            end = int(np.searchsorted(times, starts[index + 1], side="left"))
-            reason = "next cycle"
-        steps = _execution(context, start, "departure", end, reason)
-        cycles.append(CycleCheck(index, start, steps))
-    return tuple(cycles)
+    # Each execution ends where the next one starts.
+    ends = np.searchsorted(context.samples.times, starts[1:], side="left").tolist()
+    ends.append(len(context.samples.times))
+    reasons = ["next cycle"] * (len(starts) - 1) + ["recording"]
+    executions = _executions(context, starts, ["departure"] * len(starts), ends, reasons)
+    return tuple(CycleCheck(index, start, steps)
+                 for index, (start, steps) in enumerate(zip(starts, executions, strict=True)))
 
 
-def _execution(
-    context: _Context, start: float, aligned_by: str, end: int, end_reason: str
-) -> tuple[StepCheck, ...]:
-    """Return the steps of one execution judged in turn, up to the first that fails.
+def _executions(
+    context: _Context, starts: Sequence[float], aligned_by: Sequence[str], ends: Sequence[int],
+    end_reasons: Sequence[str],
+) -> list[tuple[StepCheck, ...]]:
+    """Return the steps of each execution judged in turn, each up to its first that fails.
 
-    Samples at indices >= `end` belong to something else (the next cycle, or none exist).
+    Step by step, every execution still going is judged in one pass. Samples of execution
+    i at indices >= `ends[i]` belong to something else (the next cycle, or none exist).
     """
-    steps: list[StepCheck] = []
+    times = context.samples.times
+    steps: list[list[StepCheck]] = [[] for _ in starts]
+    begins, hows = list(starts), list(aligned_by)
+    going = list(range(len(starts)))
     for number, profile in enumerate(context.profiles):
         if number > 0:
-            previous = steps[-1]
-            decided = int(np.searchsorted(context.samples.times,
-                                          previous.start_s + previous.duration_s, side="left"))
-            start, aligned_by = next_start(context.samples, profile, min(decided, end - 1), end)
-        report, decided_s = _judge_step(context, profile, start, end, end_reason)
-        steps.append(StepCheck(profile.name, start, decided_s, report, aligned_by))
-        if not report.ok:
-            break
-    return tuple(steps)
+            going = [i for i in going if steps[i][-1].ok]
+            for i in going:
+                previous = steps[i][-1]
+                decided = int(np.searchsorted(times, previous.start_s + previous.duration_s,
+                                              side="left"))
+                begins[i], hows[i] = next_start(context.samples, profile,
+                                                min(decided, ends[i] - 1), ends[i])
+        verdicts = _judge_steps(context, profile, [begins[i] for i in going],
+                                [ends[i] for i in going], [end_reasons[i] for i in going])
+        for i, (report, decided_s) in zip(going, verdicts, strict=True):
+            steps[i].append(StepCheck(profile.name, begins[i], decided_s, report, hows[i]))
+    return [tuple(s) for s in steps]
 
 
-def _judge_step(
-    context: _Context, profile: StepProfile, start: float, end: int, end_reason: str
-) -> tuple[ToleranceReport, float]:
-    """Return the step's verdict and the time [s] from its start to the deciding sample.
+def _judge_steps(
+    context: _Context, profile: StepProfile, starts: Sequence[float], ends: Sequence[int],
+    end_reasons: Sequence[str],
+) -> list[tuple[ToleranceReport, float]]:
+    """Return per execution the step's verdict and the time [s] from its start to the deciding sample.
 
-    Judged over growing spans of samples, so a step decided early does not sample the
+    Judged first over the samples up to a little past the step's end, then, for the few
+    still undecided there, over growing spans: a step decided early does not sample the
     plan over the rest of an hour-long recording.
     """
+    verdicts: dict[int, tuple[ToleranceReport, float]] = {}
+    windows: list[tuple[int, _Window]] = []
+    for slot, (start, end, end_reason) in enumerate(zip(starts, ends, end_reasons, strict=True)):
+        opened = _open(context, profile, start, end, end_reason)
+        if isinstance(opened, _Window):
+            windows.append((slot, opened))
+        else:
+            verdicts[slot] = opened
+    # A step that succeeds is decided a cycle or two past its last point.
+    extra = 4.0 / context.controller.update_rate_hz + 4.0 * context.samples.period_s + 0.02
+    judged = _judge_windows(context, profile, [window for _, window in windows], extra)
+    for (slot, window), (report, decided_s, undecided) in zip(windows, judged, strict=True):
+        grown = extra
+        while undecided:
+            grown *= 4.0
+            ((report, decided_s, undecided),) = _judge_windows(context, profile, [window], grown)
+        verdicts[slot] = (report, decided_s)
+    return [verdicts[slot] for slot in range(len(starts))]
+
+
+def _open(
+    context: _Context, profile: StepProfile, start: float, end: int, end_reason: str
+) -> _Window | tuple[ToleranceReport, float]:
+    """Return the step's goal as sent at `start`, or its verdict if it is decided at once."""
     samples = context.samples
     times = samples.times
     trajectory = profile.trajectory
@@ -339,40 +396,94 @@ def _judge_step(
     if first >= end:
         message = f"the {end_reason} ends before the step's start at {start:.3f} s"
         return ToleranceReport(ExecutionResult(TIMED_OUT, "TIMED_OUT", message), (), {}, 0), 0.0
+    timeout = _timeout(context, trajectory.duration_s, float(times[end - 1]) - start, end_reason)
+    return _Window(start, first, end, at_send, current, timeout)
+
+
+def _judge_windows(
+    context: _Context, profile: StepProfile, windows: Sequence[_Window], extra: float
+) -> list[tuple[ToleranceReport, float, bool]]:
+    """Return per window the verdict over its samples up to `extra` [s] past the step's end.
+
+    With the time [s] from the start to the deciding sample, and whether the verdict is
+    only that the samples ran out before the step was decided (a longer span may decide it).
+    """
+    if not windows:
+        return []
+    times = context.samples.times
+    duration = profile.trajectory.duration_s
+    firsts = np.array([w.first for w in windows], dtype=np.intp)
+    ends = np.array([w.end for w in windows], dtype=np.intp)
+    stops = np.searchsorted(times, [w.start + duration + extra for w in windows], side="right")
+    stops = np.minimum(np.maximum(stops, firsts + 1), ends)
+    judged: list[tuple[ToleranceReport, float, bool]] = []
+    begin = 0
+    while begin < len(windows):
+        # As many windows as fit in a batch; one longer than a batch gets a pass of its own.
+        total = np.cumsum(stops[begin:] - firsts[begin:])
+        count = max(1, int(np.searchsorted(total, _BATCH_ROWS, side="right")))
+        batch = slice(begin, begin + count)
+        judged += _judge_stacked(context, profile, windows[batch], firsts[batch], stops[batch])
+        begin += count
+    return judged
+
+
+def _judge_stacked(
+    context: _Context, profile: StepProfile, windows: Sequence[_Window],
+    firsts: NDArray[np.intp], stops: NDArray[np.intp],
+) -> list[tuple[ToleranceReport, float, bool]]:
+    """Return `_judge_windows`' verdicts, the windows judged over samples [firsts, stops) at once."""
+    samples = context.samples
+    trajectory = profile.trajectory
     duration = trajectory.duration_s
-    timeout = _timeout(context, duration, float(times[end - 1]) - start, end_reason)
-    point_before = _point_before(context, at_send, current)
-    # A step that succeeds is decided a cycle or two past its last point.
-    extra = 4.0 / context.controller.update_rate_hz + 4.0 * samples.period_s + 0.02
-    while True:
-        stop = int(np.searchsorted(times, start + duration + extra, side="right"))
-        stop = min(max(stop, first + 1), end)
-        since = times[first:stop] - start
-        reference, reference_v, _ = sample(trajectory, since, point_before=point_before,
-                                           continuous=samples.continuous,
-                                           derivatives=1 if context.check_velocities else 0)
-        report = judge(
-            context.tolerances, since, reference, samples.rows(first, stop),
-            # As the simulation: JTC takes the segment from the command's time, one period on.
-            before_last_point=since + 1.0 / context.controller.update_rate_hz < duration,
-            last_point_s=duration,
-            timeout=timeout,
-            reference_velocities=reference_v if context.check_velocities else None,
-            actual_velocities=_velocities(context, first, stop),
-            continuous=samples.continuous,
-        )
-        undecided = (report.result.code == TIMED_OUT and report.end_index == stop - first - 1
-                     and since[-1] <= timeout.time_s)
-        if stop == end or not undecided:
-            return report, float(since[report.end_index])
-        extra *= 4.0
+    lengths = stops - firsts
+    span_starts = np.concatenate(([0], np.cumsum(lengths)[:-1]))
+    begins, ends = firsts.tolist(), stops.tolist()
+    since = np.concatenate([samples.times[b:e] - w.start
+                            for w, b, e in zip(windows, begins, ends, strict=True)])
+    derivatives = 1 if context.check_velocities else 0
+    if trajectory.times_s[0] > 0.0:
+        # JTC blends from the state it read at the send time: each window its own.
+        parts = [
+            sample(trajectory, since[a : a + n], point_before=_point_before(context, w),
+                   continuous=samples.continuous, derivatives=derivatives)
+            for w, a, n in zip(windows, span_starts.tolist(), lengths.tolist(), strict=True)
+        ]
+        reference = np.concatenate([p[0] for p in parts])
+        reference_v = np.concatenate([p[1] for p in parts])
+    else:
+        reference, reference_v, _ = sample(trajectory, since, derivatives=derivatives)
+    reports = judge_spans(
+        context.tolerances, since, reference, samples.spans(begins, ends),
+        # As the simulation: JTC takes the segment from the command's time, one period on.
+        before_last_point=since + 1.0 / context.controller.update_rate_hz < duration,
+        last_point_s=duration,
+        span_starts=span_starts,
+        timeouts=[w.timeout for w in windows],
+        reference_velocities=reference_v if context.check_velocities else None,
+        actual_velocities=_velocities(context, begins, ends),
+        continuous=samples.continuous,
+    )
+    judged = []
+    for window, report, at, length, stop in zip(windows, reports, span_starts.tolist(),
+                                                lengths.tolist(), stops.tolist(), strict=True):
+        last = at + length - 1
+        undecided = (report.result.code == TIMED_OUT and report.end_index == length - 1
+                     and since[last] <= window.timeout.time_s)
+        judged.append((report, float(since[at + report.end_index]),
+                       undecided and stop != window.end))
+    return judged
 
 
-def _velocities(context: _Context, begin: int, end: int) -> NDArray[np.float64] | None:
-    """Return recorded velocities of samples [begin, end) when JTC would compute velocity errors."""
+def _velocities(
+    context: _Context, begins: Sequence[int], ends: Sequence[int]
+) -> NDArray[np.float64] | None:
+    """Return recorded velocities of samples [begins[i], ends[i]) when JTC computes velocity errors."""
     if not context.check_velocities or context.velocities is None:
         return None
-    return context.velocities[begin:end][:, context.samples.columns]
+    velocities = context.velocities
+    block = np.concatenate([velocities[b:e] for b, e in zip(begins, ends, strict=True)])
+    return block[:, context.samples.columns]
 
 
 def _timeout(context: _Context, duration: float, last_s: float, end_reason: str) -> Timeout:
@@ -390,16 +501,16 @@ def _timeout(context: _Context, duration: float, last_s: float, end_reason: str)
         f"decided (it waits for the goal tolerance {waits})"))
 
 
-def _point_before(context: _Context, index: int, positions: NDArray[np.float64]) -> PointBefore:
+def _point_before(context: _Context, window: _Window) -> PointBefore:
     """Return the state JTC blends from, with the fields its state interfaces provide."""
     states = context.controller.state_interfaces
     velocities = None
     if "velocity" in states and context.velocities is not None:
-        velocities = context.velocities[index, context.samples.columns]
+        velocities = context.velocities[window.at_send, context.samples.columns]
     accelerations = None
     if velocities is not None and "acceleration" in states:
-        accelerations = np.zeros_like(positions)  # no acceleration is recorded: read as 0
-    return PointBefore(positions, velocities, accelerations)
+        accelerations = np.zeros_like(window.current)  # no acceleration is recorded: read as 0
+    return PointBefore(window.current, velocities, accelerations)
 
 
 # --- reports --------------------------------------------------------------------------------

@@ -18,16 +18,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from moveplan.core import recording
-from moveplan.core.checking import CheckReport, check_recording
+from moveplan.core.checking import CheckReport, check_recording, uses_velocities
 from moveplan.core.config import CONFIG_FILE, ControllerConfig, RobotConfig, load_robot_config, parse_controllers
-from moveplan.core.controller import Disturbance, ExecutionReport, simulate
 from moveplan.core.errors import ConfigError, InputError, UnknownName
 from moveplan.core.jointstates import read_joint_states
-from moveplan.core.plants import make_plant
 from moveplan.core.tolerances import ExecutionResult, Violation
 from moveplan.core.types import TfSamples
 
 if TYPE_CHECKING:
+    from moveplan.core.controller import Disturbance, ExecutionReport
     from moveplan.core.robot import Robot
 
 _TF_RATE_HZ = 30.0
@@ -132,6 +131,10 @@ def pick_controller(
 
 def execute(request: ExecuteRequest) -> PlanExecution:
     """Return what executing the plan through the simulated controller did."""
+    # Imported here: check-tolerances shares this module and simulates nothing.
+    from moveplan.core.controller import Disturbance, simulate
+    from moveplan.core.plants import make_plant
+
     plan = recording.read_plan(request.plan)
     config = plan_config(plan, request.plan)
     controller = _controller(config, plan, request.controllers)
@@ -198,7 +201,8 @@ def check(request: CheckRequest) -> CheckReport:
     config = plan_config(plan, request.plan)
     controller = _controller(config, plan, request.controllers)
     series = read_joint_states(request.recording, request.topic, joints=controller.joints,
-                               time_source=request.time_source)
+                               time_source=request.time_source,
+                               velocities=uses_velocities(plan, controller))
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
     return check_recording(plan, series, controller, config.execution, continuous, request.start)
 

@@ -11,6 +11,7 @@ The CDR layout itself is core.jointstate_cdr's, which also encodes payloads
 from __future__ import annotations
 
 import logging
+import mmap
 import struct
 from collections.abc import Sequence
 from pathlib import Path
@@ -43,6 +44,7 @@ def read_joint_states(
     topic: str = "/joint_states",
     joints: Sequence[str] | None = None,
     time_source: TimeSource = "header",
+    velocities: bool = True,
 ) -> JointStateSeries:
     """Return the joint states recorded on `topic`, columns in the order of `joints`.
 
@@ -56,6 +58,8 @@ def read_joint_states(
         joints: Joints to keep, in column order; None = those of the first message.
         time_source: "header" for header.stamp (falls back to log time, with a warning,
             when every stamp is zero), "log" for the MCAP log time (receive time).
+        velocities: False to leave the recorded velocities unread (series.velocities is None):
+            an hour at 1 kHz holds 170 MB of them.
 
     Raises:
         InputError: The file is missing, not MCAP, truncated or corrupt; the topic is
@@ -66,7 +70,7 @@ def read_joint_states(
     if time_source not in ("header", "log"):
         raise ValueError(f"time_source must be 'header' or 'log', got {time_source!r}")
     source = Path(path)
-    decoder = _Decoder(source, topic, tuple(joints) if joints is not None else None)
+    decoder = _Decoder(source, topic, tuple(joints) if joints is not None else None, velocities)
     read_topic(source, topic, decoder)
     return decoder.series(time_source)
 
@@ -74,9 +78,13 @@ def read_joint_states(
 class _Decoder:
     """Collects decoded columns across chunks and files: the MessageSink of read_topic."""
 
-    def __init__(self, source: Path, topic: str, joints: tuple[str, ...] | None) -> None:
+    def __init__(
+        self, source: Path, topic: str, joints: tuple[str, ...] | None, velocities: bool = True
+    ) -> None:
         self.source, self.topic, self.joints = source, topic, joints
-        self.columns = _Columns()
+        self.columns = _Columns(velocities)
+        # The layout of the last rows decoded together, and a row laid out so.
+        self.template: tuple[NDArray[np.uint8], JointStateLayout] | None = None
         self.joint_columns: dict[tuple[str, ...], NDArray[np.intp] | None] = {}
         self.seen_joints: set[str] = set()
         self.skipped = 0
@@ -100,11 +108,16 @@ class _Decoder:
 
     def add_rows(self, rows: NDArray[np.uint8], log_times: NDArray[np.int64]) -> bool:
         """Decode payloads of equal length, one per row; return False if they differ in layout."""
-        template = self._layout(rows[0], 0, rows.shape[1])
-        if not template.little or not _matches(rows, rows[0], template).all():
-            return False
+        # Rows laid out as the previous batch's take its layout without parsing one again.
+        template = self.template
+        if (template is None or template[1].length != rows.shape[1]
+                or not _matches(rows, *template).all()):
+            layout = self._layout(rows[0], 0, rows.shape[1])
+            if not layout.little or not _matches(rows, rows[0], layout).all():
+                return False
+            template = self.template = (np.array(rows[0]), layout)
         self.messages += len(rows)
-        self._add_rows(rows, template, log_times)
+        self._add_rows(rows, template[1], log_times)
         return True
 
     def add(
@@ -221,15 +234,16 @@ class _Decoder:
                 time_source = "log"
             times = log_times
         del log_times
-        if velocities is None and self.columns.some_velocities:
+        if not self.columns.all_velocities and self.columns.some_velocities:
             logger.warning("%s: only some messages on %s carry velocities; ignoring velocities",
                            source, self.topic)
-        if np.any(np.diff(times) < 0):
+        if np.any(times[1:] < times[:-1]):
             order = np.argsort(times, kind="stable")
             times, positions = times[order], positions[order]
             velocities = velocities[order] if velocities is not None else None
         start_ns = int(times[0])
-        times_s = (times - start_ns) / 1e9
+        times -= start_ns  # in place: a fresh hour-long array costs more in page faults
+        times_s = times / 1e9
         for array in (times_s, positions, velocities):
             if array is not None:
                 array.setflags(write=False)
@@ -242,10 +256,12 @@ class _Columns:
 
     Filling preallocated arrays keeps the peak near one copy of the result (an hour at
     1 kHz is 170 MB per float array); batches beyond the reserved size are kept apart and
-    concatenated at the end.
+    concatenated at the end. Velocities are kept only if `velocities`; whether every
+    batch had them is noted either way.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, velocities: bool = True) -> None:
+        self.keep_velocities = velocities
         self.capacity = 0
         self.count = 0
         self._filled = 0
@@ -269,6 +285,8 @@ class _Columns:
         self.count += m
         self.some_velocities |= velocities is not None
         self.all_velocities &= velocities is not None
+        if not self.keep_velocities:
+            velocities = None
         if self._arrays is None and self.capacity >= m:
             self._arrays = [_touched((self.capacity,), np.int64),
                             _touched((self.capacity,), np.int64),
@@ -301,7 +319,7 @@ class _Columns:
         else:
             times, log_times, positions = (np.concatenate([p[i] for p in parts]) for i in range(3))
             velocities = None
-            if self.all_velocities:
+            if self.all_velocities and self.keep_velocities:
                 velocities = np.concatenate([p[3] for p in parts if p[3] is not None])
         return times, log_times, positions, velocities if self.all_velocities else None
 
@@ -310,12 +328,16 @@ def _touched(shape: tuple[int, ...], dtype: type[np.generic]) -> np.ndarray:
     """Return a zeroed array whose pages are already mapped.
 
     Pages first touched one batch at a time, between the decompressor's allocations,
-    cost ten times more than one sweep over them.
+    cost ten times more than one sweep over them; where the system maps them all in one
+    call (Linux MAP_POPULATE), that costs about half a sweep.
     """
-    count = int(np.prod(shape))
-    array = np.frombuffer(bytearray(count * np.dtype(dtype).itemsize), dtype=dtype).reshape(shape)
-    array.fill(0)
-    return array
+    size = int(np.prod(shape)) * np.dtype(dtype).itemsize
+    populate = getattr(mmap, "MAP_POPULATE", 0)
+    if populate and size:
+        memory = mmap.mmap(-1, size, flags=mmap.MAP_PRIVATE | mmap.MAP_ANONYMOUS | populate)
+        return np.frombuffer(memory, dtype=dtype).reshape(shape)
+    # A bytearray is zero-filled, which touches every page.
+    return np.frombuffer(bytearray(size), dtype=dtype).reshape(shape)
 
 
 def _matches(rows: np.ndarray, template: np.ndarray, layout: JointStateLayout) -> NDArray[np.bool_]:
@@ -327,7 +349,9 @@ def _matches(rows: np.ndarray, template: np.ndarray, layout: JointStateLayout) -
     end = layout.position_at
     words = (end - 12) // 8
     key = slice(12, 12 + 8 * words)
-    same: NDArray[np.bool_] = (rows[:, key].view("<u8") == template[key].view("<u8")).all(axis=1)
+    equal = rows[:, key].view("<u8") == template[key].view("<u8")
+    # Usually every row is alike: one test of the whole block beats a test per row.
+    same: NDArray[np.bool_] = np.ones(len(rows), dtype=bool) if equal.all() else equal.all(axis=1)
     for at, size in ((end - 8, "<u8"), (0, "<u2"), (layout.velocity_count_at, "<u4"),
                      (layout.effort_count_at, "<u4")):
         width = np.dtype(size).itemsize

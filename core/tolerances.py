@@ -9,6 +9,7 @@ cycle, whether the controller was still before the trajectory's last point.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -19,7 +20,7 @@ from numpy.typing import NDArray
 from moveplan.core.config import ControllerConfig, ExecutionConfig
 from moveplan.core.errors import InputError, UnknownName
 from moveplan.core.trajectory import shortest_angular_distance
-from moveplan.core.types import JointTrajectory, frozen_array
+from moveplan.core.types import JointTrajectory
 
 __all__ = [
     "in_controller_order",
@@ -38,6 +39,7 @@ __all__ = [
     "check_state_tolerance_per_joint",
     "expected_duration_s",
     "judge",
+    "judge_spans",
     "position_error",
     "segment_tolerances",
     "velocity_error_computable",
@@ -253,16 +255,19 @@ def check_start_state(
 
 @dataclass(frozen=True)
 class _Series:
-    """Per-cycle values, each (K, n), with the joint names and cycle times (K,)."""
+    """Per-cycle values, each (K, n), with the joint names and cycle times (K,).
+
+    The velocity arrays are None when no velocity errors are computed (they would be 0).
+    """
 
     joints: tuple[str, ...]
     times_s: NDArray[np.float64]
     reference: NDArray[np.float64]
     actual: NDArray[np.float64]
     error: NDArray[np.float64]
-    velocity_reference: NDArray[np.float64]
-    velocity_actual: NDArray[np.float64]
-    velocity_error: NDArray[np.float64]
+    velocity_reference: NDArray[np.float64] | None
+    velocity_actual: NDArray[np.float64] | None
+    velocity_error: NDArray[np.float64] | None
 
 
 def judge(
@@ -299,42 +304,109 @@ def judge(
         actual_velocities: (K, n) measured velocities.
         continuous: Per joint, True for continuous joints.
     """
+    (report,) = judge_spans(
+        tolerances, times_s, reference_positions, actual_positions, before_last_point,
+        last_point_s, [0], [timeout], reference_velocities=reference_velocities,
+        actual_velocities=actual_velocities, continuous=continuous,
+    )
+    return report
+
+
+def judge_spans(
+    tolerances: SegmentTolerances,
+    times_s: npt.ArrayLike,
+    reference_positions: npt.ArrayLike,
+    actual_positions: npt.ArrayLike,
+    before_last_point: npt.ArrayLike,
+    last_point_s: float,
+    span_starts: npt.ArrayLike,
+    timeouts: Sequence[Timeout],
+    *,
+    reference_velocities: npt.ArrayLike | None = None,
+    actual_velocities: npt.ArrayLike | None = None,
+    continuous: npt.ArrayLike | None = None,
+) -> list[ToleranceReport]:
+    """Return `judge`'s verdict on each of several executions of one trajectory, stacked.
+
+    Span s holds the cycles from `span_starts[s]` up to the next span's start (the last
+    up to the end); its times are from its own trajectory start and its report's
+    end_index counts from its first cycle. One pass over the stacked arrays judges them
+    all: a long recording holds thousands of executions.
+
+    Args:
+        tolerances: As for `judge`.
+        times_s: Cycle times of every span, each from its trajectory's start in [s], (K,).
+        reference_positions: (K, n), as for `judge`; so are the other arrays.
+        actual_positions: (K, n).
+        before_last_point: (K,).
+        last_point_s: Time of the trajectory's last point in [s], the same for every span.
+        span_starts: Index of each span's first cycle, increasing from 0; no span is empty.
+        timeouts: When MoveIt gives up on each span.
+        reference_velocities: (K, n) or None, as for `judge`.
+        actual_velocities: (K, n) or None.
+        continuous: Per joint, True for continuous joints.
+    """
     series = _series(tolerances.joint_names, times_s, reference_positions, actual_positions,
                      reference_velocities, actual_velocities, continuous)
+    count = len(series.times_s)
+    starts = np.asarray(span_starts, dtype=np.intp)
+    stops = np.append(starts[1:], count)
+    if len(starts) == 0 or len(starts) != len(timeouts) or starts[0] != 0 or np.any(stops <= starts):
+        raise ValueError("span_starts: expected increasing indices from 0, one per timeout")
     before = np.asarray(before_last_point, dtype=bool)
     path_checked = before.copy()
-    path_checked[0] = True
-    path_failed = _outside(series, tolerances.state)
-    goal_failed = _outside(series, tolerances.goal)
-    aborts_path = path_failed.any(axis=1) & path_checked
-    succeeds = ~before & ~goal_failed.any(axis=1)
+    path_checked[starts] = True
+    magnitude = np.abs(series.error)
+    path_failed = _outside(magnitude, series.velocity_error, tolerances.state)
+    goal_failed = _outside(magnitude, series.velocity_error, tolerances.goal)
+    aborts_path = _any_per_row(path_failed) & path_checked
+    succeeds = ~before & ~_any_per_row(goal_failed)
     late = series.times_s - last_point_s > tolerances.goal_time_s
     aborts_goal = ~before & ~succeeds & late & (tolerances.goal_time_s > 0.0)
-    times_out = series.times_s > timeout.time_s
-    times_out[-1] = True
-    end = int(np.argmax(aborts_path | succeeds | aborts_goal | times_out))
-    margins = _margins(series, tolerances, path_checked[: end + 1], not before[end])
-    if aborts_path[end]:
-        violations = _state_violations(series, tolerances.state, path_failed[end], end, "path")
+    lengths = stops - starts
+    limit = np.repeat(np.array([t.time_s for t in timeouts], dtype=np.float64), lengths)
+    times_out = series.times_s > limit
+    times_out[stops - 1] = True
+    decisive = np.flatnonzero(aborts_path | succeeds | aborts_goal | times_out)
+    # Every span's last cycle decides, so each span's first decisive cycle lies inside it.
+    ends = decisive[np.searchsorted(decisive, starts)]
+    margins = _margins(series, magnitude, tolerances, path_checked, starts, ends, ~before[ends])
+    return [
+        _report(series, tolerances, int(end) - int(start), int(end), last_point_s, timeout,
+                bool(aborts_path[end]), bool(succeeds[end]), bool(aborts_goal[end]),
+                bool(before[end]), margin, path_failed[end], goal_failed[end])
+        for start, end, timeout, margin in zip(starts, ends, timeouts, margins, strict=True)
+    ]
+
+
+def _report(
+    series: _Series, tolerances: SegmentTolerances, end_index: int, k: int, last_point_s: float,
+    timeout: Timeout, aborts_path: bool, succeeds: bool, aborts_goal: bool, before: bool,
+    margins: dict[str, float], path_failed: NDArray[np.bool_], goal_failed: NDArray[np.bool_],
+) -> ToleranceReport:
+    """Return the report of a span decided at row `k` of `series`, its `end_index` in the span."""
+    if aborts_path:
+        violations = _state_violations(series, tolerances.state, path_failed, k, "path")
         return ToleranceReport(_result(PATH_TOLERANCE_VIOLATED, _path_message(violations)),
-                               violations, margins, end)
-    if succeeds[end]:
-        return ToleranceReport(_result(SUCCESSFUL, "Goal successfully reached!"), (), margins, end)
-    outside = goal_failed[end] & ~before[end]
-    state = _state_violations(series, tolerances.goal, outside, end, "goal", "stopped_velocity")
-    t_end = float(series.times_s[end])
-    if aborts_goal[end]:
+                               violations, margins, end_index)
+    if succeeds:
+        return ToleranceReport(_result(SUCCESSFUL, "Goal successfully reached!"), (), margins,
+                               end_index)
+    outside = goal_failed & (not before)
+    state = _state_violations(series, tolerances.goal, outside, k, "goal", "stopped_velocity")
+    t_end = float(series.times_s[k])
+    if aborts_goal:
         # JTC's own message: it reports the time past the last point, not past goal_time.
         exceeded = t_end - last_point_s
         message = f"Aborted due to goal_time_tolerance exceeding by {exceeded:.6f} seconds"
         late_by = Violation("goal_time", "", t_end, last_point_s, t_end, last_point_s - t_end,
                             tolerances.goal_time_s)
         return ToleranceReport(_result(GOAL_TOLERANCE_VIOLATED, message + _goal_details(state)),
-                               (late_by, *state), margins, end)
+                               (late_by, *state), margins, end_index)
     late_by = Violation("timeout", "", t_end, last_point_s, t_end, last_point_s - t_end,
                         timeout.time_s - last_point_s)
     return ToleranceReport(_result(TIMED_OUT, timeout.message + _goal_details(state)),
-                           (late_by, *state), margins, end)
+                           (late_by, *state), margins, end_index)
 
 
 def _series(
@@ -346,19 +418,30 @@ def _series(
     velocity_actual: npt.ArrayLike | None,
     continuous: npt.ArrayLike | None,
 ) -> _Series:
-    times = frozen_array(times_s, (None,), "times_s")
+    # Read, not copied: the series lives only for one verdict, and copies of stacked
+    # executions would cost as much as the checks.
+    times = _checked(times_s, (None,), "times_s")
     if len(times) == 0:
         raise ValueError("a time series needs at least one cycle")
     shape = (len(times), len(joints))
-    ref = frozen_array(reference, shape, "reference_positions")
-    act = frozen_array(actual, shape, "actual_positions")
-    if velocity_reference is None or velocity_actual is None:
-        v_ref = v_act = np.zeros(shape)
-    else:
-        v_ref = frozen_array(velocity_reference, shape, "reference_velocities")
-        v_act = frozen_array(velocity_actual, shape, "actual_velocities")
+    ref = _checked(reference, shape, "reference_positions")
+    act = _checked(actual, shape, "actual_positions")
     error = position_error(ref, act, continuous)
+    if velocity_reference is None or velocity_actual is None:
+        return _Series(joints, times, ref, act, error, None, None, None)
+    v_ref = _checked(velocity_reference, shape, "reference_velocities")
+    v_act = _checked(velocity_actual, shape, "actual_velocities")
     return _Series(joints, times, ref, act, error, v_ref, v_act, v_ref - v_act)
+
+
+def _checked(value: npt.ArrayLike, shape: tuple[int | None, ...], name: str) -> NDArray[np.float64]:
+    """Return `value` as a float64 array, checked against `shape` (None = any size)."""
+    array = np.asarray(value, dtype=np.float64)
+    if array.ndim != len(shape) or any(
+        want is not None and got != want for got, want in zip(array.shape, shape, strict=True)
+    ):
+        raise ValueError(f"{name}: expected shape {shape}, got {array.shape}")
+    return array
 
 
 def _limits(
@@ -371,20 +454,37 @@ def _limits(
 
 
 def _outside_parts(
-    series: _Series, tolerances: Sequence[StateTolerance]
+    error: NDArray[np.float64], velocity_error: NDArray[np.float64] | None,
+    tolerances: Sequence[StateTolerance],
 ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
-    """Return per cycle and joint whether position, resp. velocity, is outside its tolerance."""
+    """Return per joint (of one cycle) whether position, resp. velocity, is outside its tolerance."""
     position, velocity = _limits(tolerances)
     # No acceleration errors are computed (no acceleration state), so they never fail.
-    return (
-        (position > 0.0) & (np.abs(series.error) > position),
-        (velocity > 0.0) & (np.abs(series.velocity_error) > velocity),
-    )
+    position_out = (position > 0.0) & (np.abs(error) > position)
+    if velocity_error is None:
+        return position_out, np.zeros_like(position_out)
+    return position_out, (velocity > 0.0) & (np.abs(velocity_error) > velocity)
 
 
-def _outside(series: _Series, tolerances: Sequence[StateTolerance]) -> NDArray[np.bool_]:
-    position, velocity = _outside_parts(series, tolerances)
-    return position | velocity
+def _outside(
+    magnitude: NDArray[np.float64], velocity_error: NDArray[np.float64] | None,
+    tolerances: Sequence[StateTolerance],
+) -> NDArray[np.bool_]:
+    """Return per cycle and joint whether |error| `magnitude` or the velocity is outside."""
+    position, velocity = _limits(tolerances)
+    # A tolerance of 0 is not checked: nothing is above an infinite one.
+    outside: NDArray[np.bool_] = magnitude > np.where(position > 0.0, position, np.inf)
+    if velocity_error is not None and np.any(velocity > 0.0):
+        outside |= (velocity > 0.0) & (np.abs(velocity_error) > velocity)
+    return outside
+
+
+def _any_per_row(outside: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """Return per cycle whether any joint is outside."""
+    # Cheaper than any(axis=1) over few joints, as long as few cycles are outside.
+    found = np.zeros(len(outside), dtype=bool)
+    found[np.flatnonzero(outside) // max(outside.shape[1], 1)] = True
+    return found
 
 
 def _state_violations(
@@ -396,43 +496,51 @@ def _state_violations(
     velocity_check: str = "path",
 ) -> tuple[Violation, ...]:
     """Return cycle `k`'s violations of joints in `joints_outside`: positions, then velocities."""
-    position_out, velocity_out = _outside_parts(series, tolerances)
+    velocity_error = None if series.velocity_error is None else series.velocity_error[k]
+    position_out, velocity_out = _outside_parts(series.error[k], velocity_error, tolerances)
     position, velocity = _limits(tolerances)
     t = float(series.times_s[k])
     found = [
         Violation(position_check, series.joints[j], t, float(series.reference[k, j]),
                   float(series.actual[k, j]), float(series.error[k, j]), float(position[j]))
-        for j in map(int, np.flatnonzero(joints_outside & position_out[k]))
+        for j in map(int, np.flatnonzero(joints_outside & position_out))
     ]
-    found += [
-        Violation(velocity_check, series.joints[j], t, float(series.velocity_reference[k, j]),
-                  float(series.velocity_actual[k, j]), float(series.velocity_error[k, j]),
-                  float(velocity[j]))
-        for j in map(int, np.flatnonzero(joints_outside & velocity_out[k]))
-    ]
+    if series.velocity_reference is not None and series.velocity_actual is not None:
+        assert series.velocity_error is not None
+        found += [
+            Violation(velocity_check, series.joints[j], t, float(series.velocity_reference[k, j]),
+                      float(series.velocity_actual[k, j]), float(series.velocity_error[k, j]),
+                      float(velocity[j]))
+            for j in map(int, np.flatnonzero(joints_outside & velocity_out))
+        ]
     return tuple(found)
 
 
 def _margins(
-    series: _Series, tolerances: SegmentTolerances, path_checked: NDArray[np.bool_], goal: bool
-) -> dict[str, float]:
-    """Return per joint the smallest position tolerance - |error| over the checks that ran.
+    series: _Series, magnitude: NDArray[np.float64], tolerances: SegmentTolerances,
+    path_checked: NDArray[np.bool_], starts: NDArray[np.intp], ends: NDArray[np.intp],
+    goal: NDArray[np.bool_],
+) -> list[dict[str, float]]:
+    """Return per span the smallest position tolerance - |error| over the checks that ran.
 
-    `path_checked` covers the cycles up to the last one; `goal` says whether that last one
-    was goal-checked. A goal margin before the last cycle says nothing: the robot may still
-    be on its way in.
+    Span s counts its path-checked cycles up to `ends[s]`, and the goal check of cycle
+    `ends[s]` if `goal[s]`. A goal margin before the last cycle says nothing: the robot
+    may still be on its way in.
     """
-    end = len(path_checked) - 1
     path, _ = _limits(tolerances.state)
     goal_tolerance, _ = _limits(tolerances.goal)
-    margin = np.full(len(series.joints), np.inf)
-    errors = np.abs(series.error[: end + 1][path_checked])
-    if len(errors):
-        margin = np.where(path > 0.0, np.minimum(margin, (path - errors).min(axis=0)), margin)
-    if goal:
-        goal_margin = goal_tolerance - np.abs(series.error[end])
-        margin = np.where(goal_tolerance > 0.0, np.minimum(margin, goal_margin), margin)
-    return {j: float(m) for j, m in zip(series.joints, margin, strict=True) if np.isfinite(m)}
+    values = path - magnitude
+    values[~path_checked] = np.inf
+    for end, stop in zip(ends.tolist(), [*starts[1:].tolist(), len(values)], strict=True):
+        values[end + 1 : stop] = np.inf
+    margin = np.where(path > 0.0, np.minimum.reduceat(values, starts, axis=0), np.inf)
+    goal_margin = goal_tolerance - magnitude[ends]
+    margin = np.where((goal_tolerance > 0.0) & goal[:, None], np.minimum(margin, goal_margin),
+                      margin)
+    return [
+        {j: float(m) for j, m in zip(series.joints, row.tolist(), strict=True) if math.isfinite(m)}
+        for row in margin
+    ]
 
 
 def _goal_details(violations: Sequence[Violation]) -> str:

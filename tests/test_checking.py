@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from mcap.writer import Writer
 
-from moveplan.core.checking import CheckReport, check_recording
+from moveplan.core.checking import CheckReport, check_recording, uses_velocities
 from moveplan.core.config import ControllerConfig, ExecutionConfig
 from moveplan.core.controller import Disturbance, simulate
 from moveplan.core.errors import InputError, UsageError
@@ -185,6 +185,14 @@ def test_stopped_velocity_is_checked_only_where_jtc_computes_velocity_errors() -
     report = check(ONE_STEP, recorded, jtc(commands=("velocity",)))
     assert report.result.name == "GOAL_TOLERANCE_VIOLATED"
     assert {v.check for _, v in report.violations} == {"goal_time", "stopped_velocity"}
+
+
+def test_velocities_are_read_only_where_jtc_computes_velocity_errors_or_blends_from_them() -> None:
+    assert not uses_velocities(CYCLE, jtc())
+    assert uses_velocities(CYCLE, jtc(commands=("velocity",)))
+    later = JointTrajectory(JOINTS, OUT.times_s + 0.1, OUT.positions, OUT.velocities,
+                            OUT.accelerations)
+    assert uses_velocities(Plan((PlanStepRecord("out", 0.0, later),)), jtc())
 
 
 def test_steps_are_separate_goals_started_by_their_departures() -> None:

@@ -111,6 +111,13 @@ def test_joints_in_another_order_with_an_extra_joint(tmp_path: Path) -> None:
     np.testing.assert_array_equal(series.velocities, velocities[:, order])
 
 
+def test_velocities_are_left_unread_when_not_wanted(tmp_path: Path) -> None:
+    path, (_, positions, _) = joint_state_bag(tmp_path / "js.mcap")
+    series = read_joint_states(path, joints=JOINTS, velocities=False)
+    assert series.velocities is None
+    np.testing.assert_array_equal(series.positions, positions)
+
+
 def test_missing_joint_names_it_and_the_joints_present(tmp_path: Path) -> None:
     path, _ = joint_state_bag(tmp_path / "js.mcap", names=JOINTS[:5])
     with pytest.raises(InputError, match="no joint wrist_3_joint") as error:

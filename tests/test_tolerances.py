@@ -17,6 +17,7 @@ from moveplan.core.tolerances import (
     check_state_tolerance_per_joint,
     expected_duration_s,
     judge,
+    judge_spans,
     position_error,
     segment_tolerances,
     velocity_error_computable,
@@ -183,6 +184,19 @@ def test_stopped_velocity_is_checked_only_with_velocity_errors_given():
     assert checked.result.code == TIMED_OUT
     checks = [(v.check, v.joint) for v in checked.violations]
     assert checks == [("timeout", ""), ("stopped_velocity", "joint1")]
+
+
+def test_spans_judged_together_get_the_verdicts_they_get_alone():
+    spans = [series([0.0, 0.05, 0.12, 0.0, 0.0]), series([0.0, 0.05, 0.08, 0.03, 0.0]),
+             series([0.0, 0.08, 0.08])]
+    timeouts = [FAR, FAR, Timeout(0.15, "late")]
+    stacked = [np.concatenate(arrays) for arrays in zip(*spans, strict=True)]
+    times = stacked[0]
+    together = judge_spans(tolerances(), *stacked, times < 0.25, 0.3, [0, 5, 10], timeouts)
+    alone = [judge(tolerances(), t, r, a, t < 0.25, 0.3, timeout)
+             for (t, r, a), timeout in zip(spans, timeouts, strict=True)]
+    assert together == alone
+    assert [r.result.code for r in together] == [PATH_TOLERANCE_VIOLATED, SUCCESSFUL, TIMED_OUT]
 
 
 def test_series_ending_without_verdict_times_out_at_its_last_cycle():
