@@ -180,7 +180,8 @@ class CollisionChecker:
         self.mode: GeometryMode = geometry
         model = robot.model
         config = robot.config
-        geom = _robot_geometry(robot, geometry).copy()
+        self.robot_geometry = _robot_geometry(robot, geometry)  # shared per process: never modify
+        geom = self.robot_geometry.copy()
         owner = [str(model.frames[g.parentFrame].name) for g in geom.geometryObjects]
         touch: list[frozenset[str]] = [frozenset() for _ in owner]
         for obj in objects:

@@ -39,6 +39,7 @@ from moveplan.core.moveit_request import MotionPlanRequest, load_motion_plan_req
 from moveplan.core.planning import PathResult, Validity, plan_path, seed_planner
 from moveplan.core.robot import Robot
 from moveplan.core.scene import Scene, empty_scene, load_scene
+from moveplan.core.sphere_check import SphereFilter, UnsupportedJoint
 from moveplan.core.tasks import StepSpec, TaskFile
 from moveplan.core.timing import time_parameterize
 from moveplan.core.trajectory import sample
@@ -154,7 +155,7 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
     checker = CollisionChecker(robot, scene.objects, scene.source, geometry=config.planning["collision"],
                                allowed=scene.allowed)
     base, current = _start_values(request, robot, scene)
-    checks = MotionChecker(robot, checker, base)
+    checks = MotionChecker(robot, checker, base, _sphere_filter(robot, checker, scene))
     pair = checks.colliding_pair(current)
     if pair:
         raise StartInCollision(pair)
@@ -190,6 +191,15 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
         metadata={"seed": str(request.seed), "moveplan_version": version("moveplan"),
                   "planners": ",".join(s.planner for s in steps)},
     )
+
+
+def _sphere_filter(robot: Robot, checker: CollisionChecker, scene: Scene) -> SphereFilter | None:
+    """Return the fast conservative pre-check for `robot` in `scene`, or None where it does not apply."""
+    try:
+        return SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed)
+    except UnsupportedJoint as exc:
+        logger.info("no sphere filter (%s): every state is checked by coal", exc)
+        return None
 
 
 def _in_step(exc: Exception, step: str) -> Exception:

@@ -1,0 +1,353 @@
+"""A fast conservative collision filter: the robot's enclosing spheres against the scene and themselves.
+
+Compiled with numba (imported only when a filter is built, so commands that do not plan
+never pay its start-up). One call checks a batch of configurations: forward kinematics
+of the joint tree, then per owner (link or attached object) its bounding ball first and
+its spheres only if that ball touches something. A state is "clear" only if no sphere
+touches an obstacle or another owner's sphere; since the spheres enclose the real
+geometry (core/sphere_model.py), a clear state is collision-free. Anything else is
+"maybe": the caller asks the exact checker.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import coal
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from moveplan.core.robot import Robot
+from moveplan.core.sphere_model import fit_shape, robot_spheres
+from moveplan.core.types import CollisionObject
+
+__all__ = ["SphereFilter", "UnsupportedJoint"]
+
+# Joint kinds the kernel knows; anything else (planar, free-flyer, ...) makes the filter unavailable.
+_REVOLUTE, _PRISMATIC, _UNBOUNDED = 1, 2, 3
+_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+_BOX, _SPHERE, _CYLINDER = 0, 1, 2
+_KERNELS: dict[str, Any] = {}
+_CLOSE: dict[str, frozenset[frozenset[str]]] = {}  # per URDF: link pairs whose spheres are mostly touching
+
+
+class UnsupportedJoint(ValueError):
+    """The robot has a joint the filter's kinematics do not handle."""
+
+
+def _joint_kind(model: pin.Model, jid: int) -> tuple[int, tuple[float, float, float]]:
+    """Return (kind, axis) of a pinocchio joint."""
+    name = model.joints[jid].shortname().removeprefix("JointModel")
+    for prefix, kind in (("RUB", _UNBOUNDED), ("R", _REVOLUTE), ("P", _PRISMATIC)):
+        if name.startswith(prefix) and name[len(prefix):] in _AXES:
+            return kind, _AXES[name[len(prefix):]]
+    joint = model.joints[jid]
+    if name in ("RevoluteUnaligned", "RevoluteUnboundedUnaligned", "PrismaticUnaligned"):
+        kind = {"RevoluteUnaligned": _REVOLUTE, "RevoluteUnboundedUnaligned": _UNBOUNDED}.get(name, _PRISMATIC)
+        return kind, tuple(float(v) for v in np.asarray(joint.extract().axis))  # type: ignore[return-value]
+    raise UnsupportedJoint(f"joint '{model.names[jid]}' ({name}) is not handled by the sphere filter")
+
+
+class SphereFilter:
+    """Clears robot configurations whose enclosing spheres touch nothing."""
+
+    def __init__(
+        self,
+        robot: Robot,
+        geometry: pin.GeometryModel,
+        objects: tuple[CollisionObject, ...],
+        allowed: frozenset[frozenset[str]] = frozenset(),
+    ) -> None:
+        """Fit spheres to `robot` (its `geometry`), add attached objects, and list what to check.
+
+        Raises:
+            UnsupportedJoint: The robot has a joint kind the kernel does not handle.
+        """
+        model = robot.model
+        kinds = [(0, (0.0, 0.0, 1.0))] + [_joint_kind(model, j) for j in range(1, model.njoints)]
+        self._parents = np.array(model.parents, dtype=np.int64)
+        self._kind = np.array([k for k, _ in kinds], dtype=np.int64)
+        self._axis = np.array([a for _, a in kinds], dtype=float)
+        self._iq = np.array(model.idx_qs, dtype=np.int64)
+        self._rot = np.array([np.asarray(p.rotation) for p in model.jointPlacements])
+        self._trans = np.array([np.asarray(p.translation) for p in model.jointPlacements])
+
+        robot_set = robot_spheres(model, geometry, robot.config.urdf)
+        centres, radii = [robot_set.centres], [robot_set.radii]
+        joints, owners = [robot_set.joints], list(robot_set.owners)
+        touch: dict[str, frozenset[str]] = {}
+        world = [obj for obj in objects if not obj.link]
+        for obj in objects:
+            if obj.link:
+                frame = model.frames[model.getFrameId(obj.link)]
+                c, r = fit_shape(obj.shape, np.asarray(frame.placement.homogeneous) @ obj.transform)
+                centres.append(c)
+                radii.append(r)
+                joints.append(np.full(len(r), frame.parentJoint))
+                owners.extend([obj.name] * len(r))
+                touch[obj.name] = frozenset((obj.link, *obj.touch_links))
+        centres_all, radii_all, joints_all = np.concatenate(centres), np.concatenate(radii), np.concatenate(joints)
+        names = list(dict.fromkeys(owners))
+        owner_index = np.array([names.index(o) for o in owners], dtype=np.int64)
+        order = np.argsort(owner_index, kind="stable")
+        self._centres, self._radii = centres_all[order], radii_all[order]
+        self._sjoint, owner_index = joints_all[order], owner_index[order]
+        self._start = np.searchsorted(owner_index, np.arange(len(names) + 1)).astype(np.int64)
+        # Each owner's bounding ball, in its joint's frame.
+        self._ojoint = self._sjoint[self._start[:-1]]
+        self._ocentre = np.zeros((len(names), 3))
+        self._oradius = np.zeros(len(names))
+        for k in range(len(names)):
+            c, r = self._centres[self._start[k]:self._start[k + 1]], self._radii[self._start[k]:self._start[k + 1]]
+            middle = (c.min(axis=0) + c.max(axis=0)) / 2
+            self._ocentre[k] = middle
+            self._oradius[k] = np.max(np.linalg.norm(c - middle, axis=1) + r)
+
+        disabled = robot.config.srdf.disabled_pairs | allowed
+        pairs = []
+        for a in range(len(names)):
+            for b in range(a + 1, len(names)):
+                na, nb = names[a], names[b]
+                if self._ojoint[a] == self._ojoint[b] or frozenset((na, nb)) in disabled:
+                    continue
+                if na in touch.get(nb, ()) or nb in touch.get(na, ()):
+                    continue
+                pairs.append((a, b))
+        pairs_array = np.array(pairs, dtype=np.int64).reshape(-1, 2)
+        # Links that sit a few millimetres apart in most configurations (a wrist's neighbours)
+        # would keep most states "maybe"; those pairs are checked exactly instead, in one batch.
+        key = robot.config.urdf
+        if key not in _CLOSE:
+            robot_owners = sorted({names.index(o) for o in robot_set.owners})
+            every = np.array([(a, b) for a in robot_owners for b in robot_owners
+                              if a < b and self._ojoint[a] != self._ojoint[b]], dtype=np.int64).reshape(-1, 2)
+            close = self._always_close(robot, every)
+            _CLOSE[key] = frozenset(frozenset((names[a], names[b])) for a, b in every[close])
+        hard = np.array([frozenset((names[a], names[b])) in _CLOSE[key] for a, b in pairs_array], dtype=bool)
+        self._pairs = pairs_array[~hard]
+        self.exact_pairs = tuple((names[a], names[b]) for a, b in pairs_array[hard])
+        self._exact = _pair_pool(robot, geometry, self.exact_pairs)
+        self._obstacles = _obstacles(world)
+        self._check = np.array([[frozenset((name, obj.name)) not in allowed for obj in world] for name in names],
+                               dtype=np.bool_).reshape(len(names), len(world))
+        self._kernel = _kernels()
+        self.clear(np.array(pin.neutral(model))[None, :])  # compile (or load) the kernel now, not mid-search
+
+    def clear(self, q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """Return per configuration (rows of `q`, shape (k, nq)) True if it is certainly collision-free."""
+        q = np.ascontiguousarray(q, dtype=np.float64)
+        out = np.empty(len(q), dtype=np.bool_)
+        self._kernel(q, *self._arrays(), out)
+        if self._exact is not None and out.any():
+            cleared = np.flatnonzero(out)
+            hits = pin.computeCollisionsInParallel(1, self._exact, np.asfortranarray(q[cleared].T), True, False)
+            out[cleared] = ~np.asarray(hits, dtype=bool)
+        return out
+
+    def _always_close(self, robot: Robot, pairs: NDArray[np.int64], samples: int = 200) -> NDArray[np.bool_]:
+        """Return per owner pair True if its spheres touch in over a third of random configurations."""
+        model = robot.model
+        rng = np.random.default_rng(0)
+        lower = np.nan_to_num(np.asarray(model.lowerPositionLimit), nan=-np.pi, posinf=np.pi, neginf=-np.pi)
+        upper = np.nan_to_num(np.asarray(model.upperPositionLimit), nan=np.pi, posinf=np.pi, neginf=-np.pi)
+        data = model.createData()
+        touching = np.zeros(len(pairs))
+        for _ in range(samples):
+            q = pin.normalize(model, rng.uniform(np.maximum(lower, -np.pi), np.minimum(upper, np.pi)))
+            pin.forwardKinematics(model, data, q)
+            rotations = np.array([np.asarray(data.oMi[int(j)].rotation) for j in self._sjoint])
+            translations = np.array([np.asarray(data.oMi[int(j)].translation) for j in self._sjoint])
+            world = np.einsum("sij,sj->si", rotations, self._centres) + translations
+            for k, (a, b) in enumerate(pairs):
+                sa, sb = slice(self._start[a], self._start[a + 1]), slice(self._start[b], self._start[b + 1])
+                gaps = np.linalg.norm(world[sa, None] - world[None, sb], axis=2)
+                touching[k] += bool(np.any(gaps <= self._radii[sa, None] + self._radii[None, sb]))
+        return touching > samples / 3
+
+    def _arrays(self) -> tuple[Any, ...]:
+        kind, centre, rot, size = self._obstacles
+        return (self._parents, self._kind, self._axis, self._iq, self._rot, self._trans, self._centres, self._radii,
+                self._sjoint, self._start, self._ojoint, self._ocentre, self._oradius, self._pairs, kind, centre, rot,
+                size, self._check)
+
+
+def _pair_pool(robot: Robot, geometry: pin.GeometryModel, pairs: tuple[tuple[str, str], ...]) -> Any:
+    """Return a pinocchio pool that checks the convex hulls of the shapes of `pairs` (link names), or None."""
+    if not pairs:
+        return None
+    from moveplan.core.collision import convex_hull
+
+    model = robot.model
+    exact = geometry.copy()
+    exact.removeAllCollisionPairs()
+    for obj in exact.geometryObjects:
+        # Hulls enclose their meshes (so a pair free as hulls is free) and cost a fraction of a mesh check.
+        if isinstance(obj.geometry, coal.BVHModelBase) and obj.meshPath:
+            key = (str(obj.meshPath), tuple(float(v) for v in obj.meshScale))
+            obj.geometry = convex_hull(obj.geometry, key, f"{robot.config.urdf_path}: {obj.name}")
+    owner = [str(model.frames[g.parentFrame].name) for g in exact.geometryObjects]
+    wanted = {frozenset(p) for p in pairs}
+    for i in range(len(owner)):
+        for j in range(i + 1, len(owner)):
+            if frozenset((owner[i], owner[j])) in wanted:
+                exact.addCollisionPair(pin.CollisionPair(i, j))
+    return pin.GeometryPool(model, exact, 1)
+
+
+def _obstacles(world: list[CollisionObject]) -> tuple[NDArray[Any], ...]:
+    """Return world obstacles as arrays: kind, centre, rotation, size (box half sides; radius; radius, half length)."""
+    from moveplan.core.collision import coal_geometry
+
+    kinds, centres, rotations, sizes = [], [], [], []
+    for obj in world:
+        shape, transform = obj.shape, np.asarray(obj.transform)
+        rotation, centre = transform[:3, :3], transform[:3, 3]
+        if shape.kind == "box":
+            kind, size = _BOX, np.array([*shape.dims]) / 2
+        elif shape.kind == "sphere":
+            kind, size = _SPHERE, np.array([shape.dims[0], 0.0, 0.0])
+        elif shape.kind == "cylinder":
+            kind, size = _CYLINDER, np.array([shape.dims[0], shape.dims[1] / 2, 0.0])
+        else:
+            # A mesh counts as its bounding box in its own frame: it encloses the mesh.
+            mesh = coal_geometry(shape, obj.name)
+            mesh.computeLocalAABB()
+            lo, hi = np.asarray(mesh.aabb_local.min_), np.asarray(mesh.aabb_local.max_)
+            kind, size = _BOX, (hi - lo) / 2
+            centre = centre + rotation @ ((hi + lo) / 2)
+        kinds.append(kind)
+        centres.append(centre)
+        rotations.append(rotation)
+        sizes.append(size)
+    count = len(world)
+    return (np.array(kinds, dtype=np.int64), np.array(centres, dtype=float).reshape(count, 3),
+            np.array(rotations, dtype=float).reshape(count, 3, 3), np.array(sizes, dtype=float).reshape(count, 3))
+
+
+def _kernels() -> Any:
+    """Return the compiled batch kernel (compiled once per process, cached on disk by numba)."""
+    if "clear" in _KERNELS:
+        return _KERNELS["clear"]
+    import numba
+
+    @numba.njit(cache=True, fastmath=False)
+    def gap(kind: int, centre: Any, rot: Any, size: Any, p: Any, radius: float) -> float:
+        # Distance from a ball to an obstacle, <= 0 when they touch; exact for box, sphere, cylinder.
+        d0, d1, d2 = p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]
+        x = rot[0, 0] * d0 + rot[1, 0] * d1 + rot[2, 0] * d2
+        y = rot[0, 1] * d0 + rot[1, 1] * d1 + rot[2, 1] * d2
+        z = rot[0, 2] * d0 + rot[1, 2] * d1 + rot[2, 2] * d2
+        if kind == 0:
+            ex = max(abs(x) - size[0], 0.0)
+            ey = max(abs(y) - size[1], 0.0)
+            ez = max(abs(z) - size[2], 0.0)
+            return np.sqrt(ex * ex + ey * ey + ez * ez) - radius
+        if kind == 1:
+            return np.sqrt(x * x + y * y + z * z) - size[0] - radius
+        er = max(np.sqrt(x * x + y * y) - size[0], 0.0)
+        ez = max(abs(z) - size[1], 0.0)
+        return np.sqrt(er * er + ez * ez) - radius
+
+    @numba.njit(cache=True, fastmath=False)
+    def clear(qs: Any, parents: Any, kinds: Any, axes: Any, iq: Any, prot: Any, ptrans: Any, centres: Any,
+              radii: Any, sjoint: Any, start: Any, ojoint: Any, ocentre: Any, oradius: Any, pairs: Any,
+              okind: Any, opos: Any, orot: Any, osize: Any, check: Any, out: Any) -> None:
+        nj = len(parents)
+        ns = len(radii)
+        no = len(oradius)
+        rot = np.empty((nj, 3, 3))
+        pos = np.empty((nj, 3))
+        world = np.empty((ns, 3))
+        owc = np.empty((no, 3))
+        local = np.empty((3, 3))
+        for k in range(len(qs)):
+            q = qs[k]
+            rot[0] = np.eye(3)
+            pos[0] = 0.0
+            for j in range(1, nj):
+                # local = placement rotation * joint motion
+                kind = kinds[j]
+                a = axes[j]
+                if kind == 2:
+                    for r in range(3):
+                        for c in range(3):
+                            local[r, c] = prot[j, r, c]
+                    shift = q[iq[j]]
+                    t0 = ptrans[j, 0] + (prot[j, 0, 0] * a[0] + prot[j, 0, 1] * a[1] + prot[j, 0, 2] * a[2]) * shift
+                    t1 = ptrans[j, 1] + (prot[j, 1, 0] * a[0] + prot[j, 1, 1] * a[1] + prot[j, 1, 2] * a[2]) * shift
+                    t2 = ptrans[j, 2] + (prot[j, 2, 0] * a[0] + prot[j, 2, 1] * a[1] + prot[j, 2, 2] * a[2]) * shift
+                else:
+                    if kind == 3:
+                        cs, sn = q[iq[j]], q[iq[j] + 1]
+                    else:
+                        cs, sn = np.cos(q[iq[j]]), np.sin(q[iq[j]])
+                    # Rodrigues: R = c I + s [a]x + (1 - c) a a^T
+                    v = 1.0 - cs
+                    m00 = cs + a[0] * a[0] * v
+                    m01 = a[0] * a[1] * v - a[2] * sn
+                    m02 = a[0] * a[2] * v + a[1] * sn
+                    m10 = a[1] * a[0] * v + a[2] * sn
+                    m11 = cs + a[1] * a[1] * v
+                    m12 = a[1] * a[2] * v - a[0] * sn
+                    m20 = a[2] * a[0] * v - a[1] * sn
+                    m21 = a[2] * a[1] * v + a[0] * sn
+                    m22 = cs + a[2] * a[2] * v
+                    for r in range(3):
+                        p0, p1, p2 = prot[j, r, 0], prot[j, r, 1], prot[j, r, 2]
+                        local[r, 0] = p0 * m00 + p1 * m10 + p2 * m20
+                        local[r, 1] = p0 * m01 + p1 * m11 + p2 * m21
+                        local[r, 2] = p0 * m02 + p1 * m12 + p2 * m22
+                    t0, t1, t2 = ptrans[j, 0], ptrans[j, 1], ptrans[j, 2]
+                p = parents[j]
+                for r in range(3):
+                    for c in range(3):
+                        rot[j, r, c] = (rot[p, r, 0] * local[0, c] + rot[p, r, 1] * local[1, c]
+                                        + rot[p, r, 2] * local[2, c])
+                    pos[j, r] = pos[p, r] + rot[p, r, 0] * t0 + rot[p, r, 1] * t1 + rot[p, r, 2] * t2
+            for s in range(ns):
+                j = sjoint[s]
+                for r in range(3):
+                    world[s, r] = pos[j, r] + rot[j, r, 0] * centres[s, 0] + rot[j, r, 1] * centres[s, 1] \
+                        + rot[j, r, 2] * centres[s, 2]
+            for o in range(no):
+                j = ojoint[o]
+                for r in range(3):
+                    owc[o, r] = pos[j, r] + rot[j, r, 0] * ocentre[o, 0] + rot[j, r, 1] * ocentre[o, 1] \
+                        + rot[j, r, 2] * ocentre[o, 2]
+            free = True
+            for o in range(no):
+                if not free:
+                    break
+                for b in range(len(okind)):
+                    if not check[o, b]:
+                        continue
+                    if gap(okind[b], opos[b], orot[b], osize[b], owc[o], oradius[o]) > 0.0:
+                        continue
+                    for s in range(start[o], start[o + 1]):
+                        if gap(okind[b], opos[b], orot[b], osize[b], world[s], radii[s]) <= 0.0:
+                            free = False
+                            break
+                    if not free:
+                        break
+            for i in range(len(pairs)):
+                if not free:
+                    break
+                a, b = pairs[i, 0], pairs[i, 1]
+                dx, dy, dz = owc[a, 0] - owc[b, 0], owc[a, 1] - owc[b, 1], owc[a, 2] - owc[b, 2]
+                reach = oradius[a] + oradius[b]
+                if dx * dx + dy * dy + dz * dz > reach * reach:
+                    continue
+                for s in range(start[a], start[a + 1]):
+                    for t in range(start[b], start[b + 1]):
+                        dx, dy, dz = world[s, 0] - world[t, 0], world[s, 1] - world[t, 1], world[s, 2] - world[t, 2]
+                        reach = radii[s] + radii[t]
+                        if dx * dx + dy * dy + dz * dz <= reach * reach:
+                            free = False
+                            break
+                    if not free:
+                        break
+            out[k] = free
+
+    _KERNELS["clear"] = clear
+    return clear

@@ -1,0 +1,83 @@
+"""The sphere filter: spheres enclose the real geometry, and a state it clears never collides."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import ROOT, UR10E
+
+from moveplan.core import sphere_model
+from moveplan.core.collision import CollisionChecker
+from moveplan.core.config import load_robot_config
+from moveplan.core.robot import Robot
+from moveplan.core.scene import load_scene
+from moveplan.core.sphere_check import SphereFilter
+from moveplan.core.sphere_model import fit_geometry, robot_spheres
+
+PANDA = ROOT / "configs" / "panda"
+MBM = ROOT / "tests" / "data" / "mbm"
+
+
+def _surface_points(obj: pin.GeometryObject, rng: np.random.Generator) -> np.ndarray:
+    """Return vertices and random points on the triangles of a shape's surface, in its joint's frame."""
+    vertices, triangles = sphere_model._surface(obj.geometry)
+    corners = vertices[triangles]
+    weights = rng.dirichlet(np.ones(3), size=(len(triangles), 20))
+    inside = np.einsum("tkc,tcx->tkx", weights, corners).reshape(-1, 3)
+    points = np.vstack([vertices, inside])
+    return points @ np.asarray(obj.placement.rotation).T + np.asarray(obj.placement.translation)
+
+
+@pytest.mark.parametrize("config", [PANDA, UR10E], ids=["panda meshes", "ur10e cylinders"])
+def test_every_point_of_every_shape_lies_inside_its_spheres(config: Path) -> None:
+    robot = Robot(load_robot_config(config))
+    geometry = CollisionChecker(robot).robot_geometry
+    rng = np.random.default_rng(0)
+    for obj in geometry.geometryObjects:
+        centres, radii = fit_geometry(obj)
+        points = _surface_points(obj, rng)
+        gaps = np.linalg.norm(points[:, None, :] - centres[None], axis=2) - radii[None]
+        assert np.all(gaps.min(axis=1) <= 0.0), obj.name
+
+
+@pytest.fixture(scope="module")
+def panda_in_box() -> tuple[Robot, CollisionChecker, SphereFilter]:
+    robot = Robot(load_robot_config(PANDA))
+    scene = load_scene(MBM / "scene0001.yaml", robot)
+    checker = CollisionChecker(robot, scene.objects, scene.source, geometry="exact", allowed=scene.allowed)
+    return robot, checker, SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed)
+
+
+def test_no_state_the_filter_clears_collides_and_most_free_states_are_cleared(
+    panda_in_box: tuple[Robot, CollisionChecker, SphereFilter]
+) -> None:
+    robot, checker, spheres = panda_in_box
+    rng = np.random.default_rng(1)
+    values = rng.uniform(robot.lower, robot.upper, size=(3000, robot.dof))
+    # States near the box's walls too: small moves from a known free state.
+    values = np.vstack([values, robot.values(robot.neutral()) + rng.normal(scale=0.3, size=(1000, robot.dof))])
+    values = np.clip(values, robot.lower, robot.upper)
+    q = robot.configurations(values, robot.neutral())
+    free = checker.free_batch(q)
+    cleared = spheres.clear(np.ascontiguousarray(q.T))
+    assert not np.any(cleared & ~free)
+    assert cleared[free].mean() > 0.6
+
+
+def test_fitted_spheres_are_cached_on_disk_and_a_corrupt_cache_is_rebuilt(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("MOVEPLAN_CACHE_DIR", str(tmp_path))
+    robot = Robot(load_robot_config(UR10E))
+    geometry = CollisionChecker(robot).robot_geometry
+    monkeypatch.setattr(sphere_model, "_CACHE", {})
+    first = robot_spheres(robot.model, geometry, robot.config.urdf)
+    [cached] = tmp_path.glob("spheres-*.pickle")
+    cached.write_bytes(b"not a pickle")
+    monkeypatch.setattr(sphere_model, "_CACHE", {})
+    again = robot_spheres(robot.model, geometry, robot.config.urdf)
+    np.testing.assert_array_equal(first.radii, again.radii)
+    assert cached.read_bytes() != b"not a pickle"
