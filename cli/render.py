@@ -303,4 +303,4 @@ def benchmark_summary(runs: list[Run], rows: list[dict[str, Any]], as_json: bool
                       ms(row, "simplify"), ms(row, "total"), ms(row, "timing"), number(row["path_length_median"], 2),
                       number(row["duration_median_s"], 2), f"{row['exact_valid']}/{row['succeeded']}")
     # Piped to a file, rich would fold the table into 80 columns.
-    _console.print(table, width=None if _console.is_terminal else 160)
+    (_console if _console.is_terminal else Console(width=160)).print(table)

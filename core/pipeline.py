@@ -54,7 +54,7 @@ logger = logging.getLogger(__name__)
 # interpolates it, with no robot point moving more than 5 mm between checked states. A
 # trajectory that fails certification is planned again with fine edge checks and a
 # closer-following time parameterisation.
-_ATTEMPTS = ((0.02, 0.05), (0.005, 0.01))  # (edge check resolution [rad], timing resample step [rad])
+_ATTEMPTS = ((0.05, 0.05), (0.005, 0.01))  # (edge check resolution [rad], timing resample step [rad])
 _TF_RATE_HZ = 30.0
 
 

@@ -28,6 +28,7 @@ __all__ = ["CERTIFY_STEP_M", "MotionChecker"]
 logger = logging.getLogger(__name__)
 
 CERTIFY_STEP_M = 0.005  # the most any robot point moves between two certified states [m]
+_STRIDE = 8
 
 
 class Filter(Protocol):
@@ -72,11 +73,20 @@ class MotionChecker:
         """Return True if the straight edge from `a` to `b` is free at states `resolution` [rad] apart."""
         count = max(1, int(np.ceil(np.max(np.abs(b - a)) / resolution)))
         states = a + (b - a) * (np.arange(1, count + 1) / count)[:, None]
+        # Most edges a search tries run into something, over many states in a row: every
+        # eighth state first finds most collisions with an eighth of the checks.
+        coarse = np.zeros(count, dtype=bool)
+        coarse[_STRIDE - 1 :: _STRIDE] = True
+        return self._all_free(states[coarse]) and self._all_free(states[~coarse])
+
+    def _all_free(self, states: NDArray[np.float64]) -> bool:
+        """Return True if every state is free, stopping at the first collision."""
+        if len(states) == 0:
+            return True
         q = self.robot.configurations(states, self.base)
         if self.spheres is None:
             return bool(self.checker.free_batch(q, stop_at_first=True).all())
-        clear = np.asarray(self.spheres.clear(np.ascontiguousarray(q.T)), dtype=bool)
-        unclear = np.flatnonzero(~clear)
+        unclear = np.flatnonzero(~np.asarray(self.spheres.clear(np.ascontiguousarray(q.T)), dtype=bool))
         self.coal_states += len(unclear)
         return len(unclear) == 0 or bool(self.checker.free_batch(q[:, unclear], stop_at_first=True).all())
 
