@@ -1,148 +1,206 @@
-"""Time parameterisation of a joint-space path with TOPPRA, within velocity and acceleration limits.
+"""Time parameterisation of a joint-space path within the velocity and acceleration limits, as interpolated.
 
-TOPPRA times a spline through the path; its joint accelerations jump at grid
-points, and the controller's quintic between sampled points can overshoot
-them. So the sampled trajectory is checked densely, as the controller
-interpolates it, and re-timed against tighter limits until it holds.
+The path's corners are rounded (core.blends), the fastest speeds along it come
+from TOPP-RA (core.topp), and the result is smoothed so that the controller's
+quintics can follow it: the optimum switches between full acceleration and full
+braking in an instant, which no quintic between sampled points reproduces.
+Averaging the path position over a sliding window turns every switch into a
+linear ramp as long as the window (10 ms, or 0.25 % of shorter motions), and adds
+that much to the duration. Knots go where the smoothed motion changes form,
+so between knots it is almost exactly the quintic the controller draws. The
+exact peaks of those quintics are then checked, and where they exceed a limit
+(typically by about 0.5 %, at corners, where the ramps meet the curvature, and
+where the discretised optimum strays between grid points), the whole trajectory
+is slowed by the one factor that brings it within: stretching time by k divides
+velocities by k and accelerations by k^2, quintics included.
 """
 
 from __future__ import annotations
 
 import logging
+import math
+from dataclasses import dataclass
 
 import numpy as np
-import toppra
-import toppra.algorithm
-import toppra.constraint
-import toppra.parametrizer
+import numpy.typing as npt
 from numpy.typing import NDArray
 
+from moveplan.core.blends import BlendedPath, blended_path
 from moveplan.core.errors import PlanningFailed
+from moveplan.core.topp import SpeedProfile, fastest_speeds
 from moveplan.core.trajectory import peak_rates
-from moveplan.core.types import JointTrajectory
+from moveplan.core.types import JointTrajectory, frozen_array
 
-__all__ = ["resample_path", "time_parameterize"]
+__all__ = ["time_parameterize"]
 
 logger = logging.getLogger(__name__)
-# TOPPRA logs its numerical trouble itself; we report failures as PlanningFailed instead.
-logging.getLogger("toppra").setLevel(logging.CRITICAL)
 
-_ATTEMPTS = 6
-_GRID_INTERVALS = 100
-
-
-def resample_path(waypoints: NDArray[np.float64], max_step: float) -> NDArray[np.float64]:
-    """Return the polyline through `waypoints` with no joint moving more than `max_step` per step."""
-    points = [waypoints[:1]]
-    for a, b in zip(waypoints[:-1], waypoints[1:], strict=True):
-        count = max(1, int(np.ceil(np.max(np.abs(b - a)) / max_step)))
-        points.append(a + (b - a) * (np.arange(1, count + 1) / count)[:, None])
-    return np.concatenate(points)
+# A cubic spline through a corner's segments resampled one step h apart strays from the corner
+# by 0.085 h |d_out - d_in| cos(angle / 2) (less with unequal steps); a blend taking 0.44 h from
+# each segment strays by 3/16 0.44 = 0.0825 times the same (benchmarks/timing_speed.py measures).
+_CORNER_FRACTION = 0.44
+_GRID_PER_BLEND = 8  # intervals per blend; a straight piece is one exact interval
+_RAMP_S = 0.01  # [s] every switch of the path acceleration becomes a linear ramp this long,
+_RAMP_FRACTION = 0.0025  # or this fraction of the optimal duration if shorter,
+_MIN_RAMP_S = 1e-3  # but not shorter than this [s]
+_MIN_KNOT_GAP_S = 1e-4  # [s] closer knots make the quintic's coefficients lose precision
+_REST_S = 1e9  # [s] the time law's rest before its start and after its end
+# Relative slow-down covering the rounding of knot times to whole nanoseconds: moving a knot by
+# 0.5 ns changes its acceleration by the jerk times that, < 1e-6 of a limit with ramps >= 1 ms.
+_SAFETY = 1e-5
 
 
 def time_parameterize(
     joint_names: tuple[str, ...],
-    waypoints: NDArray[np.float64],
+    waypoints: npt.ArrayLike,
     max_velocity: NDArray[np.float64],
     max_acceleration: NDArray[np.float64],
-    sample_period_s: float = 0.01,
     max_step: float = 0.05,
 ) -> JointTrajectory:
-    """Return the time-optimal trajectory along `waypoints` within the (already scaled) limits.
+    """Return a near time-optimal trajectory along `waypoints` within the (already scaled) limits.
 
-    The result starts and ends at rest (velocity and acceleration exactly 0), its
-    times are whole nanoseconds, and its quintic interpolation stays within the limits.
+    The result starts and ends at rest (velocity and acceleration exactly 0), its times
+    are whole nanoseconds, and its quintic interpolation stays within the limits. It
+    follows the straight segments between waypoints, except where it rounds a corner.
+
+    Args:
+        joint_names: Joint order of the columns.
+        waypoints: Joint positions, shape (m, n).
+        max_velocity: In [rad]/[s], shape (n,).
+        max_acceleration: In [rad]/[s]^2, shape (n,).
+        max_step: Corners are rounded within 0.44 of a step from their waypoint, the
+            segments divided into equal steps of at most max_step [rad] in every joint:
+            closer to the polyline than a cubic spline through those steps.
     """
-    path = resample_path(waypoints, max_step)
-    keep = np.concatenate(([True], np.any(np.abs(np.diff(path, axis=0)) > 1e-12, axis=1)))
-    path = path[keep]
-    if len(path) == 1:
-        zeros = np.zeros_like(path)
-        return JointTrajectory(joint_names, [0.0], path, zeros, zeros)
-    # TOPPRA's optimum touches the limits between its grid points and its time law is
-    # smoothed into a spline, so the result peaks up to ~1 % above the velocity limits and
-    # ~20 % above the acceleration limits; the overshoot scales with the limit given.
-    velocity_margin, acceleration_margin = 0.99, 0.86
-    for _ in range(_ATTEMPTS):
-        trajectory = _toppra(joint_names, path, max_velocity * velocity_margin,
-                             max_acceleration * acceleration_margin, sample_period_s)
-        peak_v, peak_a = peak_rates(trajectory)
-        excess_v = float(np.max(peak_v / max_velocity))
-        excess_a = float(np.max(peak_a / max_acceleration))
-        if excess_v <= 1.0 and excess_a <= 1.0:
-            return trajectory
-        logger.debug("timing peaks at %.3f of velocity, %.3f of acceleration limits; retrying",
-                     excess_v, excess_a)
-        velocity_margin *= min(1.0, 0.995 / excess_v)
-        acceleration_margin *= min(1.0, 0.995 / excess_a)
-    raise PlanningFailed("time parameterisation could not keep the interpolated trajectory within the limits")
+    points = np.asarray(waypoints, dtype=np.float64)
+    if not np.any(np.abs(points - points[0]) > 1e-12):
+        zeros = np.zeros_like(points[:1])
+        return JointTrajectory(joint_names, np.zeros(1), points[:1], zeros, zeros)
+    path = blended_path(points, max_step, _CORNER_FRACTION)
+    grid, straight = _grid(path)
+    points_and_middles = np.empty(2 * len(grid) - 1)
+    points_and_middles[::2], points_and_middles[1::2] = grid, (grid[:-1] + grid[1:]) / 2
+    first, second = path.derivatives(points_and_middles)
+    profile = fastest_speeds(grid, first, second, straight, max_velocity, max_acceleration)
+    law = _TimeLaw.of(profile)
+    times = law.knots()
+    smooth = _sampled(joint_names, path, law, points[[0, -1]], times)
+    peak_v, peak_a = peak_rates(smooth)
+    excess = max(1.0, float(np.max(peak_v / max_velocity)), math.sqrt(float(np.max(peak_a / max_acceleration))))
+    if excess > 1.0:
+        logger.debug("interpolated trajectory peaks at %.4f of a limit; slowing it by %.4f", excess**2, excess)
+    stretch = excess * (1.0 + _SAFETY)
+    # Whole nanoseconds, as a message carries them. Each knot moves by less than a nanosecond
+    # and its state moves along the motion with it, so the knots stay consistent with each other.
+    stretched = np.round(times * stretch * 1e9) / 1e9
+    shift = (stretched / stretch - times)[:, None]
+    v, a = smooth.velocities, smooth.accelerations
+    return JointTrajectory(joint_names, stretched, smooth.positions + shift * (v + shift * a / 2),
+                           (v + shift * a) / stretch, a / stretch**2)
 
 
-def _gridpoints(count: int) -> NDArray[np.float64]:
-    """Return path parameters in [0, 1]: uniform, refined geometrically towards both ends."""
-    # Finer than 1e-5 of the path, TOPPRA's solver loses its footing (infeasible sets).
-    ends = np.geomspace(1e-5, 2.0 / count, 30)
-    return np.unique(np.concatenate((np.linspace(0.0, 1.0, count + 1), ends, 1.0 - ends)))
+def _grid(path: BlendedPath) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """Return grid points along the path and, per interval, whether it is straight."""
+    # Turning by more than ~145 degrees (|turn| > 1.9), a blend's dq/ds comes close to 0 in
+    # its middle (at a reversal, 0: a singular point of the time law); a finer grid follows it.
+    counts = np.where(path.blend, np.where(path.turns > 1.9, 2 * _GRID_PER_BLEND, _GRID_PER_BLEND), 1)
+    piece = np.repeat(np.arange(len(counts)), counts)
+    within = np.arange(len(piece)) - np.repeat(np.cumsum(counts) - counts, counts)
+    starts = path.breaks[piece] + np.diff(path.breaks)[piece] * within / counts[piece]
+    return np.append(starts, path.length), ~path.blend[piece]
 
 
-def _soft_ends(grid: NDArray[np.float64], sd: NDArray[np.float64], ramp_s: float) -> NDArray[np.float64]:
-    """Return path speeds capped so the path acceleration fades to 0 at both ends.
+@dataclass(frozen=True)
+class _TimeLaw:
+    """The optimal time law s(t): path acceleration u constant between grid points, at rest before and after.
 
-    TOPPRA brakes at full deceleration D right up to the goal, so the acceleration
-    jumps to 0 at the last point and the controller's quintic overshoots the limit.
-    Capping the speed squared by 4/3 D x^1.5 / sqrt(delta) within distance delta of an
-    end (x the distance, beyond it 2 D x - 2/3 D delta) makes the deceleration fall
-    as sqrt(x) to 0, never exceed D, and still stop in the finite time `ramp_s`.
+    The arrays hold the grid points' intervals and, first and last, a rest of 1e9 s
+    before the start and after the end, so that any time finds its interval.
+
+    Attributes:
+        times: Start of each interval in [s], the grid points' times from index 1, shape (N + 3,).
+        s: Path parameter at the start of each interval, shape (N + 3,).
+        speeds: ds/dt at the start of each interval, shape (N + 3,).
+        accelerations: d2s/dt2 on each interval, shape (N + 3,).
+        ramp: The averaging window of the smoothed motion in [s].
     """
-    speed2 = sd**2
-    for x, side in ((1.0 - grid, slice(-6, None)), (grid, slice(0, 6))):
-        window = grid[side]
-        decel = np.abs(np.diff(speed2[side])) / (2 * np.diff(window))
-        rate = float(np.max(decel))
-        if rate <= 0.0:
-            continue
-        delta = rate * ramp_s**2 / 12.0
-        cap = np.where(x < delta, 4.0 / 3.0 * rate * x**1.5 / np.sqrt(delta), 2 * rate * x - 2.0 / 3.0 * rate * delta)
-        speed2 = np.minimum(speed2, cap)
-    return np.sqrt(np.maximum(speed2, 0.0))
 
+    times: NDArray[np.float64]
+    s: NDArray[np.float64]
+    speeds: NDArray[np.float64]
+    accelerations: NDArray[np.float64]
+    ramp: float
 
-def _toppra(
-    joint_names: tuple[str, ...],
-    path: NDArray[np.float64],
-    max_velocity: NDArray[np.float64],
-    max_acceleration: NDArray[np.float64],
-    sample_period_s: float,
-) -> JointTrajectory:
-    arc = np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))))
-    spline = toppra.SplineInterpolator(arc / arc[-1], path)
-    constraints = [
-        toppra.constraint.JointVelocityConstraint(np.stack([-max_velocity, max_velocity], axis=1)),
-        toppra.constraint.JointAccelerationConstraint(np.stack([-max_acceleration, max_acceleration], axis=1)),
-    ]
-    grid = _gridpoints(max(_GRID_INTERVALS, 4 * len(path)))
-    algorithm = toppra.algorithm.TOPPRA(constraints, spline, gridpoints=grid)
-    _, sd, _ = algorithm.compute_parameterization(0.0, 0.0)
-    if sd is None or not np.all(np.isfinite(sd)):
-        raise PlanningFailed("TOPPRA found no feasible time parameterisation of the path")
-    sd = _soft_ends(grid, sd, 10 * sample_period_s)
-    timed = toppra.parametrizer.ParametrizeSpline(spline, grid, sd)
-    duration = float(timed.duration)
-    times = np.linspace(0.0, duration, max(2, int(np.ceil(duration / sample_period_s)) + 1))
-    return _sampled(joint_names, timed, times, path)
+    def __post_init__(self) -> None:
+        times = frozen_array(self.times, (None,), "times")
+        object.__setattr__(self, "times", times)
+        for name in ("s", "speeds", "accelerations"):
+            object.__setattr__(self, name, frozen_array(getattr(self, name), times.shape, name))
+
+    @classmethod
+    def of(cls, profile: SpeedProfile) -> _TimeLaw:
+        """Return the time law that follows the squared speeds of `profile`."""
+        speeds = np.sqrt(profile.squared_speeds)
+        steps = profile.s[1:] - profile.s[:-1]
+        with np.errstate(divide="ignore"):
+            durations = 2 * steps / (speeds[:-1] + speeds[1:])  # constant acceleration: mean speed
+        if not np.all(np.isfinite(durations)):
+            raise PlanningFailed("time parameterisation found the path blocked: the speed along it drops to 0")
+        accelerations = (profile.squared_speeds[1:] - profile.squared_speeds[:-1]) / (2 * steps)
+        times = np.concatenate(([-_REST_S, 0.0], np.cumsum(durations), [_REST_S]))
+        times[-1] += times[-2]
+        ramp = min(_RAMP_S, max(_MIN_RAMP_S, _RAMP_FRACTION * float(times[-2])))
+        rest = np.zeros(1)
+        return cls(times, np.concatenate((rest, profile.s, profile.s[-1:])), np.concatenate((rest, speeds, rest)),
+                   np.concatenate((rest, accelerations, rest, rest)), ramp)
+
+    def knots(self) -> NDArray[np.float64]:
+        """Return the times in [s] where the smoothed motion changes form (it starts at 0, ends a ramp late)."""
+        grid = self.times[1:-1]
+        times = np.unique(np.concatenate((grid, grid + self.ramp)))
+        keep = np.concatenate(([True], times[1:] - times[:-1] > _MIN_KNOT_GAP_S))
+        times = times[keep]
+        times[-1] = grid[-1] + self.ramp
+        return times
+
+    def smoothed(
+        self, times: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """Return s, ds/dt and d2s/dt2 of the motion averaged over the last ramp, at sorted `times` from 0.
+
+        The average of the position over [t - ramp, t] has as its velocity the mean
+        velocity and as its acceleration the mean acceleration over that window.
+        """
+        count = len(times)
+        at = np.concatenate((times, (times[:-1] + times[1:]) / 2))
+        at = np.concatenate((at, at - self.ramp))
+        interval = np.searchsorted(self.times, at, side="right") - 1
+        tau = at - self.times[interval]
+        u = self.accelerations[interval]
+        speed = self.speeds[interval] + u * tau
+        s = self.s[interval] + tau * (speed - 0.5 * u * tau)
+        mean_speed = (s[: 2 * count - 1] - s[2 * count - 1 :]) / self.ramp
+        acceleration = (speed[:count] - speed[2 * count - 1 : 3 * count - 1]) / self.ramp
+        # Integrate the mean speed knot to knot (Simpson's rule, exact: it is quadratic in
+        # between), rather than differencing a running integral, which would lose the digits
+        # that tell two close knots apart.
+        edge, middle = mean_speed[:count], mean_speed[count:]
+        steps = (times[1:] - times[:-1]) / 6 * (edge[:-1] + 4 * middle + edge[1:])
+        return np.minimum(np.concatenate(([0.0], np.cumsum(steps))), self.s[-1]), edge, acceleration
 
 
 def _sampled(
     joint_names: tuple[str, ...],
-    timed: toppra.parametrizer.ParametrizeSpline,
+    path: BlendedPath,
+    law: _TimeLaw,
+    ends: NDArray[np.float64],
     times: NDArray[np.float64],
-    path: NDArray[np.float64],
 ) -> JointTrajectory:
-    """Return `timed` sampled at `times`, rounded to whole nanoseconds, starting and ending at rest."""
-    # Whole nanoseconds, so the times written to a message are exactly the times checked here.
-    times = np.unique(np.round(times * 1e9)) / 1e9
-    positions, velocities, accelerations = timed(times), timed(times, 1), timed(times, 2)
-    positions[0], positions[-1] = path[0], path[-1]
-    for rates in (velocities, accelerations):
-        rates[0], rates[-1] = 0.0, 0.0
+    """Return the smoothed motion at `times` [s], at rest exactly at `ends`."""
+    s, speed, acceleration = law.smoothed(times)
+    positions, first, second = path(s)
+    velocities = first * speed[:, None]
+    accelerations = second * (speed**2)[:, None] + first * acceleration[:, None]
+    positions[0], positions[-1] = ends
+    velocities[0] = velocities[-1] = accelerations[0] = accelerations[-1] = 0.0
     return JointTrajectory(joint_names, times, positions, velocities, accelerations)

@@ -110,3 +110,11 @@ def test_peak_rates_of_linear_quintic_segment():
     peak_v, peak_a = peak_rates(trajectory)
     np.testing.assert_allclose(peak_v, [1.0], atol=EPS)
     np.testing.assert_allclose(peak_a, [0.0], atol=EPS)
+
+
+def test_peak_rates_of_rest_to_rest_quintic_are_inside_the_segment():
+    # 10t^3 - 15t^4 + 6t^5: velocity peaks at t = 1/2 (15/8), acceleration at (3 -+ sqrt 3) / 6 (10/sqrt 3).
+    trajectory = one_joint([0.0, 1.0, 2.0], [0.0, 1.0, 1.0])
+    peak_v, peak_a = peak_rates(trajectory)
+    np.testing.assert_allclose(peak_v, [15 / 8], rtol=1e-12)
+    np.testing.assert_allclose(peak_a, [10 / np.sqrt(3)], rtol=1e-12)
