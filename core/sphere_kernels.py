@@ -1,0 +1,134 @@
+"""The sphere filter's compiled kernels (numba), at module level so numba caches them on disk.
+
+Imported only by core/sphere_check.py when a filter is first built: importing numba and
+loading these costs ~1 s, which commands that do not plan never pay.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numba
+import numpy as np
+
+__all__ = ["clear"]
+
+
+@numba.njit(cache=True)
+def gap(kind: int, centre: Any, rot: Any, size: Any, p: Any, radius: float) -> float:
+    """Return the distance from a ball to an obstacle (box, sphere, cylinder), <= 0 when they touch."""
+    d0, d1, d2 = p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]
+    x = rot[0, 0] * d0 + rot[1, 0] * d1 + rot[2, 0] * d2
+    y = rot[0, 1] * d0 + rot[1, 1] * d1 + rot[2, 1] * d2
+    z = rot[0, 2] * d0 + rot[1, 2] * d1 + rot[2, 2] * d2
+    if kind == 0:
+        ex = max(abs(x) - size[0], 0.0)
+        ey = max(abs(y) - size[1], 0.0)
+        ez = max(abs(z) - size[2], 0.0)
+        return np.sqrt(ex * ex + ey * ey + ez * ez) - radius
+    if kind == 1:
+        return np.sqrt(x * x + y * y + z * z) - size[0] - radius
+    er = max(np.sqrt(x * x + y * y) - size[0], 0.0)
+    ez = max(abs(z) - size[1], 0.0)
+    return np.sqrt(er * er + ez * ez) - radius
+
+@numba.njit(cache=True)
+def clear(qs: Any, parents: Any, kinds: Any, axes: Any, iq: Any, prot: Any, ptrans: Any, centres: Any,
+          radii: Any, sjoint: Any, start: Any, ojoint: Any, ocentre: Any, oradius: Any, pairs: Any,
+          okind: Any, opos: Any, orot: Any, osize: Any, check: Any, out: Any) -> None:
+    """Write into `out` per configuration (rows of `qs`) whether its spheres touch nothing."""
+    nj = len(parents)
+    ns = len(radii)
+    no = len(oradius)
+    rot = np.empty((nj, 3, 3))
+    pos = np.empty((nj, 3))
+    world = np.empty((ns, 3))
+    owc = np.empty((no, 3))
+    local = np.empty((3, 3))
+    for k in range(len(qs)):
+        q = qs[k]
+        rot[0] = np.eye(3)
+        pos[0] = 0.0
+        for j in range(1, nj):
+            # local = placement rotation * joint motion
+            kind = kinds[j]
+            a = axes[j]
+            if kind == 2:
+                for r in range(3):
+                    for c in range(3):
+                        local[r, c] = prot[j, r, c]
+                shift = q[iq[j]]
+                t0 = ptrans[j, 0] + (prot[j, 0, 0] * a[0] + prot[j, 0, 1] * a[1] + prot[j, 0, 2] * a[2]) * shift
+                t1 = ptrans[j, 1] + (prot[j, 1, 0] * a[0] + prot[j, 1, 1] * a[1] + prot[j, 1, 2] * a[2]) * shift
+                t2 = ptrans[j, 2] + (prot[j, 2, 0] * a[0] + prot[j, 2, 1] * a[1] + prot[j, 2, 2] * a[2]) * shift
+            else:
+                if kind == 3:
+                    cs, sn = q[iq[j]], q[iq[j] + 1]
+                else:
+                    cs, sn = np.cos(q[iq[j]]), np.sin(q[iq[j]])
+                # Rodrigues: R = c I + s [a]x + (1 - c) a a^T
+                v = 1.0 - cs
+                m00 = cs + a[0] * a[0] * v
+                m01 = a[0] * a[1] * v - a[2] * sn
+                m02 = a[0] * a[2] * v + a[1] * sn
+                m10 = a[1] * a[0] * v + a[2] * sn
+                m11 = cs + a[1] * a[1] * v
+                m12 = a[1] * a[2] * v - a[0] * sn
+                m20 = a[2] * a[0] * v - a[1] * sn
+                m21 = a[2] * a[1] * v + a[0] * sn
+                m22 = cs + a[2] * a[2] * v
+                for r in range(3):
+                    p0, p1, p2 = prot[j, r, 0], prot[j, r, 1], prot[j, r, 2]
+                    local[r, 0] = p0 * m00 + p1 * m10 + p2 * m20
+                    local[r, 1] = p0 * m01 + p1 * m11 + p2 * m21
+                    local[r, 2] = p0 * m02 + p1 * m12 + p2 * m22
+                t0, t1, t2 = ptrans[j, 0], ptrans[j, 1], ptrans[j, 2]
+            p = parents[j]
+            for r in range(3):
+                for c in range(3):
+                    rot[j, r, c] = (rot[p, r, 0] * local[0, c] + rot[p, r, 1] * local[1, c]
+                                    + rot[p, r, 2] * local[2, c])
+                pos[j, r] = pos[p, r] + rot[p, r, 0] * t0 + rot[p, r, 1] * t1 + rot[p, r, 2] * t2
+        for s in range(ns):
+            j = sjoint[s]
+            for r in range(3):
+                world[s, r] = pos[j, r] + rot[j, r, 0] * centres[s, 0] + rot[j, r, 1] * centres[s, 1] \
+                    + rot[j, r, 2] * centres[s, 2]
+        for o in range(no):
+            j = ojoint[o]
+            for r in range(3):
+                owc[o, r] = pos[j, r] + rot[j, r, 0] * ocentre[o, 0] + rot[j, r, 1] * ocentre[o, 1] \
+                    + rot[j, r, 2] * ocentre[o, 2]
+        free = True
+        for o in range(no):
+            if not free:
+                break
+            for b in range(len(okind)):
+                if not check[o, b]:
+                    continue
+                if gap(okind[b], opos[b], orot[b], osize[b], owc[o], oradius[o]) > 0.0:
+                    continue
+                for s in range(start[o], start[o + 1]):
+                    if gap(okind[b], opos[b], orot[b], osize[b], world[s], radii[s]) <= 0.0:
+                        free = False
+                        break
+                if not free:
+                    break
+        for i in range(len(pairs)):
+            if not free:
+                break
+            a, b = pairs[i, 0], pairs[i, 1]
+            dx, dy, dz = owc[a, 0] - owc[b, 0], owc[a, 1] - owc[b, 1], owc[a, 2] - owc[b, 2]
+            reach = oradius[a] + oradius[b]
+            if dx * dx + dy * dy + dz * dz > reach * reach:
+                continue
+            for s in range(start[a], start[a + 1]):
+                for t in range(start[b], start[b + 1]):
+                    dx, dy, dz = world[s, 0] - world[t, 0], world[s, 1] - world[t, 1], world[s, 2] - world[t, 2]
+                    reach = radii[s] + radii[t]
+                    if dx * dx + dy * dy + dz * dz <= reach * reach:
+                        free = False
+                        break
+                if not free:
+                    break
+        out[k] = free
