@@ -50,7 +50,7 @@ __all__ = ["PlanRequest", "plan", "resolve_request"]
 
 logger = logging.getLogger(__name__)
 
-# The search checks edges every 0.02 rad; what is written is certified as the controller
+# The search checks edges every 0.05 rad; what is written is certified as the controller
 # interpolates it, with no robot point moving more than 5 mm between checked states. A
 # trajectory that fails certification is planned again with fine edge checks and a
 # closer-following time parameterisation.
@@ -155,7 +155,8 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
     checker = CollisionChecker(robot, scene.objects, scene.source, geometry=config.planning["collision"],
                                allowed=scene.allowed)
     base, current = _start_values(request, robot, scene)
-    checks = MotionChecker(robot, checker, base, _sphere_filter(robot, checker, scene))
+    checks = MotionChecker(robot, checker, base, _sphere_filter(robot, checker, scene, base),
+                           _hull_checker(robot, checker, scene))
     pair = checks.colliding_pair(current)
     if pair:
         raise StartInCollision(pair)
@@ -193,12 +194,25 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
     )
 
 
-def _sphere_filter(robot: Robot, checker: CollisionChecker, scene: Scene) -> SphereFilter | None:
-    """Return the fast conservative pre-check for `robot` in `scene`, or None where it does not apply."""
+def _sphere_filter(
+    robot: Robot, checker: CollisionChecker, scene: Scene, base: NDArray[np.float64]
+) -> SphereFilter | None:
+    """Return the fast conservative pre-check for `robot` (other joints at `base`) in `scene`, or None."""
     try:
-        return SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed)
+        return SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed, base)
     except UnsupportedJoint as exc:
         logger.info("no sphere filter (%s): every state is checked by coal", exc)
+        return None
+
+
+def _hull_checker(robot: Robot, checker: CollisionChecker, scene: Scene) -> CollisionChecker | None:
+    """Return a checker of the robot's meshes as convex hulls in `scene` when `checker` has meshes, else None."""
+    if checker.mode != "exact":
+        return None
+    try:
+        return CollisionChecker(robot, scene.objects, scene.source, geometry="convex", allowed=scene.allowed)
+    except ConfigError as exc:
+        logger.info("no hull stage (%s): states the spheres cannot clear go to the meshes", exc)
         return None
 
 
@@ -287,8 +301,12 @@ def _plan_step(
     v_scale, a_scale = _scaling(robot, request, spec)
     max_velocity, max_acceleration = robot.max_velocity * v_scale, robot.max_acceleration * a_scale
     stats = {"plan_s": 0.0, "simplify_s": 0.0, "timing_s": 0.0, "certify_s": 0.0}
+    # The search checks the hulls, not the meshes, unless the start or goal is free only under the meshes.
+    ends = start[None, :] if spec.linear else np.array([start, goal])
+    conservative = checks.conservative_available and bool(checks.free(ends, conservative=True).all())
     for resolution, max_step in _ATTEMPTS:
-        path = search(Validity(checks.state_free, partial(checks.edge_free, resolution=resolution)))
+        path = search(Validity(partial(checks.state_free, conservative=conservative),
+                               partial(checks.edge_free, resolution=resolution, conservative=conservative)))
         mark = time.perf_counter()
         trajectory = time_parameterize(robot.joint_names, path.waypoints, max_velocity, max_acceleration,
                                        max_step=max_step)

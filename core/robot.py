@@ -40,7 +40,7 @@ class Robot:
         self.max_acceleration = _readonly([lim.max_acceleration for lim in limits])
         self.continuous = np.array([lim.continuous for lim in limits])
         ids = [self.model.getJointId(j) for j in self.joint_names]
-        self._q_index = np.array([self.model.idx_qs[i] for i in ids])
+        self.q_index = np.array([self.model.idx_qs[i] for i in ids])
         self.link_names = tuple(f.name for f in self.model.frames if f.type == pin.FrameType.BODY)
 
     @property
@@ -59,17 +59,17 @@ class Robot:
         base = self.neutral() if base is None else base
         q = np.repeat(base[:, None], len(values), axis=1)
         plain = ~self.continuous
-        q[self._q_index[plain], :] = values[:, plain].T
+        q[self.q_index[plain], :] = values[:, plain].T
         # A continuous joint is stored by pinocchio as (cos, sin).
-        q[self._q_index[self.continuous], :] = np.cos(values[:, self.continuous]).T
-        q[self._q_index[self.continuous] + 1, :] = np.sin(values[:, self.continuous]).T
+        q[self.q_index[self.continuous], :] = np.cos(values[:, self.continuous]).T
+        q[self.q_index[self.continuous] + 1, :] = np.sin(values[:, self.continuous]).T
         return q
 
     def values(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
         """Return the group's joint values in configuration `q`."""
-        out = q[self._q_index].astype(float)
+        out = q[self.q_index].astype(float)
         cont = self.continuous
-        out[cont] = np.arctan2(q[self._q_index[cont] + 1], q[self._q_index[cont]])
+        out[cont] = np.arctan2(q[self.q_index[cont] + 1], q[self.q_index[cont]])
         return out
 
     def neutral(self) -> NDArray[np.float64]:

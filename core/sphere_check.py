@@ -58,8 +58,12 @@ class SphereFilter:
         geometry: pin.GeometryModel,
         objects: tuple[CollisionObject, ...],
         allowed: frozenset[frozenset[str]] = frozenset(),
+        base: NDArray[np.float64] | None = None,
     ) -> None:
         """Fit spheres to `robot` (its `geometry`), add attached objects, and list what to check.
+
+        States are the group's joint values; the other joints stay at `base` (default: the neutral
+        configuration).
 
         Raises:
             UnsupportedJoint: The robot has a joint kind the kernel does not handle.
@@ -128,22 +132,29 @@ class SphereFilter:
         self._pairs = pairs_array[~hard]
         self.exact_pairs = tuple((names[a], names[b]) for a, b in pairs_array[hard])
         self._exact = _pair_pool(robot, geometry, self.exact_pairs)
-        self._obstacles = _obstacles(world)
         self._check = np.array([[frozenset((name, obj.name)) not in allowed for obj in world] for name in names],
                                dtype=np.bool_).reshape(len(names), len(world))
         self._kernel = _kernels()
-        self.clear(np.array(pin.neutral(model))[None, :])  # compile (or load) the kernel now, not mid-search
+        base = robot.neutral() if base is None else base
+        kind, centre, rot, size = _obstacles(world)
+        # Built once: the kernel runs thousands of times per search, and its call costs more than its work.
+        self._args = (np.asarray(base, dtype=float), np.asarray(robot.q_index, dtype=np.int64),
+                      np.asarray(robot.continuous, dtype=np.bool_), self._parents, self._kind, self._axis, self._iq,
+                      self._rot, self._trans, self._centres, self._radii, self._sjoint, self._start, self._ojoint,
+                      self._ocentre, self._oradius, self._pairs, kind, centre, rot, size, self._check)
+        self._nq = model.nq
+        self.clear(robot.values(base)[None, :])  # compile (or load) the kernel now, not mid-search
 
-    def clear(self, q: NDArray[np.float64]) -> NDArray[np.bool_]:
-        """Return per configuration (rows of `q`, shape (k, nq)) True if it is certainly collision-free."""
-        q = np.ascontiguousarray(q, dtype=np.float64)
-        out = np.empty(len(q), dtype=np.bool_)
-        self._kernel(q, *self._arrays(), out)
+    def clear(self, values: NDArray[np.float64]) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
+        """Return per group state (rows of `values`) True if certainly collision-free, and the configurations."""
+        q = np.empty((len(values), self._nq))
+        out = np.empty(len(values), dtype=np.bool_)
+        self._kernel(values, *self._args, q, out)
         if self._exact is not None and out.any():
             cleared = np.flatnonzero(out)
-            hits = pin.computeCollisionsInParallel(1, self._exact, np.asfortranarray(q[cleared].T), True, False)
+            hits = pin.computeCollisionsInParallel(1, self._exact, q[cleared].T, True, False)
             out[cleared] = ~np.asarray(hits, dtype=bool)
-        return out
+        return out, q
 
     def _always_close(self, robot: Robot, pairs: NDArray[np.int64], samples: int = 200) -> NDArray[np.bool_]:
         """Return per owner pair True if its spheres touch in over a third of random configurations."""
@@ -164,12 +175,6 @@ class SphereFilter:
                 gaps = np.linalg.norm(world[sa, None] - world[None, sb], axis=2)
                 touching[k] += bool(np.any(gaps <= self._radii[sa, None] + self._radii[None, sb]))
         return touching > samples / 3
-
-    def _arrays(self) -> tuple[Any, ...]:
-        kind, centre, rot, size = self._obstacles
-        return (self._parents, self._kind, self._axis, self._iq, self._rot, self._trans, self._centres, self._radii,
-                self._sjoint, self._start, self._ojoint, self._ocentre, self._oradius, self._pairs, kind, centre, rot,
-                size, self._check)
 
 
 def _pair_pool(robot: Robot, geometry: pin.GeometryModel, pairs: tuple[tuple[str, str], ...]) -> Any:

@@ -33,10 +33,19 @@ def gap(kind: int, centre: Any, rot: Any, size: Any, p: Any, radius: float) -> f
     return np.sqrt(er * er + ez * ez) - radius
 
 @numba.njit(cache=True)
-def clear(qs: Any, parents: Any, kinds: Any, axes: Any, iq: Any, prot: Any, ptrans: Any, centres: Any,
-          radii: Any, sjoint: Any, start: Any, ojoint: Any, ocentre: Any, oradius: Any, pairs: Any,
-          okind: Any, opos: Any, orot: Any, osize: Any, check: Any, out: Any) -> None:
-    """Write into `out` per configuration (rows of `qs`) whether its spheres touch nothing."""
+def clear(values: Any, base: Any, group: Any, continuous: Any, parents: Any, kinds: Any, axes: Any, iq: Any,
+          prot: Any, ptrans: Any, centres: Any, radii: Any, sjoint: Any, start: Any, ojoint: Any, ocentre: Any,
+          oradius: Any, pairs: Any, okind: Any, opos: Any, orot: Any, osize: Any, check: Any, qs: Any,
+          out: Any) -> None:
+    """Write per group state (rows of `values`) its configuration into `qs`, into `out` if it touches nothing."""
+    for k in range(len(values)):
+        qs[k] = base
+        for i in range(len(group)):
+            if continuous[i]:
+                qs[k, group[i]] = np.cos(values[k, i])
+                qs[k, group[i] + 1] = np.sin(values[k, i])
+            else:
+                qs[k, group[i]] = values[k, i]
     nj = len(parents)
     ns = len(radii)
     no = len(oradius)
@@ -45,10 +54,13 @@ def clear(qs: Any, parents: Any, kinds: Any, axes: Any, iq: Any, prot: Any, ptra
     world = np.empty((ns, 3))
     owc = np.empty((no, 3))
     local = np.empty((3, 3))
+    near = np.empty(ns, dtype=np.int64)
+    rot[0] = 0.0
+    for r in range(3):
+        rot[0, r, r] = 1.0
+    pos[0] = 0.0
     for k in range(len(qs)):
         q = qs[k]
-        rot[0] = np.eye(3)
-        pos[0] = 0.0
         for j in range(1, nj):
             # local = placement rotation * joint motion
             kind = kinds[j]
@@ -122,13 +134,22 @@ def clear(qs: Any, parents: Any, kinds: Any, axes: Any, iq: Any, prot: Any, ptra
             reach = oradius[a] + oradius[b]
             if dx * dx + dy * dy + dz * dz > reach * reach:
                 continue
+            # Only b's spheres that reach a's bounding ball can touch one of a's spheres.
+            count = 0
+            for t in range(start[b], start[b + 1]):
+                dx, dy, dz = world[t, 0] - owc[a, 0], world[t, 1] - owc[a, 1], world[t, 2] - owc[a, 2]
+                reach = radii[t] + oradius[a]
+                if dx * dx + dy * dy + dz * dz <= reach * reach:
+                    near[count] = t
+                    count += 1
             for s in range(start[a], start[a + 1]):
-                for t in range(start[b], start[b + 1]):
+                if count == 0 or not free:
+                    break
+                for n in range(count):
+                    t = near[n]
                     dx, dy, dz = world[s, 0] - world[t, 0], world[s, 1] - world[t, 1], world[s, 2] - world[t, 2]
                     reach = radii[s] + radii[t]
                     if dx * dx + dy * dy + dz * dz <= reach * reach:
                         free = False
                         break
-                if not free:
-                    break
         out[k] = free

@@ -1,9 +1,12 @@
 """Collision checks of group motions: states, edges for the search, and certification of what is written.
 
-Two geometries answer. A conservative sphere model (core/fastcheck.py) clears most
-states in microseconds; whatever it cannot clear goes to coal with the robot's real
-collision geometry (core/collision.py). Since the spheres enclose the real geometry,
-a state they clear is free, so every answer is the real geometry's answer.
+Up to three geometries answer, cheapest first. A sphere model (core/sphere_check.py)
+clears most states in microseconds; what it cannot clear goes to coal with the robot's
+meshes as convex hulls (~14 us a state), and what those cannot clear to coal with the
+real collision geometry (~55 us). The spheres enclose the hulls' meshes and the hulls
+enclose the meshes, so a state an earlier stage clears is free, and every answer is the
+real geometry's answer. The search may stop at the hulls (`conservative`): it then
+loses only the little space between a mesh and its hull.
 
 Certification checks a trajectory as the controller interpolates it, at states so
 close that no point of the robot moves more than `step_m` between two of them
@@ -32,10 +35,10 @@ _STRIDE = 8
 
 
 class Filter(Protocol):
-    """A conservative pre-check: True where a configuration is certainly free."""
+    """A conservative pre-check: True where a group state is certainly free."""
 
-    def clear(self, q: NDArray[np.float64]) -> NDArray[np.bool_]:
-        """Return per configuration (rows of shape (k, nq)) True if it is certainly collision-free."""
+    def clear(self, values: NDArray[np.float64]) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
+        """Return per group state (rows of `values`) True if certainly free, and the configurations (k, nq)."""
         ...
 
 
@@ -43,52 +46,78 @@ class MotionChecker:
     """Answers whether group states, straight edges and timed trajectories are collision-free."""
 
     def __init__(
-        self, robot: Robot, checker: CollisionChecker, base: NDArray[np.float64], spheres: Filter | None = None
+        self,
+        robot: Robot,
+        checker: CollisionChecker,
+        base: NDArray[np.float64],
+        spheres: Filter | None = None,
+        hulls: CollisionChecker | None = None,
     ) -> None:
-        """Check `robot` with its other joints at `base`, by `checker`'s geometry, pre-filtered by `spheres`."""
+        """Check `robot` with its other joints at `base`, by `checker`'s geometry.
+
+        `spheres` and `hulls` (the robot's meshes as convex hulls) are conservative geometries
+        asked first, in that order: a state they clear is free under `checker`'s geometry.
+        """
         self.robot = robot
         self.checker = checker
         self.base = base
         self.spheres = spheres
         self.reach = certify.reach(robot, checker.geometry)
-        self.coal_states = 0  # states the spheres could not clear, for statistics
+        self._stages = (checker,) if hulls is None else (hulls, checker)
+        self.conservative_available = hulls is not None
 
-    def free(self, values: NDArray[np.float64]) -> NDArray[np.bool_]:
-        """Return per group state (rows of `values`) True if it is collision-free."""
-        q = self.robot.configurations(np.atleast_2d(values), self.base)
-        if self.spheres is None:
-            return self.checker.free_batch(q)
-        free = np.asarray(self.spheres.clear(np.ascontiguousarray(q.T)), dtype=bool)
-        unclear = np.flatnonzero(~free)
-        if len(unclear):
-            self.coal_states += len(unclear)
-            free[unclear] = self.checker.free_batch(q[:, unclear])
+    def free(self, values: NDArray[np.float64], conservative: bool = False) -> NDArray[np.bool_]:
+        """Return per group state (rows of `values`) True if it is collision-free.
+
+        With `conservative`, a state is free only if the spheres or the hulls clear it; one
+        that only the real geometry would free reads as colliding. The search uses this:
+        a hull check costs a quarter of a mesh check.
+        """
+        free, q = self._cleared(values)
+        for checker in self._stages[:1] if conservative else self._stages:
+            if free.all():
+                break
+            unclear = np.flatnonzero(~free)
+            free[unclear] = checker.free_batch(q[unclear].T)
         return free
 
-    def state_free(self, values: NDArray[np.float64]) -> bool:
-        """Return True if one group state is collision-free."""
-        return bool(self.free(values[None, :])[0])
+    def state_free(self, values: NDArray[np.float64], conservative: bool = False) -> bool:
+        """Return True if one group state is collision-free (see `free` for `conservative`)."""
+        return bool(self.free(values[None, :], conservative)[0])
 
-    def edge_free(self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float) -> bool:
+    def edge_free(
+        self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, conservative: bool = False
+    ) -> bool:
         """Return True if the straight edge from `a` to `b` is free at states `resolution` [rad] apart."""
         count = max(1, int(np.ceil(np.max(np.abs(b - a)) / resolution)))
         states = a + (b - a) * (np.arange(1, count + 1) / count)[:, None]
+        if count < 2 * _STRIDE:
+            return self._all_free(states, conservative)
         # Most edges a search tries run into something, over many states in a row: every
         # eighth state first finds most collisions with an eighth of the checks.
         coarse = np.zeros(count, dtype=bool)
         coarse[_STRIDE - 1 :: _STRIDE] = True
-        return self._all_free(states[coarse]) and self._all_free(states[~coarse])
+        return self._all_free(states[coarse], conservative) and self._all_free(states[~coarse], conservative)
 
-    def _all_free(self, states: NDArray[np.float64]) -> bool:
-        """Return True if every state is free, stopping at the first collision."""
-        if len(states) == 0:
-            return True
-        q = self.robot.configurations(states, self.base)
+    def _cleared(self, values: NDArray[np.float64]) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
+        """Return which states the spheres clear, and the states' configurations (k, nq)."""
         if self.spheres is None:
-            return bool(self.checker.free_batch(q, stop_at_first=True).all())
-        unclear = np.flatnonzero(~np.asarray(self.spheres.clear(np.ascontiguousarray(q.T)), dtype=bool))
-        self.coal_states += len(unclear)
-        return len(unclear) == 0 or bool(self.checker.free_batch(q[:, unclear], stop_at_first=True).all())
+            q = self.robot.configurations(np.atleast_2d(values), self.base).T
+            return np.zeros(len(q), dtype=bool), q
+        return self.spheres.clear(values)
+
+    def _all_free(self, states: NDArray[np.float64], conservative: bool) -> bool:
+        """Return True if every state is free, stopping at the first collision."""
+        free, q = self._cleared(states)
+        stages = self._stages[:1] if conservative else self._stages
+        for k, checker in enumerate(stages):
+            if free.all():
+                return True
+            unclear = np.flatnonzero(~free)
+            if k == len(stages) - 1:
+                return bool(checker.free_batch(q[unclear].T, stop_at_first=True).all())
+            free[unclear] = checker.free_batch(q[unclear].T)
+        return bool(free.all())
 
     def edge_free_certified(self, a: NDArray[np.float64], b: NDArray[np.float64]) -> bool:
         """Return True if the straight edge is free at the states certification checks on it."""

@@ -62,7 +62,8 @@ def test_no_state_the_filter_clears_collides_and_most_free_states_are_cleared(
     values = np.clip(values, robot.lower, robot.upper)
     q = robot.configurations(values, robot.neutral())
     free = checker.free_batch(q)
-    cleared = spheres.clear(np.ascontiguousarray(q.T))
+    cleared, configurations = spheres.clear(values)
+    np.testing.assert_allclose(configurations, q.T)
     assert not np.any(cleared & ~free)
     assert cleared[free].mean() > 0.6
 
