@@ -18,7 +18,7 @@ from moveplan.core.robot import Robot
 from moveplan.core.trajectory import peak_rates, sample
 from moveplan.core.types import JointTrajectory
 
-__all__ = ["reach", "segment_states", "trajectory_states"]
+__all__ = ["farthest_point", "is_prismatic", "reach", "segment_states", "trajectory_states"]
 
 
 def reach(robot: Robot, geometry: pin.GeometryModel) -> NDArray[np.float64]:
@@ -31,10 +31,10 @@ def reach(robot: Robot, geometry: pin.GeometryModel) -> NDArray[np.float64]:
     for obj in geometry.geometryObjects:
         if obj.parentJoint == 0:
             continue  # world objects do not move
-        extent[obj.parentJoint] = max(extent[obj.parentJoint], _farthest(obj))
+        extent[obj.parentJoint] = max(extent[obj.parentJoint], farthest_point(obj))
     travel = np.zeros(model.njoints)  # how far a prismatic joint can push its children out
     for jid in range(1, model.njoints):
-        if _prismatic(model.joints[jid].shortname()):
+        if is_prismatic(model.joints[jid].shortname()):
             index = model.idx_qs[jid]
             travel[jid] = max(abs(model.lowerPositionLimit[index]), abs(model.upperPositionLimit[index]))
     # Farthest point below each joint, from the leaves up: a child's origin is a fixed offset away.
@@ -47,16 +47,16 @@ def reach(robot: Robot, geometry: pin.GeometryModel) -> NDArray[np.float64]:
     out = []
     for name in robot.joint_names:
         jid = model.getJointId(name)
-        out.append(1.0 if _prismatic(model.joints[jid].shortname()) else below[jid])
+        out.append(1.0 if is_prismatic(model.joints[jid].shortname()) else below[jid])
     return np.array(out)
 
 
-def _prismatic(kind: str) -> bool:
+def is_prismatic(kind: str) -> bool:
     """Return True for pinocchio's prismatic joint models (JointModelPX/PY/PZ/PrismaticUnaligned)."""
     return kind in ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned")
 
 
-def _farthest(obj: pin.GeometryObject) -> float:
+def farthest_point(obj: pin.GeometryObject) -> float:
     """Return the largest distance from its joint's origin to a point of a collision shape."""
     geometry = obj.geometry
     geometry.computeLocalAABB()  # pinocchio has already scaled a mesh when it loaded it

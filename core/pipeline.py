@@ -155,8 +155,8 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
     checker = CollisionChecker(robot, scene.objects, scene.source, geometry=config.planning["collision"],
                                allowed=scene.allowed)
     base, current = _start_values(request, robot, scene)
-    checks = MotionChecker(robot, checker, base, _sphere_filter(robot, checker, scene, base),
-                           _hull_checker(robot, checker, scene))
+    hulls = _hull_checker(robot, checker, scene)
+    checks = MotionChecker(robot, checker, base, _sphere_filter(robot, checker, hulls, scene, base), hulls)
     pair = checks.colliding_pair(current)
     if pair:
         raise StartInCollision(pair)
@@ -195,11 +195,12 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
 
 
 def _sphere_filter(
-    robot: Robot, checker: CollisionChecker, scene: Scene, base: NDArray[np.float64]
+    robot: Robot, checker: CollisionChecker, hulls: CollisionChecker | None, scene: Scene, base: NDArray[np.float64]
 ) -> SphereFilter | None:
     """Return the fast conservative pre-check for `robot` (other joints at `base`) in `scene`, or None."""
     try:
-        return SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed, base)
+        return SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed, base,
+                            (hulls or checker).robot_geometry)
     except UnsupportedJoint as exc:
         logger.info("no sphere filter (%s): every state is checked by coal", exc)
         return None

@@ -3,21 +3,23 @@
 Compiled with numba (imported only when a filter is built, so commands that do not plan
 never pay its start-up). One call checks a batch of configurations: forward kinematics
 of the joint tree, then per owner (link or attached object) its bounding ball first and
-its spheres only if that ball touches something. A state is "clear" only if no sphere
-touches an obstacle or another owner's sphere; since the spheres enclose the real
-geometry (core/sphere_model.py), a clear state is collision-free. Anything else is
-"maybe": the caller asks the exact checker.
+its spheres only if that ball touches something. Link pairs whose distance depends on
+one or two joints are looked up in distance tables instead (core/pair_tables.py). A
+state is "clear" only if no sphere touches an obstacle or another owner's sphere and
+every tabulated pair is apart; since the spheres enclose the real geometry
+(core/sphere_model.py), a clear state is collision-free. Anything else is "maybe": the
+caller asks coal.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-import coal
 import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from moveplan.core.pair_tables import PairTable, pair_tables
 from moveplan.core.robot import Robot
 from moveplan.core.sphere_model import fit_shape, robot_spheres
 from moveplan.core.types import CollisionObject
@@ -29,7 +31,6 @@ _REVOLUTE, _PRISMATIC, _UNBOUNDED = 1, 2, 3
 _AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
 _BOX, _SPHERE, _CYLINDER = 0, 1, 2
 _KERNELS: dict[str, Any] = {}
-_CLOSE: dict[str, frozenset[frozenset[str]]] = {}  # per URDF: link pairs whose spheres are mostly touching
 
 
 class UnsupportedJoint(ValueError):
@@ -59,11 +60,13 @@ class SphereFilter:
         objects: tuple[CollisionObject, ...],
         allowed: frozenset[frozenset[str]] = frozenset(),
         base: NDArray[np.float64] | None = None,
+        hulls: pin.GeometryModel | None = None,
     ) -> None:
         """Fit spheres to `robot` (its `geometry`), add attached objects, and list what to check.
 
         States are the group's joint values; the other joints stay at `base` (default: the neutral
-        configuration).
+        configuration). Link pairs with distance tables are tabulated from `hulls` (the robot's
+        shapes as convex hulls; default `geometry`).
 
         Raises:
             UnsupportedJoint: The robot has a joint kind the kernel does not handle.
@@ -118,20 +121,13 @@ class SphereFilter:
                 if na in touch.get(nb, ()) or nb in touch.get(na, ()):
                     continue
                 pairs.append((a, b))
-        pairs_array = np.array(pairs, dtype=np.int64).reshape(-1, 2)
-        # Links that sit a few millimetres apart in most configurations (a wrist's neighbours)
-        # would keep most states "maybe"; those pairs are checked exactly instead, in one batch.
-        key = robot.config.urdf
-        if key not in _CLOSE:
-            robot_owners = sorted({names.index(o) for o in robot_set.owners})
-            every = np.array([(a, b) for a in robot_owners for b in robot_owners
-                              if a < b and self._ojoint[a] != self._ojoint[b]], dtype=np.int64).reshape(-1, 2)
-            close = self._always_close(robot, every)
-            _CLOSE[key] = frozenset(frozenset((names[a], names[b])) for a, b in every[close])
-        hard = np.array([frozenset((names[a], names[b])) in _CLOSE[key] for a, b in pairs_array], dtype=bool)
-        self._pairs = pairs_array[~hard]
-        self.exact_pairs = tuple((names[a], names[b]) for a, b in pairs_array[hard])
-        self._exact = _pair_pool(robot, geometry, self.exact_pairs)
+        # Pairs whose distance depends on one or two joints (a wrist's links) are looked up in tables.
+        tables = [t for t in pair_tables(model, hulls or geometry, robot.config.srdf.disabled_pairs, robot.config.urdf)
+                  if frozenset((t.upper, t.lower)) not in disabled]
+        tabulated = {frozenset((t.upper, t.lower)) for t in tables}
+        self._pairs = np.array([(a, b) for a, b in pairs if frozenset((names[a], names[b])) not in tabulated],
+                               dtype=np.int64).reshape(-1, 2)
+        self.tabulated = tuple((t.upper, t.lower) for t in tables)
         self._check = np.array([[frozenset((name, obj.name)) not in allowed for obj in world] for name in names],
                                dtype=np.bool_).reshape(len(names), len(world))
         self._kernel = _kernels()
@@ -139,9 +135,10 @@ class SphereFilter:
         kind, centre, rot, size = _obstacles(world)
         # Built once: the kernel runs thousands of times per search, and its call costs more than its work.
         self._args = (np.asarray(base, dtype=float), np.asarray(robot.q_index, dtype=np.int64),
-                      np.asarray(robot.continuous, dtype=np.bool_), self._parents, self._kind, self._axis, self._iq,
-                      self._rot, self._trans, self._centres, self._radii, self._sjoint, self._start, self._ojoint,
-                      self._ocentre, self._oradius, self._pairs, kind, centre, rot, size, self._check)
+                      np.asarray(robot.continuous, dtype=np.bool_), *_table_arrays(tables), self._parents, self._kind,
+                      self._axis, self._iq, self._rot, self._trans, self._centres, self._radii, self._sjoint,
+                      self._start, self._ojoint, self._ocentre, self._oradius, self._pairs, kind, centre, rot, size,
+                      self._check)
         self._nq = model.nq
         self.clear(robot.values(base)[None, :])  # compile (or load) the kernel now, not mid-search
 
@@ -150,54 +147,27 @@ class SphereFilter:
         q = np.empty((len(values), self._nq))
         out = np.empty(len(values), dtype=np.bool_)
         self._kernel(values, *self._args, q, out)
-        if self._exact is not None and out.any():
-            cleared = np.flatnonzero(out)
-            hits = pin.computeCollisionsInParallel(1, self._exact, q[cleared].T, True, False)
-            out[cleared] = ~np.asarray(hits, dtype=bool)
         return out, q
 
-    def _always_close(self, robot: Robot, pairs: NDArray[np.int64], samples: int = 200) -> NDArray[np.bool_]:
-        """Return per owner pair True if its spheres touch in over a third of random configurations."""
-        model = robot.model
-        rng = np.random.default_rng(0)
-        lower = np.nan_to_num(np.asarray(model.lowerPositionLimit), nan=-np.pi, posinf=np.pi, neginf=-np.pi)
-        upper = np.nan_to_num(np.asarray(model.upperPositionLimit), nan=np.pi, posinf=np.pi, neginf=-np.pi)
-        data = model.createData()
-        touching = np.zeros(len(pairs))
-        for _ in range(samples):
-            q = pin.normalize(model, rng.uniform(np.maximum(lower, -np.pi), np.minimum(upper, np.pi)))
-            pin.forwardKinematics(model, data, q)
-            rotations = np.array([np.asarray(data.oMi[int(j)].rotation) for j in self._sjoint])
-            translations = np.array([np.asarray(data.oMi[int(j)].translation) for j in self._sjoint])
-            world = np.einsum("sij,sj->si", rotations, self._centres) + translations
-            for k, (a, b) in enumerate(pairs):
-                sa, sb = slice(self._start[a], self._start[a + 1]), slice(self._start[b], self._start[b + 1])
-                gaps = np.linalg.norm(world[sa, None] - world[None, sb], axis=2)
-                touching[k] += bool(np.any(gaps <= self._radii[sa, None] + self._radii[None, sb]))
-        return touching > samples / 3
 
+def _table_arrays(tables: list[PairTable]) -> tuple[NDArray[Any], ...]:
+    """Return the tables as the kernel's arrays.
 
-def _pair_pool(robot: Robot, geometry: pin.GeometryModel, pairs: tuple[tuple[str, str], ...]) -> Any:
-    """Return a pinocchio pool that checks the convex hulls of the shapes of `pairs` (link names), or None."""
-    if not pairs:
-        return None
-    from moveplan.core.collision import convex_hull
-
-    model = robot.model
-    exact = geometry.copy()
-    exact.removeAllCollisionPairs()
-    for obj in exact.geometryObjects:
-        # Hulls enclose their meshes (so a pair free as hulls is free) and cost a fraction of a mesh check.
-        if isinstance(obj.geometry, coal.BVHModelBase) and obj.meshPath:
-            key = (str(obj.meshPath), tuple(float(v) for v in obj.meshScale))
-            obj.geometry = convex_hull(obj.geometry, key, f"{robot.config.urdf_path}: {obj.name}")
-    owner = [str(model.frames[g.parentFrame].name) for g in exact.geometryObjects]
-    wanted = {frozenset(p) for p in pairs}
-    for i in range(len(owner)):
-        for j in range(i + 1, len(owner)):
-            if frozenset((owner[i], owner[j])) in wanted:
-                exact.addCollisionPair(pin.CollisionPair(i, j))
-    return pin.GeometryPool(model, exact, 1)
+    Per table and axis: q index (-1: no such axis), start, step, count; per table: offset
+    into the flat distances, margin; then the flat distances.
+    """
+    axes = np.full((len(tables), 2), -1, dtype=np.int64)
+    start, step = np.zeros((len(tables), 2)), np.ones((len(tables), 2))
+    count = np.ones((len(tables), 2), dtype=np.int64)
+    for k, table in enumerate(tables):
+        n = len(table.q_index)
+        axes[k, :n], start[k, :n], step[k, :n], count[k, :n] = table.q_index, table.start, table.step, \
+            table.distances.shape
+    sizes = [t.distances.size for t in tables]
+    offset = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64) if tables else np.zeros(0, np.int64)
+    margin = np.array([t.margin for t in tables], dtype=float)
+    flat = np.concatenate([t.distances.ravel() for t in tables]) if tables else np.zeros(0)
+    return axes, start, step, count, offset, margin, flat
 
 
 def _obstacles(world: list[CollisionObject]) -> tuple[NDArray[Any], ...]:

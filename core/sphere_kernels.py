@@ -11,7 +11,7 @@ from typing import Any
 import numba
 import numpy as np
 
-__all__ = ["clear"]
+__all__ = ["clear", "tabled_apart"]
 
 
 @numba.njit(cache=True)
@@ -33,7 +33,26 @@ def gap(kind: int, centre: Any, rot: Any, size: Any, p: Any, radius: float) -> f
     return np.sqrt(er * er + ez * ez) - radius
 
 @numba.njit(cache=True)
-def clear(values: Any, base: Any, group: Any, continuous: Any, parents: Any, kinds: Any, axes: Any, iq: Any,
+def tabled_apart(q: Any, taxes: Any, tstart: Any, tstep: Any, tcount: Any, toffset: Any, tmargin: Any,
+                 tdistance: Any) -> bool:
+    """Return True if every tabulated pair is farther apart than its margin at `q`'s nearest grid point."""
+    for p in range(len(toffset)):
+        flat = 0
+        for axis in range(2):
+            if taxes[p, axis] < 0:
+                continue
+            x = (q[taxes[p, axis]] - tstart[p, axis]) / tstep[p, axis]
+            if x < -0.5 or x >= tcount[p, axis] - 0.5:
+                return False  # off the grid, where the margin does not hold
+            flat = flat * tcount[p, axis] + int(x + 0.5)
+        if tdistance[toffset[p] + flat] <= tmargin[p]:
+            return False
+    return True
+
+
+@numba.njit(cache=True)
+def clear(values: Any, base: Any, group: Any, continuous: Any, taxes: Any, tstart: Any, tstep: Any, tcount: Any,
+          toffset: Any, tmargin: Any, tdistance: Any, parents: Any, kinds: Any, axes: Any, iq: Any,
           prot: Any, ptrans: Any, centres: Any, radii: Any, sjoint: Any, start: Any, ojoint: Any, ocentre: Any,
           oradius: Any, pairs: Any, okind: Any, opos: Any, orot: Any, osize: Any, check: Any, qs: Any,
           out: Any) -> None:
@@ -61,6 +80,9 @@ def clear(values: Any, base: Any, group: Any, continuous: Any, parents: Any, kin
     pos[0] = 0.0
     for k in range(len(qs)):
         q = qs[k]
+        if not tabled_apart(q, taxes, tstart, tstep, tcount, toffset, tmargin, tdistance):
+            out[k] = False
+            continue
         for j in range(1, nj):
             # local = placement rotation * joint motion
             kind = kinds[j]
