@@ -19,12 +19,16 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from moveplan.core.inner_spheres import inner_spheres
 from moveplan.core.pair_tables import PairTable, pair_tables
 from moveplan.core.robot import Robot
-from moveplan.core.sphere_model import fit_shape, robot_spheres
+from moveplan.core.sphere_model import SphereSet, fit_shape, robot_spheres
 from moveplan.core.types import CollisionObject
 
-__all__ = ["SphereFilter", "UnsupportedJoint"]
+__all__ = ["CLEAR", "COLLIDES", "MAYBE", "SphereFilter", "UnsupportedJoint"]
+
+# A state's verdict: its spheres touch nothing; unsure; a convex hull (or table pair) surely touches something.
+CLEAR, MAYBE, COLLIDES = 1, 0, -1
 
 # Joint kinds the kernel knows; anything else (planar, free-flyer, ...) makes the filter unavailable.
 _REVOLUTE, _PRISMATIC, _UNBOUNDED = 1, 2, 3
@@ -132,22 +136,31 @@ class SphereFilter:
                                dtype=np.bool_).reshape(len(names), len(world))
         self._kernel = _kernels()
         base = robot.neutral() if base is None else base
-        kind, centre, rot, size = _obstacles(world)
         # Built once: the kernel runs thousands of times per search, and its call costs more than its work.
         self._args = (np.asarray(base, dtype=float), np.asarray(robot.q_index, dtype=np.int64),
-                      np.asarray(robot.continuous, dtype=np.bool_), *_table_arrays(tables), self._parents, self._kind,
-                      self._axis, self._iq, self._rot, self._trans, self._centres, self._radii, self._sjoint,
-                      self._start, self._ojoint, self._ocentre, self._oradius, self._pairs, kind, centre, rot, size,
+                      np.asarray(robot.continuous, dtype=np.bool_), _table_arrays(tables),
+                      (self._parents, self._kind, self._axis, self._iq, self._rot, self._trans),
+                      (self._centres, self._radii, self._sjoint, self._start),
+                      (self._ojoint, self._ocentre, self._oradius),
+                      _inner_arrays(inner_spheres(model, hulls or geometry), names), self._pairs, _obstacles(world),
                       self._check)
         self._nq = model.nq
-        self.clear(robot.values(base)[None, :])  # compile (or load) the kernel now, not mid-search
+        self.classify(robot.values(base)[None, :])  # compile (or load) the kernel now, not mid-search
 
-    def clear(self, values: NDArray[np.float64]) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
-        """Return per group state (rows of `values`) True if certainly collision-free, and the configurations."""
+    def classify(self, values: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+        """Return per group state (rows of `values`) CLEAR, MAYBE or COLLIDES (see module), and the configurations."""
         q = np.empty((len(values), self._nq))
-        out = np.empty(len(values), dtype=np.bool_)
+        out = np.empty(len(values), dtype=np.int8)
         self._kernel(values, *self._args, q, out)
         return out, q
+
+
+def _inner_arrays(inner: SphereSet, names: list[str]) -> tuple[NDArray[Any], ...]:
+    """Return the inner balls as the kernel's arrays, grouped by owner as `names` orders them."""
+    index = np.array([names.index(o) if o in names else len(names) for o in inner.owners], dtype=np.int64)
+    order = np.argsort(index, kind="stable")
+    start = np.searchsorted(index[order], np.arange(len(names) + 1)).astype(np.int64)
+    return inner.centres[order], inner.radii[order], inner.joints[order].astype(np.int64), start
 
 
 def _table_arrays(tables: list[PairTable]) -> tuple[NDArray[Any], ...]:
@@ -171,10 +184,15 @@ def _table_arrays(tables: list[PairTable]) -> tuple[NDArray[Any], ...]:
 
 
 def _obstacles(world: list[CollisionObject]) -> tuple[NDArray[Any], ...]:
-    """Return world obstacles as arrays: kind, centre, rotation, size (box half sides; radius; radius, half length)."""
+    """Return world obstacles as arrays: kind, centre, rotation, size, and whether each is that solid.
+
+    Sizes: a box's half sides; a sphere's radius; a cylinder's radius and half length. A
+    mesh is its bounding box, which is not solid: a ball touching it proves nothing.
+    """
     from moveplan.core.collision import coal_geometry
 
     kinds, centres, rotations, sizes = [], [], [], []
+    solid = [obj.shape.kind in ("box", "sphere", "cylinder") for obj in world]
     for obj in world:
         shape, transform = obj.shape, np.asarray(obj.transform)
         rotation, centre = transform[:3, :3], transform[:3, 3]
@@ -197,7 +215,8 @@ def _obstacles(world: list[CollisionObject]) -> tuple[NDArray[Any], ...]:
         sizes.append(size)
     count = len(world)
     return (np.array(kinds, dtype=np.int64), np.array(centres, dtype=float).reshape(count, 3),
-            np.array(rotations, dtype=float).reshape(count, 3, 3), np.array(sizes, dtype=float).reshape(count, 3))
+            np.array(rotations, dtype=float).reshape(count, 3, 3), np.array(sizes, dtype=float).reshape(count, 3),
+            np.array(solid, dtype=np.bool_))
 
 
 def _kernels() -> Any:

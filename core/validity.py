@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 from moveplan.core import certify
 from moveplan.core.collision import CollisionChecker
 from moveplan.core.robot import Robot
+from moveplan.core.sphere_check import CLEAR, COLLIDES, MAYBE
 from moveplan.core.types import JointTrajectory
 
 __all__ = ["CERTIFY_STEP_M", "MotionChecker"]
@@ -35,10 +36,10 @@ _STRIDE = 8
 
 
 class Filter(Protocol):
-    """A conservative pre-check: True where a group state is certainly free."""
+    """A pre-check: per group state, certainly free (CLEAR), unsure, or surely colliding under the hulls."""
 
-    def clear(self, values: NDArray[np.float64]) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
-        """Return per group state (rows of `values`) True if certainly free, and the configurations (k, nq)."""
+    def classify(self, values: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+        """Return per group state (rows of `values`) CLEAR, MAYBE or COLLIDES, and the configurations (k, nq)."""
         ...
 
 
@@ -56,7 +57,9 @@ class MotionChecker:
         """Check `robot` with its other joints at `base`, by `checker`'s geometry.
 
         `spheres` and `hulls` (the robot's meshes as convex hulls) are conservative geometries
-        asked first, in that order: a state they clear is free under `checker`'s geometry.
+        asked first, in that order: a state they clear is free under `checker`'s geometry. A
+        state `spheres` finds surely colliding collides under the hulls (or, without them,
+        under `checker`'s geometry).
         """
         self.robot = robot
         self.checker = checker
@@ -73,12 +76,16 @@ class MotionChecker:
         that only the real geometry would free reads as colliding. The search uses this:
         a hull check costs a quarter of a mesh check.
         """
-        free, q = self._cleared(values)
-        for checker in self._stages[:1] if conservative else self._stages:
-            if free.all():
-                break
-            unclear = np.flatnonzero(~free)
-            free[unclear] = checker.free_batch(q[unclear].T)
+        verdict, q = self._classified(values)
+        free = verdict == CLEAR
+        maybe = np.flatnonzero(verdict == MAYBE)
+        if len(maybe):
+            free[maybe] = self._stages[0].free_batch(q[maybe].T)
+        if conservative or len(self._stages) == 1:
+            return free
+        rest = np.flatnonzero(~free)  # colliding under the hulls: only the meshes can tell
+        if len(rest):
+            free[rest] = self._stages[1].free_batch(q[rest].T)
         return free
 
     def state_free(self, values: NDArray[np.float64], conservative: bool = False) -> bool:
@@ -99,25 +106,29 @@ class MotionChecker:
         coarse[_STRIDE - 1 :: _STRIDE] = True
         return self._all_free(states[coarse], conservative) and self._all_free(states[~coarse], conservative)
 
-    def _cleared(self, values: NDArray[np.float64]) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
-        """Return which states the spheres clear, and the states' configurations (k, nq)."""
+    def _classified(self, values: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+        """Return the spheres' verdict per state, and the states' configurations (k, nq)."""
         if self.spheres is None:
             q = self.robot.configurations(np.atleast_2d(values), self.base).T
-            return np.zeros(len(q), dtype=bool), q
-        return self.spheres.clear(values)
+            return np.full(len(q), MAYBE, dtype=np.int8), q
+        return self.spheres.classify(values)
 
     def _all_free(self, states: NDArray[np.float64], conservative: bool) -> bool:
         """Return True if every state is free, stopping at the first collision."""
-        free, q = self._cleared(states)
-        stages = self._stages[:1] if conservative else self._stages
-        for k, checker in enumerate(stages):
-            if free.all():
-                return True
-            unclear = np.flatnonzero(~free)
-            if k == len(stages) - 1:
-                return bool(checker.free_batch(q[unclear].T, stop_at_first=True).all())
-            free[unclear] = checker.free_batch(q[unclear].T)
-        return bool(free.all())
+        verdict, q = self._classified(states)
+        final = conservative or len(self._stages) == 1
+        if final and (verdict == COLLIDES).any():
+            return False
+        free = verdict == CLEAR
+        if free.all():
+            return True
+        maybe = np.flatnonzero(verdict == MAYBE)
+        if final:
+            return bool(self._stages[0].free_batch(q[maybe].T, stop_at_first=True).all())
+        if len(maybe):
+            free[maybe] = self._stages[0].free_batch(q[maybe].T)
+        rest = np.flatnonzero(~free)
+        return len(rest) == 0 or bool(self._stages[1].free_batch(q[rest].T, stop_at_first=True).all())
 
     def edge_free_certified(self, a: NDArray[np.float64], b: NDArray[np.float64]) -> bool:
         """Return True if the straight edge is free at the states certification checks on it."""

@@ -12,8 +12,8 @@ from moveplan.core import pair_tables
 from moveplan.core.collision import CollisionChecker
 from moveplan.core.config import load_robot_config
 from moveplan.core.robot import Robot
-from moveplan.core.sphere_check import _table_arrays
-from moveplan.core.sphere_kernels import tabled_apart
+from moveplan.core.sphere_check import CLEAR, COLLIDES, _table_arrays
+from moveplan.core.sphere_kernels import tabled
 
 
 @pytest.fixture(scope="module")
@@ -22,7 +22,7 @@ def ur10e() -> tuple[Robot, pin.GeometryModel]:
     return robot, CollisionChecker(robot, geometry="convex").robot_geometry
 
 
-def test_a_pair_the_table_calls_apart_is_apart_and_most_distant_pairs_are_called_apart(
+def test_a_pair_the_table_calls_apart_is_apart_one_it_calls_touching_touches_and_distant_ones_are_apart(
     ur10e: tuple[Robot, pin.GeometryModel]
 ) -> None:
     robot, hulls = ur10e
@@ -47,8 +47,10 @@ def test_a_pair_the_table_calls_apart_is_apart_and_most_distant_pairs_are_called
             q = pin.randomConfiguration(model)
             pin.computeDistances(model, data, pair, pair_data, q)
             distance = min(r.min_distance for r in pair_data.distanceResults)
-            said_apart = tabled_apart(q, *arrays)
+            verdict = tabled(q, arrays)
+            said_apart = verdict == CLEAR
             assert distance > 0 or not said_apart, (table.upper, table.lower, q)
+            assert distance < 0 or verdict != COLLIDES, (table.upper, table.lower, q)
             if distance > 2 * table.margin:
                 far += 1
                 apart += said_apart
@@ -60,7 +62,7 @@ def test_a_state_off_the_grid_is_not_called_apart(ur10e: tuple[Robot, pin.Geomet
     [table, *_] = pair_tables.pair_tables(robot.model, hulls, robot.config.srdf.disabled_pairs, robot.config.urdf)
     q = pin.neutral(robot.model)
     q[table.q_index[0]] = table.start[0] - table.step[0]
-    assert not tabled_apart(q, *_table_arrays([table]))
+    assert tabled(q, _table_arrays([table])) != CLEAR
 
 
 def test_tables_are_cached_on_disk(

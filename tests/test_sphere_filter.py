@@ -14,7 +14,7 @@ from moveplan.core.collision import CollisionChecker
 from moveplan.core.config import load_robot_config
 from moveplan.core.robot import Robot
 from moveplan.core.scene import load_scene
-from moveplan.core.sphere_check import SphereFilter
+from moveplan.core.sphere_check import CLEAR, COLLIDES, SphereFilter
 from moveplan.core.sphere_model import fit_geometry, robot_spheres
 
 PANDA = ROOT / "configs" / "panda"
@@ -44,17 +44,19 @@ def test_every_point_of_every_shape_lies_inside_its_spheres(config: Path) -> Non
 
 
 @pytest.fixture(scope="module")
-def panda_in_box() -> tuple[Robot, CollisionChecker, SphereFilter]:
+def panda_in_box() -> tuple[Robot, CollisionChecker, CollisionChecker, SphereFilter]:
     robot = Robot(load_robot_config(PANDA))
     scene = load_scene(MBM / "scene0001.yaml", robot)
     checker = CollisionChecker(robot, scene.objects, scene.source, geometry="exact", allowed=scene.allowed)
-    return robot, checker, SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed)
+    hulls = CollisionChecker(robot, scene.objects, scene.source, geometry="convex", allowed=scene.allowed)
+    spheres = SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed, hulls=hulls.robot_geometry)
+    return robot, checker, hulls, spheres
 
 
 def test_no_state_the_filter_clears_collides_and_most_free_states_are_cleared(
-    panda_in_box: tuple[Robot, CollisionChecker, SphereFilter]
+    panda_in_box: tuple[Robot, CollisionChecker, CollisionChecker, SphereFilter]
 ) -> None:
-    robot, checker, spheres = panda_in_box
+    robot, checker, hulls, spheres = panda_in_box
     rng = np.random.default_rng(1)
     values = rng.uniform(robot.lower, robot.upper, size=(3000, robot.dof))
     # States near the box's walls too: small moves from a known free state.
@@ -62,8 +64,9 @@ def test_no_state_the_filter_clears_collides_and_most_free_states_are_cleared(
     values = np.clip(values, robot.lower, robot.upper)
     q = robot.configurations(values, robot.neutral())
     free = checker.free_batch(q)
-    cleared, configurations = spheres.clear(values)
+    verdict, configurations = spheres.classify(values)
     np.testing.assert_allclose(configurations, q.T)
+    cleared = verdict == CLEAR
     assert not np.any(cleared & ~free)
     assert cleared[free].mean() > 0.6
 
@@ -82,3 +85,16 @@ def test_fitted_spheres_are_cached_on_disk_and_a_corrupt_cache_is_rebuilt(
     again = robot_spheres(robot.model, geometry, robot.config.urdf)
     np.testing.assert_array_equal(first.radii, again.radii)
     assert cached.read_bytes() != b"not a pickle"
+
+
+def test_a_state_the_filter_finds_colliding_collides_under_the_hulls_and_most_hull_collisions_are_found(
+    panda_in_box: tuple[Robot, CollisionChecker, CollisionChecker, SphereFilter]
+) -> None:
+    robot, _, hulls, spheres = panda_in_box
+    rng = np.random.default_rng(2)
+    values = rng.uniform(robot.lower, robot.upper, size=(4000, robot.dof))
+    verdict, q = spheres.classify(values)
+    hull_free = hulls.free_batch(q.T)
+    surely = verdict == COLLIDES
+    assert not np.any(surely & hull_free)
+    assert surely[~hull_free].mean() > 0.3
