@@ -14,17 +14,36 @@ import pinocchio as pin
 from numpy.typing import NDArray
 from scipy.spatial import ConvexHull, QhullError
 
+from moveplan.core import disk_cache
 from moveplan.core.sphere_model import SphereSet
 
 __all__ = ["inner_spheres"]
 
+_VERSION = 1  # bump when the fit changes, so cached balls are rebuilt
+_MEMORY: dict[str, SphereSet] = {}
 _PER_SHAPE = 6  # balls per shape at most
 _SMALLEST = 0.3  # stop at balls smaller than this fraction of a shape's largest
 _GRID = 12  # candidate centres per axis of a shape's bounding box
 
 
-def inner_spheres(model: pin.Model, hulls: pin.GeometryModel) -> SphereSet:
-    """Return balls inside the convex shapes of `hulls` (the robot's geometry as convex hulls), per joint."""
+def inner_spheres(model: pin.Model, hulls: pin.GeometryModel, urdf: str) -> SphereSet:
+    """Return balls inside the convex shapes of `hulls` (the robot's geometry as convex hulls), per joint.
+
+    Cached in memory and on disk, keyed by the URDF and its meshes: they take ~0.1 s to find.
+    """
+    key = disk_cache.digest(f"inner {_VERSION}\n{urdf}", hulls)
+    if key not in _MEMORY:
+        path = disk_cache.path(f"inner-{key[:32]}.pickle")
+        balls = disk_cache.read(path, SphereSet)
+        if balls is None:
+            balls = _fit(model, hulls)
+            disk_cache.write(path, balls)
+        _MEMORY[key] = balls
+    return _MEMORY[key]
+
+
+def _fit(model: pin.Model, hulls: pin.GeometryModel) -> SphereSet:
+    """Return the balls inside every shape of `hulls`."""
     centres, radii, joints, owners = [], [], [], []
     for obj in hulls.geometryObjects:
         c, r = _inside(obj.geometry)

@@ -142,17 +142,22 @@ class SphereFilter:
                       (self._parents, self._kind, self._axis, self._iq, self._rot, self._trans),
                       (self._centres, self._radii, self._sjoint, self._start),
                       (self._ojoint, self._ocentre, self._oradius),
-                      _inner_arrays(inner_spheres(model, hulls or geometry), names), self._pairs, _obstacles(world),
-                      self._check)
+                      _inner_arrays(inner_spheres(model, hulls or geometry, robot.config.urdf), names), self._pairs,
+                      _obstacles(world), self._check)
         self._nq = model.nq
         self.classify(robot.values(base)[None, :])  # compile (or load) the kernel now, not mid-search
 
-    def classify(self, values: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
-        """Return per group state (rows of `values`) CLEAR, MAYBE or COLLIDES (see module), and the configurations."""
+    def classify(
+        self, values: NDArray[np.float64], stop: bool = False
+    ) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+        """Return per group state (rows of `values`) CLEAR, MAYBE or COLLIDES, and the configurations (k, nq).
+
+        With `stop`, only the states up to the first that COLLIDES are judged and returned.
+        """
         q = np.empty((len(values), self._nq))
         out = np.empty(len(values), dtype=np.int8)
-        self._kernel(values, *self._args, q, out)
-        return out, q
+        judged = self._kernel(values, *self._args, q, out, stop)
+        return out[:judged], q[:judged]
 
 
 def _inner_arrays(inner: SphereSet, names: list[str]) -> tuple[NDArray[Any], ...]:

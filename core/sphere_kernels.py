@@ -132,12 +132,13 @@ def balls_touch(world: Any, radii: Any, a: Any, b: Any, strict: bool) -> bool:
 
 @numba.njit(cache=True)
 def clear(values: Any, base: Any, group: Any, continuous: Any, tables: Any, joints: Any, spheres: Any,
-          owners: Any, inner: Any, pairs: Any, obstacles: Any, check: Any, qs: Any, out: Any) -> None:
+          owners: Any, inner: Any, pairs: Any, obstacles: Any, check: Any, qs: Any, out: Any, stop: bool) -> int:
     """Write per group state (rows of `values`) its configuration into `qs` and its verdict into `out`.
 
     CLEAR: no sphere touches an obstacle or another owner's sphere, and the tables say
     apart. COLLIDES: a tabulated pair, or a ball inside a hull, surely touches something
     (an obstacle it is checked against, or another owner's inner ball). Else MAYBE.
+    Returns how many states were judged: all, or with `stop` up to the first COLLIDES.
     """
     for k in range(len(values)):
         qs[k] = base
@@ -163,6 +164,8 @@ def clear(values: Any, base: Any, group: Any, continuous: Any, tables: Any, join
         verdict = tabled(q, tables)
         if verdict != CLEAR:
             out[k] = verdict
+            if stop and verdict == COLLIDES:
+                return k + 1
             continue
         forward(q, joints, rot, pos)
         place(centres, sjoint, rot, pos, world)
@@ -228,3 +231,6 @@ def clear(values: Any, base: Any, group: Any, continuous: Any, tables: Any, join
             a, b = pairs[i, 0], pairs[i, 1]
             if balls_touch(iworld, iradii, (istart[a], istart[a + 1]), (istart[b], istart[b + 1]), True):
                 out[k] = COLLIDES
+        if stop and out[k] == COLLIDES:
+            return k + 1
+    return len(qs)

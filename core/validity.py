@@ -16,6 +16,7 @@ close that no point of the robot moves more than `step_m` between two of them
 from __future__ import annotations
 
 import logging
+import math
 from typing import Protocol
 
 import numpy as np
@@ -33,6 +34,7 @@ logger = logging.getLogger(__name__)
 
 CERTIFY_STEP_M = 0.005  # the most any robot point moves between two certified states [m]
 _STRIDE = 8
+_FRACTIONS: dict[int, NDArray[np.float64]] = {}
 
 
 class Filter(Protocol):
@@ -96,28 +98,26 @@ class MotionChecker:
         self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, conservative: bool = False
     ) -> bool:
         """Return True if the straight edge from `a` to `b` is free at states `resolution` [rad] apart."""
-        count = max(1, int(np.ceil(np.max(np.abs(b - a)) / resolution)))
-        states = a + (b - a) * (np.arange(1, count + 1) / count)[:, None]
-        if count < 2 * _STRIDE:
-            return self._all_free(states, conservative)
-        # Most edges a search tries run into something, over many states in a row: every
-        # eighth state first finds most collisions with an eighth of the checks.
-        coarse = np.zeros(count, dtype=bool)
-        coarse[_STRIDE - 1 :: _STRIDE] = True
-        return self._all_free(states[coarse], conservative) and self._all_free(states[~coarse], conservative)
+        count = max(1, math.ceil(float(np.max(np.abs(b - a))) / resolution))
+        return self._all_free(a + (b - a) * _fractions(count), conservative)
 
-    def _classified(self, values: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
-        """Return the spheres' verdict per state, and the states' configurations (k, nq)."""
+    def _classified(
+        self, values: NDArray[np.float64], stop: bool = False
+    ) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+        """Return the spheres' verdict per state, and the states' configurations (k, nq).
+
+        With `stop`, only the states up to the first the spheres find colliding.
+        """
         if self.spheres is None:
             q = self.robot.configurations(np.atleast_2d(values), self.base).T
             return np.full(len(q), MAYBE, dtype=np.int8), q
-        return self.spheres.classify(values)
+        return self.spheres.classify(values, stop)
 
     def _all_free(self, states: NDArray[np.float64], conservative: bool) -> bool:
-        """Return True if every state is free, stopping at the first collision."""
-        verdict, q = self._classified(states)
+        """Return True if every state is free, checking them in order and stopping at the first collision."""
         final = conservative or len(self._stages) == 1
-        if final and (verdict == COLLIDES).any():
+        verdict, q = self._classified(states, stop=final)
+        if final and len(verdict) and verdict[-1] == COLLIDES:
             return False
         free = verdict == CLEAR
         if free.all():
@@ -151,3 +151,17 @@ class MotionChecker:
     def colliding_pair(self, values: NDArray[np.float64]) -> tuple[str, str] | None:
         """Return the names of a colliding pair at a group state, or None."""
         return self.checker.colliding_pair(self.robot.configuration(values, self.base))
+
+
+def _fractions(count: int) -> NDArray[np.float64]:
+    """Return i / count for i = 1..count as a column, every eighth first when there are enough.
+
+    Most edges a search tries run into something, over many states in a row: every eighth
+    state first finds most collisions with an eighth of the checks.
+    """
+    if count not in _FRACTIONS:
+        steps = np.arange(1, count + 1)
+        if count >= 2 * _STRIDE:
+            steps = np.concatenate([steps[_STRIDE - 1 :: _STRIDE], np.delete(steps, np.s_[_STRIDE - 1 :: _STRIDE])])
+        _FRACTIONS[count] = (steps / count)[:, None]
+    return _FRACTIONS[count]
