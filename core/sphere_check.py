@@ -132,8 +132,10 @@ class SphereFilter:
         self._pairs = np.array([(a, b) for a, b in pairs if frozenset((names[a], names[b])) not in tabulated],
                                dtype=np.int64).reshape(-1, 2)
         self.tabulated = tuple((t.upper, t.lower) for t in tables)
-        self._check = np.array([[frozenset((name, obj.name)) not in allowed for obj in world] for name in names],
-                               dtype=np.bool_).reshape(len(names), len(world))
+        # A link fixed to the world (a base) never moves relative to world obstacles: the collision
+        # checker tests those pairs once, when the scene loads, so no state needs to.
+        self._check = np.array([[frozenset((name, obj.name)) not in allowed and self._ojoint[k] != 0 for obj in world]
+                                for k, name in enumerate(names)], dtype=np.bool_).reshape(len(names), len(world))
         self._kernel = _kernels()
         base = robot.neutral() if base is None else base
         # Built once: the kernel runs thousands of times per search, and its call costs more than its work.

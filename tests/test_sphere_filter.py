@@ -72,9 +72,9 @@ def test_no_state_the_filter_clears_collides_and_most_free_states_are_cleared(
 
 
 def test_most_free_states_a_tenth_of_a_radian_from_contact_are_cleared(
-    panda_in_box: tuple[Robot, CollisionChecker, SphereFilter]
+    panda_in_box: tuple[Robot, CollisionChecker, CollisionChecker, SphereFilter]
 ) -> None:
-    robot, checker, spheres = panda_in_box
+    robot, checker, _, spheres = panda_in_box
     rng = np.random.default_rng(2)
     values = rng.uniform(robot.lower, robot.upper, size=(2000, robot.dof))
     free = checker.free_batch(robot.configurations(values))
@@ -89,7 +89,7 @@ def test_most_free_states_a_tenth_of_a_radian_from_contact_are_cleared(
     direction = (end - start) / np.linalg.norm(end - start, axis=1)[:, None]
     near = np.clip(start + lo[:, None] * (end - start) - 0.1 * direction, robot.lower, robot.upper)
     near_free = checker.free_batch(robot.configurations(near))
-    cleared, _ = spheres.clear(near)
+    cleared = spheres.classify(near)[0] == CLEAR
     assert not np.any(cleared & ~near_free)
     # The clustering fit this replaced cleared 39% of them; the hull-hugging one 75%.
     assert cleared[near_free].mean() > 0.6
@@ -122,3 +122,15 @@ def test_a_state_the_filter_finds_colliding_collides_under_the_hulls_and_most_hu
     surely = verdict == COLLIDES
     assert not np.any(surely & hull_free)
     assert surely[~hull_free].mean() > 0.3
+
+
+def test_a_base_resting_on_a_table_leaves_the_other_links_to_decide() -> None:
+    robot = Robot(load_robot_config(UR10E))
+    scene = load_scene(ROOT / "samples" / "ur10e_table_scene.yaml", robot)
+    checker = CollisionChecker(robot, scene.objects, scene.source, allowed=scene.allowed)
+    spheres = SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed)
+    values = np.random.default_rng(3).uniform(robot.lower, robot.upper, size=(2000, robot.dof))
+    free = checker.free_batch(robot.configurations(values))
+    cleared = spheres.classify(values)[0] == CLEAR
+    assert not np.any(cleared & ~free)
+    assert cleared[free].mean() > 0.5
