@@ -118,6 +118,19 @@ def place(centres: Any, joint: Any, rot: Any, pos: Any, world: Any) -> None:
 
 
 @numba.njit(cache=True)
+def place_owner(o: int, start: Any, joint: Any, centres: Any, rot: Any, pos: Any, world: Any, placed: Any) -> None:
+    """Write owner `o`'s sphere centres in the world frame into `world`, once per state (`placed`)."""
+    if placed[o]:
+        return
+    placed[o] = True
+    for s in range(start[o], start[o + 1]):
+        j = joint[s]
+        for r in range(3):
+            world[s, r] = pos[j, r] + rot[j, r, 0] * centres[s, 0] + rot[j, r, 1] * centres[s, 1] \
+                + rot[j, r, 2] * centres[s, 2]
+
+
+@numba.njit(cache=True)
 def balls_touch(world: Any, radii: Any, a: Any, b: Any, strict: bool) -> bool:
     """Return True if a ball in index range `a` touches (with `strict`: overlaps) one in range `b`."""
     for s in range(a[0], a[1]):
@@ -159,6 +172,7 @@ def clear(values: Any, base: Any, group: Any, continuous: Any, tables: Any, join
     iworld = np.empty((len(iradii), 3))
     owc = np.empty((len(oradius), 3))
     near = np.empty(len(radii), dtype=np.int64)
+    placed = np.empty(len(oradius), dtype=np.bool_)
     for k in range(len(qs)):
         q = qs[k]
         verdict = tabled(q, tables)
@@ -168,8 +182,9 @@ def clear(values: Any, base: Any, group: Any, continuous: Any, tables: Any, join
                 return k + 1
             continue
         forward(q, joints, rot, pos)
-        place(centres, sjoint, rot, pos, world)
         place(ocentre, ojoint, rot, pos, owc)
+        # An owner's spheres are placed only when something comes within its bounding ball.
+        placed[:] = False
         free = True
         for o in range(len(oradius)):
             if not free:
@@ -179,6 +194,7 @@ def clear(values: Any, base: Any, group: Any, continuous: Any, tables: Any, join
                     continue
                 if gap(okind[b], opos[b], orot[b], osize[b], owc[o], oradius[o]) > 0.0:
                     continue
+                place_owner(o, start, sjoint, centres, rot, pos, world, placed)
                 for s in range(start[o], start[o + 1]):
                     if gap(okind[b], opos[b], orot[b], osize[b], world[s], radii[s]) <= 0.0:
                         free = False
@@ -193,6 +209,8 @@ def clear(values: Any, base: Any, group: Any, continuous: Any, tables: Any, join
             reach = oradius[a] + oradius[b]
             if dx * dx + dy * dy + dz * dz > reach * reach:
                 continue
+            place_owner(a, start, sjoint, centres, rot, pos, world, placed)
+            place_owner(b, start, sjoint, centres, rot, pos, world, placed)
             # Only b's spheres that reach a's bounding ball can touch one of a's spheres.
             count = 0
             for t in range(start[b], start[b + 1]):
