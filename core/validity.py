@@ -92,13 +92,13 @@ class MotionChecker:
 
     def state_free(self, values: NDArray[np.float64], conservative: bool = False) -> bool:
         """Return True if one group state is collision-free (see `free` for `conservative`)."""
-        return bool(self.free(values[None, :], conservative)[0])
+        return self._all_free(values[None, :], conservative)
 
     def edge_free(
         self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, conservative: bool = False
     ) -> bool:
         """Return True if the straight edge from `a` to `b` is free at states `resolution` [rad] apart."""
-        count = max(1, math.ceil(float(np.max(np.abs(b - a))) / resolution))
+        count = max(1, math.ceil(float(np.abs(b - a).max()) / resolution))
         return self._all_free(a + (b - a) * _fractions(count), conservative)
 
     def _classified(
@@ -119,12 +119,12 @@ class MotionChecker:
         verdict, q = self._classified(states, stop=final)
         if final and len(verdict) and verdict[-1] == COLLIDES:
             return False
-        free = verdict == CLEAR
-        if free.all():
+        if verdict.min() == CLEAR:
             return True
         maybe = np.flatnonzero(verdict == MAYBE)
         if final:
             return bool(self._stages[0].free_batch(q[maybe].T, stop_at_first=True).all())
+        free = verdict == CLEAR
         if len(maybe):
             free[maybe] = self._stages[0].free_batch(q[maybe].T)
         rest = np.flatnonzero(~free)
