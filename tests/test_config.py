@@ -222,7 +222,8 @@ def test_the_motionbenchmaker_panda_folder_loads_without_moveplan_yaml() -> None
     config = load_robot_config(MBM_PANDA)
     assert config.planning["group"] == "panda_arm" and config.missing_acceleration_limits() == ()
     assert config.sources["joint_limits"] == MBM_PANDA / "joint_limits.yaml"
-    assert config.collision_meshes()[0].path == MBM_PANDA / "meshes" / "collision" / "link0.obj"
+    # Mesh paths come resolved (symlinks followed), as pinocchio is given them.
+    assert config.collision_meshes()[0].path == (MBM_PANDA / "meshes" / "collision" / "link0.obj").resolve()
 
 
 def test_panda_urdf_and_meshes_come_from_example_robot_data(panda_config: RobotConfig) -> None:
