@@ -46,6 +46,8 @@ class SpeedProfile:
         object.__setattr__(self, "squared_speeds", frozen_array(self.squared_speeds, s.shape, "squared_speeds"))
 
 
+# A joint at rest along the path (a derivative of 0) gives an infinite bound: none.
+@np.errstate(divide="ignore", invalid="ignore")
 def fastest_speeds(
     grid: NDArray[np.float64],
     first: NDArray[np.float64],
@@ -68,20 +70,6 @@ def fastest_speeds(
         max_velocity: In [rad]/[s], shape (n,).
         max_acceleration: In [rad]/[s]^2, shape (n,).
     """
-    # A joint at rest along the path (a derivative of 0) gives an infinite bound: none.
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return _fastest_speeds(grid, first, second, straight, max_velocity, max_acceleration)
-
-
-def _fastest_speeds(
-    grid: NDArray[np.float64],
-    first: NDArray[np.float64],
-    second: NDArray[np.float64],
-    straight: NDArray[np.bool_],
-    max_velocity: NDArray[np.float64],
-    max_acceleration: NDArray[np.float64],
-) -> SpeedProfile:
-    """Return `fastest_speeds(...)`, with divisions by 0 giving infinities quietly."""
     delta = grid[1:] - grid[:-1]
     velocity = first[::2]
     cap = np.min((max_velocity / velocity) ** 2, axis=1)[:-1]
