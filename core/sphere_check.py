@@ -7,8 +7,9 @@ its spheres only if that ball touches something. Link pairs whose distance depen
 one or two joints are looked up in distance tables instead (core/pair_tables.py). A
 state is "clear" only if no sphere touches an obstacle or another owner's sphere and
 every tabulated pair is apart; since the spheres enclose the real geometry
-(core/sphere_model.py), a clear state is collision-free. Anything else is "maybe": the
-caller asks coal.
+(core/sphere_model.py), a clear state is collision-free. A state where a ball inside a
+convex hull touches an obstacle or another link's inner ball, or a table says a pair
+overlaps, surely collides under the hulls. Anything else is "maybe": the caller asks coal.
 """
 
 from __future__ import annotations
@@ -34,7 +35,6 @@ CLEAR, MAYBE, COLLIDES = 1, 0, -1
 _REVOLUTE, _PRISMATIC, _UNBOUNDED = 1, 2, 3
 _AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
 _BOX, _SPHERE, _CYLINDER = 0, 1, 2
-_KERNELS: dict[str, Any] = {}
 
 
 class UnsupportedJoint(ValueError):
@@ -136,7 +136,9 @@ class SphereFilter:
         # checker tests those pairs once, when the scene loads, so no state needs to.
         self._check = np.array([[frozenset((name, obj.name)) not in allowed and self._ojoint[k] != 0 for obj in world]
                                 for k, name in enumerate(names)], dtype=np.bool_).reshape(len(names), len(world))
-        self._kernel = _kernels()
+        from moveplan.core.sphere_kernels import clear  # numba: compiled once, then loaded from its disk cache
+
+        self._kernel = clear
         base = robot.neutral() if base is None else base
         # Built once: the kernel runs thousands of times per search, and its call costs more than its work.
         self._args = (np.asarray(base, dtype=float), np.asarray(robot.q_index, dtype=np.int64),
@@ -225,11 +227,3 @@ def _obstacles(world: list[CollisionObject]) -> tuple[NDArray[Any], ...]:
             np.array(rotations, dtype=float).reshape(count, 3, 3), np.array(sizes, dtype=float).reshape(count, 3),
             np.array(solid, dtype=np.bool_))
 
-
-def _kernels() -> Any:
-    """Return the compiled batch kernel (compiled once, then loaded from numba's disk cache)."""
-    if "clear" not in _KERNELS:
-        from moveplan.core.sphere_kernels import clear
-
-        _KERNELS["clear"] = clear
-    return _KERNELS["clear"]
