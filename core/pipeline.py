@@ -16,6 +16,7 @@ from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
+import coal
 import numpy as np
 from numpy.typing import NDArray
 
@@ -208,8 +209,9 @@ def _sphere_filter(
 
 def _hull_checker(robot: Robot, checker: CollisionChecker, scene: Scene) -> CollisionChecker | None:
     """Return a checker of the robot's meshes as convex hulls in `scene` when `checker` has meshes, else None."""
-    if checker.mode != "exact":
-        return None
+    meshes = any(isinstance(obj.geometry, coal.BVHModelBase) for obj in checker.robot_geometry.geometryObjects)
+    if checker.mode != "exact" or not meshes:
+        return None  # the hulls would be the checker's own shapes, checked twice
     try:
         return CollisionChecker(robot, scene.objects, scene.source, geometry="convex", allowed=scene.allowed)
     except ConfigError as exc:
