@@ -77,13 +77,6 @@ class SphereFilter:
         """
         model = robot.model
         kinds = [(0, (0.0, 0.0, 1.0))] + [_joint_kind(model, j) for j in range(1, model.njoints)]
-        self._parents = np.array(model.parents, dtype=np.int64)
-        self._kind = np.array([k for k, _ in kinds], dtype=np.int64)
-        self._axis = np.array([a for _, a in kinds], dtype=float)
-        self._iq = np.array(model.idx_qs, dtype=np.int64)
-        self._rot = np.array([np.asarray(p.rotation) for p in model.jointPlacements])
-        self._trans = np.array([np.asarray(p.translation) for p in model.jointPlacements])
-
         robot_set = robot_spheres(model, geometry, robot.config.urdf)
         centres, radii = [robot_set.centres], [robot_set.radii]
         joints, owners = [robot_set.joints], list(robot_set.owners)
@@ -98,29 +91,26 @@ class SphereFilter:
                 joints.append(np.full(len(r), frame.parentJoint))
                 owners.extend([obj.name] * len(r))
                 touch[obj.name] = frozenset((obj.link, *obj.touch_links))
-        centres_all, radii_all, joints_all = np.concatenate(centres), np.concatenate(radii), np.concatenate(joints)
         names = list(dict.fromkeys(owners))
         owner_index = np.array([names.index(o) for o in owners], dtype=np.int64)
         order = np.argsort(owner_index, kind="stable")
-        self._centres, self._radii = centres_all[order], radii_all[order]
-        self._sjoint, owner_index = joints_all[order], owner_index[order]
-        self._start = np.searchsorted(owner_index, np.arange(len(names) + 1)).astype(np.int64)
+        centre, radius = np.concatenate(centres)[order], np.concatenate(radii)[order]
+        joint = np.concatenate(joints)[order]
+        start = np.searchsorted(owner_index[order], np.arange(len(names) + 1))
         # Each owner's bounding ball, in its joint's frame.
-        self._ojoint = self._sjoint[self._start[:-1]]
-        self._ocentre = np.zeros((len(names), 3))
-        self._oradius = np.zeros(len(names))
+        owner_joint = joint[start[:-1]]
+        owner_centre, owner_radius = np.zeros((len(names), 3)), np.zeros(len(names))
         for k in range(len(names)):
-            c, r = self._centres[self._start[k]:self._start[k + 1]], self._radii[self._start[k]:self._start[k + 1]]
-            middle = (c.min(axis=0) + c.max(axis=0)) / 2
-            self._ocentre[k] = middle
-            self._oradius[k] = np.max(np.linalg.norm(c - middle, axis=1) + r)
+            c, r = centre[start[k]:start[k + 1]], radius[start[k]:start[k + 1]]
+            owner_centre[k] = (c.min(axis=0) + c.max(axis=0)) / 2
+            owner_radius[k] = np.max(np.linalg.norm(c - owner_centre[k], axis=1) + r)
 
         disabled = robot.config.srdf.disabled_pairs | allowed
         pairs = []
         for a in range(len(names)):
             for b in range(a + 1, len(names)):
                 na, nb = names[a], names[b]
-                if self._ojoint[a] == self._ojoint[b] or frozenset((na, nb)) in disabled:
+                if owner_joint[a] == owner_joint[b] or frozenset((na, nb)) in disabled:
                     continue
                 if na in touch.get(nb, ()) or nb in touch.get(na, ()):
                     continue
@@ -129,27 +119,29 @@ class SphereFilter:
         tables = [t for t in pair_tables(model, hulls or geometry, robot.config.srdf.disabled_pairs, robot.config.urdf)
                   if frozenset((t.upper, t.lower)) not in disabled]
         tabulated = {frozenset((t.upper, t.lower)) for t in tables}
-        self._pairs = np.array([(a, b) for a, b in pairs if frozenset((names[a], names[b])) not in tabulated],
-                               dtype=np.int64).reshape(-1, 2)
+        pairs = [(a, b) for a, b in pairs if frozenset((names[a], names[b])) not in tabulated]
         self.tabulated = tuple((t.upper, t.lower) for t in tables)
         # A link fixed to the world (a base) never moves relative to world obstacles: the collision
         # checker tests those pairs once, when the scene loads, so no state needs to.
-        self._check = np.array([[frozenset((name, obj.name)) not in allowed and self._ojoint[k] != 0 for obj in world]
-                                for k, name in enumerate(names)], dtype=np.bool_).reshape(len(names), len(world))
-        from moveplan.core.sphere_kernels import clear  # numba: compiled once, then loaded from its disk cache
+        check = np.array([[frozenset((name, obj.name)) not in allowed and owner_joint[k] != 0 for obj in world]
+                          for k, name in enumerate(names)]).reshape(len(names), len(world))
+        from moveplan.core import sphere_kernels  # numba: compiled once, then loaded from its disk cache
 
-        self._kernel = clear
+        self._kernels = sphere_kernels
         base = robot.neutral() if base is None else base
-        # Built once: the kernel runs thousands of times per search, and its call costs more than its work.
-        self._args = (np.asarray(base, dtype=float), np.asarray(robot.q_index, dtype=np.int64),
-                      np.asarray(robot.continuous, dtype=np.bool_), _table_arrays(tables),
-                      (self._parents, self._kind, self._axis, self._iq, self._rot, self._trans),
-                      (self._centres, self._radii, self._sjoint, self._start),
-                      (self._ojoint, self._ocentre, self._oradius),
-                      _inner_arrays(inner_spheres(model, hulls or geometry, robot.config.urdf), names), self._pairs,
-                      _obstacles(world), self._check)
+        inner = inner_spheres(model, hulls or geometry, robot.config.urdf)
+        # Packed once: the kernels run thousands of times per search, and a call costs per argument.
+        self._packed = sphere_kernels.pack({
+            "base": base, "group": robot.q_index, "continuous": robot.continuous, **_table_arrays(tables),
+            "parents": model.parents, "kinds": [k for k, _ in kinds], "axes": [a for _, a in kinds],
+            "iq": model.idx_qs, "prot": [np.asarray(p.rotation) for p in model.jointPlacements],
+            "ptrans": [np.asarray(p.translation) for p in model.jointPlacements],
+            "centres": centre, "radii": radius, "sjoint": joint, "start": start,
+            "ojoint": owner_joint, "ocentre": owner_centre, "oradius": owner_radius,
+            **_inner_arrays(inner, names), "pairs": np.reshape(pairs, (-1, 2)), **_obstacles(world), "check": check})
         self._nq = model.nq
-        self.classify(robot.values(base)[None, :])  # compile (or load) the kernel now, not mid-search
+        self.classify(robot.values(base)[None, :])  # compile (or load) the kernels now, not mid-search
+        self.edge(robot.values(base), robot.values(base), 1.0)
 
     def classify(
         self, values: NDArray[np.float64], stop: bool = False
@@ -160,19 +152,30 @@ class SphereFilter:
         """
         q = np.empty((len(values), self._nq))
         out = np.empty(len(values), dtype=np.int8)
-        judged = self._kernel(values, *self._args, q, out, stop)
+        judged = self._kernels.classify(values, stop, *self._packed, q, out)
         return out[:judged], q[:judged]
 
+    def edge(
+        self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, stop: bool = False
+    ) -> tuple[int, NDArray[np.int8], NDArray[np.float64]]:
+        """Return the worst verdict on the edge from `a` to `b`, and the verdicts and configurations not CLEAR.
 
-def _inner_arrays(inner: SphereSet, names: list[str]) -> tuple[NDArray[Any], ...]:
+        The edge's states are `resolution` [rad] apart in every joint, `b` included, `a` not.
+        With `stop`, judging ends at the first state that COLLIDES.
+        """
+        return self._kernels.edge(a, b, resolution, stop, *self._packed)  # type: ignore[no-any-return]
+
+
+def _inner_arrays(inner: SphereSet, names: list[str]) -> dict[str, NDArray[Any]]:
     """Return the inner balls as the kernel's arrays, grouped by owner as `names` orders them."""
     index = np.array([names.index(o) if o in names else len(names) for o in inner.owners], dtype=np.int64)
     order = np.argsort(index, kind="stable")
     start = np.searchsorted(index[order], np.arange(len(names) + 1)).astype(np.int64)
-    return inner.centres[order], inner.radii[order], inner.joints[order].astype(np.int64), start
+    return {"icentres": inner.centres[order], "iradii": inner.radii[order], "ijoint": inner.joints[order],
+            "istart": start}
 
 
-def _table_arrays(tables: list[PairTable]) -> tuple[NDArray[Any], ...]:
+def _table_arrays(tables: list[PairTable]) -> dict[str, NDArray[Any]]:
     """Return the tables as the kernel's arrays.
 
     Per table and axis: q index (-1: no such axis), start, step, count; per table: offset
@@ -189,10 +192,11 @@ def _table_arrays(tables: list[PairTable]) -> tuple[NDArray[Any], ...]:
     offset = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64) if tables else np.zeros(0, np.int64)
     margin = np.array([t.margin for t in tables], dtype=float)
     flat = np.concatenate([t.distances.ravel() for t in tables]) if tables else np.zeros(0)
-    return axes, start, step, count, offset, margin, flat
+    return {"table_axes": axes, "table_start": start, "table_step": step, "table_count": count,
+            "table_offset": offset, "table_margin": margin, "table_distance": flat}
 
 
-def _obstacles(world: list[CollisionObject]) -> tuple[NDArray[Any], ...]:
+def _obstacles(world: list[CollisionObject]) -> dict[str, NDArray[Any]]:
     """Return world obstacles as arrays: kind, centre, rotation, size, and whether each is that solid.
 
     Sizes: a box's half sides; a sphere's radius; a cylinder's radius and half length. A
@@ -223,7 +227,7 @@ def _obstacles(world: list[CollisionObject]) -> tuple[NDArray[Any], ...]:
         rotations.append(rotation)
         sizes.append(size)
     count = len(world)
-    return (np.array(kinds, dtype=np.int64), np.array(centres, dtype=float).reshape(count, 3),
-            np.array(rotations, dtype=float).reshape(count, 3, 3), np.array(sizes, dtype=float).reshape(count, 3),
-            np.array(solid, dtype=np.bool_))
+    return {"okind": np.array(kinds, dtype=np.int64), "opos": np.array(centres, dtype=float).reshape(count, 3),
+            "orot": np.array(rotations, dtype=float).reshape(count, 3, 3),
+            "osize": np.array(sizes, dtype=float).reshape(count, 3), "osolid": np.array(solid, dtype=np.bool_)}
 

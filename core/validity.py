@@ -15,7 +15,6 @@ close that no point of the robot moves more than `step_m` between two of them
 
 from __future__ import annotations
 
-import logging
 import math
 from typing import Protocol
 
@@ -30,11 +29,7 @@ from moveplan.core.types import JointTrajectory
 
 __all__ = ["CERTIFY_STEP_M", "MotionChecker"]
 
-logger = logging.getLogger(__name__)
-
 CERTIFY_STEP_M = 0.005  # the most any robot point moves between two certified states [m]
-_STRIDE = 8
-_FRACTIONS: dict[int, NDArray[np.float64]] = {}
 
 
 class Filter(Protocol):
@@ -42,6 +37,12 @@ class Filter(Protocol):
 
     def classify(self, values: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
         """Return per group state (rows of `values`) CLEAR, MAYBE or COLLIDES, and the configurations (k, nq)."""
+        ...
+
+    def edge(
+        self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, stop: bool
+    ) -> tuple[int, NDArray[np.int8], NDArray[np.float64]]:
+        """Return the worst verdict on the edge's states, and the verdicts and configurations not CLEAR."""
         ...
 
 
@@ -92,43 +93,39 @@ class MotionChecker:
 
     def state_free(self, values: NDArray[np.float64], conservative: bool = False) -> bool:
         """Return True if one group state is collision-free (see `free` for `conservative`)."""
-        return self._all_free(values[None, :], conservative)
+        return self.edge_free(values, values, 1.0, conservative)
 
     def edge_free(
         self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, conservative: bool = False
     ) -> bool:
-        """Return True if the straight edge from `a` to `b` is free at states `resolution` [rad] apart."""
-        count = max(1, math.ceil(float(np.abs(b - a).max()) / resolution))
-        return self._all_free(a + (b - a) * _fractions(count), conservative)
+        """Return True if the straight edge from `a` to `b` is free at states `resolution` [rad] apart.
 
-    def _classified(
-        self, values: NDArray[np.float64], stop: bool = False
-    ) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
-        """Return the spheres' verdict per state, and the states' configurations (k, nq).
-
-        With `stop`, only the states up to the first the spheres find colliding.
+        The states checked are `b` and those between, not `a`: a search asks about an edge
+        from a state it already knows to be free.
         """
+        final = conservative or len(self._stages) == 1
+        if self.spheres is None:
+            count = max(1, math.ceil(float(np.abs(b - a).max()) / resolution))
+            states = a + (b - a) * (np.arange(1, count + 1) / count)[:, None]
+            worst, verdict, q = MAYBE, np.full(count, MAYBE), self.robot.configurations(states, self.base).T
+        else:
+            worst, verdict, q = self.spheres.edge(a, b, resolution, stop=final)
+        if worst == CLEAR:
+            return True
+        if final:
+            return worst != COLLIDES and bool(self._stages[0].free_batch(q.T, stop_at_first=True).all())
+        free = np.zeros(len(verdict), dtype=bool)
+        maybe = verdict == MAYBE
+        if maybe.any():
+            free[maybe] = self._stages[0].free_batch(q[maybe].T)
+        return bool(free.all()) or bool(self._stages[1].free_batch(q[~free].T, stop_at_first=True).all())
+
+    def _classified(self, values: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+        """Return the spheres' verdict per state, and the states' configurations (k, nq)."""
         if self.spheres is None:
             q = self.robot.configurations(np.atleast_2d(values), self.base).T
             return np.full(len(q), MAYBE, dtype=np.int8), q
-        return self.spheres.classify(values, stop)
-
-    def _all_free(self, states: NDArray[np.float64], conservative: bool) -> bool:
-        """Return True if every state is free, checking them in order and stopping at the first collision."""
-        final = conservative or len(self._stages) == 1
-        verdict, q = self._classified(states, stop=final)
-        if final and len(verdict) and verdict[-1] == COLLIDES:
-            return False
-        if verdict.min() == CLEAR:
-            return True
-        maybe = np.flatnonzero(verdict == MAYBE)
-        if final:
-            return bool(self._stages[0].free_batch(q[maybe].T, stop_at_first=True).all())
-        free = verdict == CLEAR
-        if len(maybe):
-            free[maybe] = self._stages[0].free_batch(q[maybe].T)
-        rest = np.flatnonzero(~free)
-        return len(rest) == 0 or bool(self._stages[1].free_batch(q[rest].T, stop_at_first=True).all())
+        return self.spheres.classify(values)
 
     def edge_free_certified(self, a: NDArray[np.float64], b: NDArray[np.float64]) -> bool:
         """Return True if the straight edge is free at the states certification checks on it."""
@@ -152,16 +149,3 @@ class MotionChecker:
         """Return the names of a colliding pair at a group state, or None."""
         return self.checker.colliding_pair(self.robot.configuration(values, self.base))
 
-
-def _fractions(count: int) -> NDArray[np.float64]:
-    """Return i / count for i = 1..count as a column, every eighth first when there are enough.
-
-    Most edges a search tries run into something, over many states in a row: every eighth
-    state first finds most collisions with an eighth of the checks.
-    """
-    if count not in _FRACTIONS:
-        steps = np.arange(1, count + 1)
-        if count >= 2 * _STRIDE:
-            steps = np.concatenate([steps[_STRIDE - 1 :: _STRIDE], np.delete(steps, np.s_[_STRIDE - 1 :: _STRIDE])])
-        _FRACTIONS[count] = (steps / count)[:, None]
-    return _FRACTIONS[count]

@@ -41,7 +41,7 @@ def test_a_pair_the_table_calls_apart_is_apart_one_it_calls_touching_touches_and
             for j in ids[table.lower]:
                 pair.addCollisionPair(pin.CollisionPair(i, j))
         pair_data = pair.createData()
-        arrays = _table_arrays([table])
+        arrays = tuple(_table_arrays([table]).values())
         apart, far = 0, 0
         for _ in range(1500):
             q = pin.randomConfiguration(model)
@@ -62,7 +62,7 @@ def test_a_state_off_the_grid_is_not_called_apart(ur10e: tuple[Robot, pin.Geomet
     [table, *_] = pair_tables.pair_tables(robot.model, hulls, robot.config.srdf.disabled_pairs, robot.config.urdf)
     q = pin.neutral(robot.model)
     q[table.q_index[0]] = table.start[0] - table.step[0]
-    assert tabled(q, _table_arrays([table])) != CLEAR
+    assert tabled(q, tuple(_table_arrays([table]).values())) != CLEAR
 
 
 def test_tables_are_cached_on_disk(

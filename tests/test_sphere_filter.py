@@ -95,6 +95,24 @@ def test_most_free_states_a_tenth_of_a_radian_from_contact_are_cleared(
     assert cleared[near_free].mean() > 0.6
 
 
+@pytest.mark.parametrize("resolution", [0.5, 0.05, 0.01], ids=["few states", "search", "fine"])
+def test_an_edge_is_judged_at_every_state_between_its_ends_once(
+    panda_in_box: tuple[Robot, CollisionChecker, CollisionChecker, SphereFilter], resolution: float
+) -> None:
+    robot, _, _, spheres = panda_in_box
+    rng = np.random.default_rng(4)
+    for a, b in rng.uniform(robot.lower, robot.upper, size=(20, 2, robot.dof)):
+        count = max(1, int(np.ceil(np.abs(b - a).max() / resolution)))
+        verdict, q = spheres.classify(a + (b - a) * (np.arange(1, count + 1) / count)[:, None])
+        worst, unclear, unclear_q = spheres.edge(a, b, resolution)
+        assert worst == verdict.min()
+        assert sorted(unclear) == sorted(verdict[verdict != CLEAR])
+        order = np.lexsort(unclear_q.T)
+        np.testing.assert_allclose(unclear_q[order], q[verdict != CLEAR][np.lexsort(q[verdict != CLEAR].T)])
+        stopped = spheres.edge(a, b, resolution, stop=True)
+        assert stopped[0] == worst and (worst != COLLIDES or stopped[1][-1] == COLLIDES)
+
+
 def test_fitted_spheres_are_cached_on_disk_and_a_corrupt_cache_is_rebuilt(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
