@@ -140,6 +140,8 @@ class SphereFilter:
             "ojoint": owner_joint, "ocentre": owner_centre, "oradius": owner_radius,
             **_inner_arrays(inner, names), "pairs": np.reshape(pairs, (-1, 2)), **_obstacles(world), "check": check})
         self._nq = model.nq
+        # Reused by every `edge` call: returning fresh arrays from compiled code costs more than judging a state.
+        self._verdicts, self._unclear = np.empty(64, dtype=np.int8), np.empty((64, model.nq))
         self.classify(robot.values(base)[None, :])  # compile (or load) the kernels now, not mid-search
         self.edge(robot.values(base), robot.values(base), 1.0)
 
@@ -161,9 +163,14 @@ class SphereFilter:
         """Return the worst verdict on the edge from `a` to `b`, and the verdicts and configurations not CLEAR.
 
         The edge's states are `resolution` [rad] apart in every joint, `b` included, `a` not.
-        With `stop`, judging ends at the first state that COLLIDES.
+        With `stop`, judging ends at the first state that COLLIDES. The arrays returned are
+        overwritten by the next call.
         """
-        return self._kernels.edge(a, b, resolution, stop, *self._packed)  # type: ignore[no-any-return]
+        worst, kept = self._kernels.edge(a, b, resolution, stop, *self._packed, self._verdicts, self._unclear)
+        if kept < 0:  # more states than the buffers hold
+            self._verdicts, self._unclear = np.empty(-kept, dtype=np.int8), np.empty((-kept, self._nq))
+            return self.edge(a, b, resolution, stop)
+        return worst, self._verdicts[:kept], self._unclear[:kept]
 
 
 def _inner_arrays(inner: SphereSet, names: list[str]) -> dict[str, NDArray[Any]]:

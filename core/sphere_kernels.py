@@ -23,7 +23,10 @@ STRIDE = 8  # an edge's states are judged every STRIDE-th first
 
 @numba.njit(cache=True)
 def gap(kind: int, centre: Any, rot: Any, size: Any, p: Any, radius: float) -> float:
-    """Return the distance from a ball to an obstacle (box, sphere, cylinder), <= 0 when they touch."""
+    """Return d^2 - radius^2 for a ball at `p` whose centre lies d from an obstacle (box, sphere, cylinder).
+
+    Its sign is that of the gap between ball and obstacle (<= 0: they touch), found without a square root.
+    """
     d0, d1, d2 = p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]
     x = rot[0, 0] * d0 + rot[1, 0] * d1 + rot[2, 0] * d2
     y = rot[0, 1] * d0 + rot[1, 1] * d1 + rot[2, 1] * d2
@@ -32,12 +35,13 @@ def gap(kind: int, centre: Any, rot: Any, size: Any, p: Any, radius: float) -> f
         ex = max(abs(x) - size[0], 0.0)
         ey = max(abs(y) - size[1], 0.0)
         ez = max(abs(z) - size[2], 0.0)
-        return np.sqrt(ex * ex + ey * ey + ez * ez) - radius
+        return ex * ex + ey * ey + ez * ez - radius * radius
     if kind == 1:
-        return np.sqrt(x * x + y * y + z * z) - size[0] - radius
+        return x * x + y * y + z * z - (size[0] + radius) ** 2
     er = max(np.sqrt(x * x + y * y) - size[0], 0.0)
     ez = max(abs(z) - size[1], 0.0)
-    return np.sqrt(er * er + ez * ez) - radius
+    return er * er + ez * ez - radius * radius
+
 
 @numba.njit(cache=True)
 def tabled(q: Any, tables: Any) -> int:
@@ -62,14 +66,16 @@ def tabled(q: Any, tables: Any) -> int:
 
 
 @numba.njit(cache=True)
-def forward(q: Any, joints: Any, rot: Any, pos: Any) -> None:
-    """Write every joint's world rotation and position at configuration `q` into `rot`, `pos` (joint 0: world)."""
+def forward(q: Any, joints: Any, rot: Any, pos: Any, local: Any) -> None:
+    """Write every joint's world rotation and position at configuration `q` into `rot`, `pos` (joint 0: world).
+
+    `local` is 3 x 3 scratch.
+    """
     parents, kinds, axes, iq, prot, ptrans = joints
     rot[0] = 0.0
     for r in range(3):
         rot[0, r, r] = 1.0
     pos[0] = 0.0
-    local = np.empty((3, 3))
     for j in range(1, len(parents)):
         # local = placement rotation * joint motion
         kind = kinds[j]
@@ -164,6 +170,7 @@ def judge(values: Any, stop: bool, base: Any, group: Any, continuous: Any, model
     world, iworld = np.empty((len(radii), 3)), np.empty((len(inner[1]), 3))
     owc, placed = np.empty((len(oradius), 3)), np.empty(len(oradius), dtype=np.bool_)
     near = np.empty(len(radii), dtype=np.int64)
+    local = np.empty((3, 3))
     for k in range(len(values)):
         q = qs[k]
         q[:] = base
@@ -179,7 +186,7 @@ def judge(values: Any, stop: bool, base: Any, group: Any, continuous: Any, model
             if stop and verdict == COLLIDES:
                 return k + 1
             continue
-        forward(q, joints, rot, pos)
+        forward(q, joints, rot, pos, local)
         place(ocentre, ojoint, rot, pos, owc)
         # An owner's spheres are placed only when something comes within its bounding ball.
         placed[:] = False
@@ -266,19 +273,23 @@ def classify(values: Any, stop: bool, floats: Any, ints: Any, head: Any, qs: Any
 
 
 @numba.njit(cache=True)
-def edge(a: Any, b: Any, resolution: float, stop: bool, floats: Any, ints: Any, head: Any) -> Any:
-    """Return the worst verdict on the straight edge from `a` to `b`, and the states not CLEAR.
+def edge(a: Any, b: Any, resolution: float, stop: bool, floats: Any, ints: Any, head: Any, verdicts: Any,
+         unclear: Any) -> tuple[int, int]:
+    """Judge the states on the straight edge from `a` to `b`; return (worst verdict, how many are not CLEAR).
 
     The states are a + (b - a) i / n for i = 1..n, no joint moving more than `resolution`
     between two; every STRIDE-th first, since most edges a search tries run into something
-    over many states in a row, and those find it with a fraction of the checks. Returns
-    (worst, verdicts, configurations) of the states judged not CLEAR; with `stop`, judging
-    ends at the first that COLLIDES.
+    over many states in a row, and those find it with a fraction of the checks. The verdicts
+    and configurations of the states not CLEAR go to the front of `verdicts` and `unclear`;
+    with `stop`, judging ends at the first that COLLIDES. If those hold fewer than n rows,
+    nothing is judged and the count returned is -n.
     """
     base, group, continuous, model = unpack(floats, ints, head)
     count = 1
     for i in range(len(a)):
         count = max(count, int(np.ceil(abs(b[i] - a[i]) / resolution)))
+    if count > len(verdicts):
+        return CLEAR, -count
     strided = count // STRIDE if count >= 2 * STRIDE else 0
     values = np.empty((count, len(a)))
     for m in range(count):
@@ -294,9 +305,14 @@ def edge(a: Any, b: Any, resolution: float, stop: bool, floats: Any, ints: Any, 
     qs = np.empty((count, len(base)))
     out = np.empty(count, dtype=np.int8)
     judged = judge(values, stop, base, group, continuous, model, qs, out)
-    unclear = out[:judged] != CLEAR
-    worst = min(out[:judged].min(), CLEAR)
-    return worst, out[:judged][unclear], qs[:judged][unclear]
+    worst, kept = CLEAR, 0
+    for k in range(judged):
+        if out[k] != CLEAR:
+            worst = min(worst, out[k])
+            verdicts[kept] = out[k]
+            unclear[kept] = qs[k]
+            kept += 1
+    return worst, kept
 
 
 # The filter's arrays, in the order `pack` stores and `unpack` reads them: name, dimensions, integer.
