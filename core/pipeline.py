@@ -37,7 +37,7 @@ from moveplan.core.goals import check_limits, joint_target, pose_error, tip_targ
 from moveplan.core.kinematics import solve_ik
 from moveplan.core.moveit_messages import known_joints
 from moveplan.core.moveit_request import MotionPlanRequest, load_motion_plan_request
-from moveplan.core.planning import PathResult, Validity, plan_path, seed_planner
+from moveplan.core.planning import PathResult, Validity, plan_path, repair_path, seed_planner
 from moveplan.core.robot import Robot
 from moveplan.core.scene import Scene, empty_scene, load_scene
 from moveplan.core.sphere_check import SphereFilter, UnsupportedJoint
@@ -53,9 +53,11 @@ logger = logging.getLogger(__name__)
 
 # The search checks edges every 0.05 rad; what is written is certified as the controller
 # interpolates it, with no robot point moving more than 5 mm between checked states. A
-# trajectory that fails certification is planned again with fine edge checks and a
-# closer-following time parameterisation.
-_ATTEMPTS = ((0.05, 0.05), (0.005, 0.01))  # (edge check resolution [rad], timing resample step [rad])
+# trajectory that fails certification has usually crossed a thin obstacle between two checked
+# states: the path's segments are checked again every 0.005 rad, those that fail are planned
+# again at that resolution, and the result is timed closer to the path.
+_COARSE_RAD, _FINE_RAD = 0.05, 0.005  # edge check resolutions
+_COARSE_STEP_RAD, _FINE_STEP_RAD = 0.05, 0.01  # timing resample steps
 _TF_RATE_HZ = 30.0
 
 
@@ -307,19 +309,34 @@ def _plan_step(
     # The search checks the hulls, not the meshes, unless the start or goal is free only under the meshes.
     ends = start[None, :] if spec.linear else np.array([start, goal])
     conservative = checks.conservative_available and bool(checks.free(ends, conservative=True).all())
-    for resolution, max_step in _ATTEMPTS:
-        path = search(Validity(partial(checks.state_free, conservative=conservative),
-                               partial(checks.edge_free, resolution=resolution, conservative=conservative)))
+
+    def checked(resolution: float) -> Validity:
+        return Validity(partial(checks.state_free, conservative=conservative),
+                        partial(checks.edge_free, resolution=resolution, conservative=conservative))
+
+    def certified(path: PathResult, max_step: float) -> tuple[JointTrajectory, NDArray[np.float64] | None]:
         mark = time.perf_counter()
         trajectory = time_parameterize(robot.joint_names, path.waypoints, max_velocity, max_acceleration,
                                        max_step=max_step)
         timed = time.perf_counter()
         hit = checks.first_collision_on_trajectory(trajectory)
         _add(stats, path, timed - mark, time.perf_counter() - timed)
-        if hit is None:
-            break
-        logger.debug("trajectory planned at %.3f rad collides when certified; planning finer", resolution)
-    else:
+        return trajectory, hit
+
+    path = search(checked(_COARSE_RAD))
+    trajectory, hit = certified(path, _COARSE_STEP_RAD)
+    if hit is not None and not spec.linear:
+        logger.debug("trajectory collides when certified; planning its colliding segments again, finer")
+        try:
+            path = repair_path(path.waypoints, robot.lower, robot.upper, checked(_FINE_RAD), planner, planning_time)
+            trajectory, hit = certified(path, _FINE_STEP_RAD)
+        except PlanningFailed:
+            pass  # a whole new search below
+    if hit is not None:
+        logger.debug("trajectory collides when certified; planning it all again, finer")
+        path = search(checked(_FINE_RAD))
+        trajectory, hit = certified(path, _FINE_STEP_RAD)
+    if hit is not None:
         # A path hugging an obstacle defeats smoothing, and one through a thin obstacle can pass
         # coarse edge checks. Last resort: plan with edges checked at the certification states
         # and stop at each waypoint, so every joint, the controller's quintics included, stays on

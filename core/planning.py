@@ -24,7 +24,7 @@ from ompl import util as ou
 from moveplan.core.errors import PlanningFailed, UsageError, known
 from moveplan.core.types import frozen_array
 
-__all__ = ["PLANNERS", "PathResult", "Validity", "interpolate", "plan_path", "seed_planner"]
+__all__ = ["PLANNERS", "PathResult", "Validity", "interpolate", "plan_path", "repair_path", "seed_planner"]
 
 logger = logging.getLogger(__name__)
 ou.setLogLevel(ou.LOG_ERROR)
@@ -98,6 +98,33 @@ def plan_path(
     if planner not in PLANNERS:
         raise UsageError(f"unknown planner '{planner}'; OMPL geometric planners: {known(PLANNERS)}")
     return _plan(start, goal, lower, upper, validity, planner, time_s)
+
+
+def repair_path(
+    waypoints: NDArray[np.float64],
+    lower: NDArray[np.float64],
+    upper: NDArray[np.float64],
+    validity: Validity,
+    planner: str,
+    time_s: float,
+) -> PathResult:
+    """Return `waypoints` with each segment `validity` rejects replaced by a path searched between its ends.
+
+    Raises PlanningFailed when a waypoint is not free (a shortcut can put one between two
+    checked states of an edge), or a segment's search finds no path within what remains of `time_s`.
+    """
+    began = time.perf_counter()
+    pieces, simplify_s = [waypoints[:1]], 0.0
+    for a, b in zip(waypoints[:-1], waypoints[1:], strict=True):
+        if validity.edge_free(a, b):
+            pieces.append(b[None, :])
+            continue
+        if not validity.state_free(b):
+            raise PlanningFailed("a waypoint of the path collides")
+        detour = _plan(a, b, lower, upper, validity, planner, max(0.0, time_s - (time.perf_counter() - began)))
+        pieces.append(detour.waypoints[1:])
+        simplify_s += detour.simplify_s
+    return PathResult(np.concatenate(pieces), planner, time.perf_counter() - began - simplify_s, simplify_s)
 
 
 def _plan(

@@ -1,0 +1,42 @@
+"""Joint-space search: a path that crossed a thin obstacle between checked states is repaired where it crossed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from moveplan.core.errors import PlanningFailed
+from moveplan.core.planning import Validity, interpolate, repair_path
+
+LOWER, UPPER = np.array([-1.0, -1.0]), np.array([2.0, 2.0])
+
+
+def _wall(resolution: float) -> Validity:
+    """Return checks in a plane with a wall 1 cm thick at x = 0.51, open above y = 0.8."""
+
+    def state_free(q: np.ndarray) -> bool:
+        return not (0.51 <= q[0] <= 0.52 and q[1] < 0.8)
+
+    def edge_free(a: np.ndarray, b: np.ndarray) -> bool:
+        return all(state_free(q) for q in interpolate(a, b, resolution)[1:])
+
+    return Validity(state_free, edge_free)
+
+
+def test_only_the_segment_through_the_wall_is_planned_again() -> None:
+    waypoints = np.array([[0.0, 0.0], [0.3, 0.1], [1.0, 0.0]])
+    coarse, fine = _wall(0.05), _wall(0.005)
+    assert all(coarse.edge_free(a, b) for a, b in zip(waypoints[:-1], waypoints[1:], strict=True))
+
+    repaired = repair_path(waypoints, LOWER, UPPER, fine, "RRTConnect", 1.0).waypoints
+
+    np.testing.assert_array_equal(repaired[:2], waypoints[:2])
+    np.testing.assert_array_equal(repaired[-1], waypoints[-1])
+    assert len(repaired) > 3
+    assert all(fine.edge_free(a, b) for a, b in zip(repaired[:-1], repaired[1:], strict=True))
+
+
+def test_a_waypoint_inside_the_wall_cannot_be_repaired() -> None:
+    waypoints = np.array([[0.0, 0.0], [0.515, 0.0], [1.0, 0.0]])
+    with pytest.raises(PlanningFailed, match="waypoint"):
+        repair_path(waypoints, LOWER, UPPER, _wall(0.005), "RRTConnect", 1.0)
