@@ -8,7 +8,7 @@ continuously differentiable and the rest of every segment is followed exactly.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
@@ -37,15 +37,24 @@ class BlendedPath:
     breaks: NDArray[np.float64]
     coefficients: NDArray[np.float64]
     turns: NDArray[np.float64]
+    # Per power k of (s - start), the coefficients of q, dq/ds and d2q/ds2 per piece, shape (5, 3, P, n).
+    _table: NDArray[np.float64] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         breaks = frozen_array(self.breaks, (None,), "breaks")
         coefficients = frozen_array(self.coefficients, (len(breaks) - 1, 5, None), "coefficients")
-        if np.any(np.diff(breaks) <= 0.0):
+        if (breaks[1:] <= breaks[:-1]).any():
             raise ValueError("breaks must be strictly increasing")
         object.__setattr__(self, "breaks", breaks)
         object.__setattr__(self, "coefficients", coefficients)
         object.__setattr__(self, "turns", frozen_array(self.turns, (len(coefficients),), "turns"))
+        powers = coefficients.transpose(1, 0, 2)
+        table = np.zeros((5, 3, *powers.shape[1:]))
+        table[:, 0] = powers
+        table[:4, 1] = powers[1:] * _FIRST
+        table[:3, 2] = powers[2:] * _SECOND
+        table.setflags(write=False)
+        object.__setattr__(self, "_table", table)
 
     @property
     def blend(self) -> NDArray[np.bool_]:
@@ -59,21 +68,31 @@ class BlendedPath:
 
     def __call__(self, s: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """Return the joint positions and their first and second derivatives by s at `s`, each (len(s), n)."""
-        x, (c0, c1, c2, c3, c4) = self._pieces(s)
-        first = c1 + x * (2 * c2 + x * (3 * c3 + x * 4 * c4))
-        second = 2 * c2 + x * (6 * c3 + x * 12 * c4)
-        return c0 + x * (c1 + x * (c2 + x * (c3 + x * c4))), first, second
+        positions, first, second = self._evaluate(s, self._table)
+        return positions, first, second
 
     def derivatives(self, s: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Return the first and second derivatives of the joint positions by s at `s`, each (len(s), n)."""
-        x, (_, c1, c2, c3, c4) = self._pieces(s)
-        return c1 + x * (2 * c2 + x * (3 * c3 + x * 4 * c4)), 2 * c2 + x * (6 * c3 + x * 12 * c4)
+        first, second = self._evaluate(s, self._table[:4, 1:])  # of degree <= 3
+        return first, second
 
-    def _pieces(self, s: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Return s from the start of its piece, shape (len(s), 1), and the piece's coefficients, (5, len(s), n)."""
-        piece = np.searchsorted(self.breaks, s, side="right") - 1
-        np.clip(piece, 0, len(self.coefficients) - 1, out=piece)
-        return (s - self.breaks[piece])[:, None], np.moveaxis(np.take(self.coefficients, piece, axis=0), 1, 0)
+    def _evaluate(self, s: NDArray[np.float64], table: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Return the polynomials of `table` (per power, shape (k, m, P, n)) at `s`, shape (m, len(s), n)."""
+        # Among the inner breaks only: the first and the last piece extend beyond the path's ends.
+        piece = np.searchsorted(self.breaks[1:-1], s, side="right")
+        x = (s - self.breaks[piece])[:, None]
+        terms = np.take(table, piece, axis=2)
+        result: NDArray[np.float64] = terms[-1] * x
+        for term in terms[-2:0:-1]:
+            result += term
+            result *= x
+        result += terms[0]
+        return result
+
+
+# What the derivatives by s multiply the coefficients of (s - start)^1..4 and ^2..4 by.
+_FIRST = np.array([1.0, 2.0, 3.0, 4.0])[:, None, None]
+_SECOND = np.array([2.0, 6.0, 12.0])[:, None, None]
 
 
 def blended_path(waypoints: npt.ArrayLike, max_step: float, fraction: float) -> BlendedPath:
@@ -92,18 +111,18 @@ def blended_path(waypoints: npt.ArrayLike, max_step: float, fraction: float) -> 
     """
     points = np.asarray(waypoints, dtype=np.float64)
     steps = points[1:] - points[:-1]
-    moves = np.max(np.abs(steps), axis=1)  # of the largest joint
-    if np.any(moves <= 1e-12):
+    moves = np.abs(steps).max(axis=1)  # of the largest joint
+    if (moves <= 1e-12).any():
         points = points[np.concatenate(([True], moves > 1e-12))]
         steps = points[1:] - points[:-1]
-        moves = np.max(np.abs(steps), axis=1)
+        moves = np.abs(steps).max(axis=1)
     if len(points) < 2:
         raise ValueError("a path needs two distinct waypoints")
-    lengths = np.sqrt(np.sum(steps * steps, axis=1))
+    lengths = np.sqrt((steps * steps).sum(axis=1))
     directions = steps / lengths[:, None]
     reach = np.minimum(fraction / np.ceil(moves / max_step), 0.5) * lengths
     turns = directions[1:] - directions[:-1]
-    turn = np.sqrt(np.sum(turns * turns, axis=1))
+    turn = np.sqrt((turns * turns).sum(axis=1))
     # Each blend is symmetric: the same arc length taken from both segments.
     half = np.zeros(len(points))
     half[1:-1] = np.where(turn > 1e-9, np.minimum(reach[:-1], reach[1:]), 0.0)
@@ -125,4 +144,4 @@ def blended_path(waypoints: npt.ArrayLike, max_step: float, fraction: float) -> 
     keep = span > 1e-12
     turned = np.zeros(2 * count - 1)
     turned[1::2] = turn
-    return BlendedPath(np.concatenate(([0.0], np.cumsum(span[keep]))), coefficients[keep], turned[keep])
+    return BlendedPath(np.concatenate(([0.0], span[keep].cumsum())), coefficients[keep], turned[keep])

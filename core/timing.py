@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from moveplan.core.blends import BlendedPath, blended_path
 from moveplan.core.errors import PlanningFailed
 from moveplan.core.topp import SpeedProfile, fastest_speeds
-from moveplan.core.trajectory import peak_rates
+from moveplan.core.trajectory import quintic_peak_rates
 from moveplan.core.types import JointTrajectory, frozen_array
 
 __all__ = ["time_parameterize"]
@@ -73,7 +73,7 @@ def time_parameterize(
             closer to the polyline than a cubic spline through those steps.
     """
     points = np.asarray(waypoints, dtype=np.float64)
-    if not np.any(np.abs(points - points[0]) > 1e-12):
+    if not (np.abs(points - points[0]) > 1e-12).any():
         zeros = np.zeros_like(points[:1])
         return JointTrajectory(joint_names, np.zeros(1), points[:1], zeros, zeros)
     path = blended_path(points, max_step, _CORNER_FRACTION)
@@ -84,18 +84,17 @@ def time_parameterize(
     profile = fastest_speeds(grid, first, second, straight, max_velocity, max_acceleration)
     law = _TimeLaw.of(profile)
     times = law.knots()
-    smooth = _sampled(joint_names, path, law, points[[0, -1]], times)
-    peak_v, peak_a = peak_rates(smooth)
-    excess = max(1.0, float(np.max(peak_v / max_velocity)), math.sqrt(float(np.max(peak_a / max_acceleration))))
+    positions, v, a = _sampled(path, law, points[[0, -1]], times)
+    peak_v, peak_a = quintic_peak_rates(times, positions, v, a)
+    excess = max(1.0, float((peak_v / max_velocity).max()), math.sqrt(float((peak_a / max_acceleration).max())))
     if excess > 1.0:
         logger.debug("interpolated trajectory peaks at %.4f of a limit; slowing it by %.4f", excess**2, excess)
     stretch = excess * (1.0 + _SAFETY)
     # Whole nanoseconds, as a message carries them. Each knot moves by less than a nanosecond
     # and its state moves along the motion with it, so the knots stay consistent with each other.
-    stretched = np.round(times * stretch * 1e9) / 1e9
+    stretched = np.rint(times * stretch * 1e9) / 1e9
     shift = (stretched / stretch - times)[:, None]
-    v, a = smooth.velocities, smooth.accelerations
-    return JointTrajectory(joint_names, stretched, smooth.positions + shift * (v + shift * a / 2),
+    return JointTrajectory(joint_names, stretched, positions + shift * (v + shift * a / 2),
                            (v + shift * a) / stretch, a / stretch**2)
 
 
@@ -103,11 +102,14 @@ def _grid(path: BlendedPath) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """Return grid points along the path and, per interval, whether it is straight."""
     # Turning by more than ~145 degrees (|turn| > 1.9), a blend's dq/ds comes close to 0 in
     # its middle (at a reversal, 0: a singular point of the time law); a finer grid follows it.
-    counts = np.where(path.blend, np.where(path.turns > 1.9, 2 * _GRID_PER_BLEND, _GRID_PER_BLEND), 1)
+    blend = path.blend
+    counts = np.where(blend, np.where(path.turns > 1.9, 2 * _GRID_PER_BLEND, _GRID_PER_BLEND), 1)
     piece = np.repeat(np.arange(len(counts)), counts)
-    within = np.arange(len(piece)) - np.repeat(np.cumsum(counts) - counts, counts)
-    starts = path.breaks[piece] + np.diff(path.breaks)[piece] * within / counts[piece]
-    return np.append(starts, path.length), ~path.blend[piece]
+    ends = counts.cumsum()
+    within = np.arange(ends[-1]) - (ends - counts)[piece]
+    breaks = path.breaks
+    starts = breaks[piece] + (breaks[1:] - breaks[:-1])[piece] * within / counts[piece]
+    return np.concatenate((starts, breaks[-1:])), ~blend[piece]
 
 
 @dataclass(frozen=True)
@@ -144,10 +146,10 @@ class _TimeLaw:
         steps = profile.s[1:] - profile.s[:-1]
         with np.errstate(divide="ignore"):
             durations = 2 * steps / (speeds[:-1] + speeds[1:])  # constant acceleration: mean speed
-        if not np.all(np.isfinite(durations)):
+        if not np.isfinite(durations).all():
             raise PlanningFailed("time parameterisation found the path blocked: the speed along it drops to 0")
         accelerations = (profile.squared_speeds[1:] - profile.squared_speeds[:-1]) / (2 * steps)
-        times = np.concatenate(([-_REST_S, 0.0], np.cumsum(durations), [_REST_S]))
+        times = np.concatenate(([-_REST_S, 0.0], durations.cumsum(), [_REST_S]))
         times[-1] += times[-2]
         ramp = min(_RAMP_S, max(_MIN_RAMP_S, _RAMP_FRACTION * float(times[-2])))
         rest = np.zeros(1)
@@ -157,8 +159,8 @@ class _TimeLaw:
     def knots(self) -> NDArray[np.float64]:
         """Return the times in [s] where the smoothed motion changes form (it starts at 0, ends a ramp late)."""
         grid = self.times[1:-1]
-        times = np.unique(np.concatenate((grid, grid + self.ramp)))
-        keep = np.concatenate(([True], times[1:] - times[:-1] > _MIN_KNOT_GAP_S))
+        times = np.sort(np.concatenate((grid, grid + self.ramp)))
+        keep = np.concatenate(([True], times[1:] - times[:-1] > _MIN_KNOT_GAP_S))  # drops repeats too
         times = times[keep]
         times[-1] = grid[-1] + self.ramp
         return times
@@ -174,7 +176,7 @@ class _TimeLaw:
         count = len(times)
         at = np.concatenate((times, (times[:-1] + times[1:]) / 2))
         at = np.concatenate((at, at - self.ramp))
-        interval = np.searchsorted(self.times, at, side="right") - 1
+        interval = np.searchsorted(self.times[1:], at, side="right")  # times[0], -1e9 s, precedes them all
         tau = at - self.times[interval]
         u = self.accelerations[interval]
         speed = self.speeds[interval] + u * tau
@@ -186,21 +188,17 @@ class _TimeLaw:
         # that tell two close knots apart.
         edge, middle = mean_speed[:count], mean_speed[count:]
         steps = (times[1:] - times[:-1]) / 6 * (edge[:-1] + 4 * middle + edge[1:])
-        return np.minimum(np.concatenate(([0.0], np.cumsum(steps))), self.s[-1]), edge, acceleration
+        return np.minimum(np.concatenate(([0.0], steps.cumsum())), self.s[-1]), edge, acceleration
 
 
 def _sampled(
-    joint_names: tuple[str, ...],
-    path: BlendedPath,
-    law: _TimeLaw,
-    ends: NDArray[np.float64],
-    times: NDArray[np.float64],
-) -> JointTrajectory:
-    """Return the smoothed motion at `times` [s], at rest exactly at `ends`."""
+    path: BlendedPath, law: _TimeLaw, ends: NDArray[np.float64], times: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Return the positions, velocities and accelerations of the smoothed motion at `times` [s], at rest at `ends`."""
     s, speed, acceleration = law.smoothed(times)
     positions, first, second = path(s)
     velocities = first * speed[:, None]
     accelerations = second * (speed**2)[:, None] + first * acceleration[:, None]
     positions[0], positions[-1] = ends
     velocities[0] = velocities[-1] = accelerations[0] = accelerations[-1] = 0.0
-    return JointTrajectory(joint_names, times, positions, velocities, accelerations)
+    return positions, velocities, accelerations

@@ -73,56 +73,42 @@ def fastest_speeds(
     delta = grid[1:] - grid[:-1]
     velocity = first[::2]
     cap = np.min((max_velocity / velocity) ** 2, axis=1)[:-1]
-    # Along a straight interval the limits are the same everywhere: |u| <= A = min_j a_j / |q'_j|,
-    # one line of gain 1 for both passes: x_{i+1} <= x_i + 2 delta A, x_i <= K_{i+1} + 2 delta A.
-    straight_step = np.where(straight, 2 * delta * np.min(max_acceleration / np.abs(velocity[:-1]), axis=1), np.inf)
-    curved = np.flatnonzero(~straight)
-    back = forward = _Lines(curved, np.zeros(0), np.zeros(0))
-    if len(curved):
-        grow, step, cap[curved] = _curved_bounds(first, second, delta, curved, cap[curved], max_acceleration)
-        # Backwards, braking at u = -A - B x_i must reach at most K_{i+1}: x_i <= (K_{i+1} + 2 delta A) / grow.
-        positive = grow > 0.0
-        back = _Lines.lowest(curved, np.where(positive, 1.0 / grow, 0.0), np.where(positive, step / grow, np.inf),
-                             np.append(cap, 0.0)[curved + 1])
-    controllable = _backward(cap.tolist(), straight_step.tolist(), back)
-    if len(curved):
-        forward = _Lines.lowest(curved, grow, step, np.array(controllable)[curved])
-    x = _forward(controllable, straight_step.tolist(), forward)
+    grow, step, cap = _step_lines(first, second, delta, cap, max_acceleration)
+    grows, steps = grow.tolist(), step.tolist()
+    x = _forward(_backward(cap.tolist(), grows, steps), grows, steps)
     if not np.all(np.isfinite(x)):
         raise PlanningFailed("time parameterisation found no motion along the path within the limits")
     return _with_switches(grid, x, straight, velocity, max_velocity, max_acceleration)
 
 
-def _curved_bounds(
+def _step_lines(
     first: NDArray[np.float64],
     second: NDArray[np.float64],
     delta: NDArray[np.float64],
-    rows: NDArray[np.intp],
     cap: NDArray[np.float64],
     max_acceleration: NDArray[np.float64],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """Return, for the intervals `rows`, the lines x_i -> x_{i+1} at the largest u, and the caps on x_i.
+    """Return per interval the lines x_i -> x_{i+1} at the largest u, and `cap` lowered to where u runs out.
 
     Each joint's limit holds at the start, the middle and the end of the interval:
     |q'' (x_i + 2 o u) + q' u| <= a at offset o reads |u + B x_i| <= A, so at the largest
     u = min(A - B x_i), x_{i+1} = min over the limits of (1 - 2 delta B) x_i + 2 delta A.
+    Along a straight interval B = 0: the lines are x_i + 2 delta A, the lowest of them the exact step.
     """
-    offset = delta[rows, None]
-    at_start, at_middle, at_end = 2 * rows, 2 * rows + 1, 2 * rows + 2
-    middle, end = second[at_middle], second[at_end]
-    d1 = np.concatenate((first[at_start], first[at_middle] + offset * middle, first[at_end] + 2 * offset * end), axis=1)
-    d2 = np.concatenate((second[at_start], middle, end), axis=1)
-    bound = np.tile(max_acceleration, 3)
-    reach = bound / np.abs(d1)  # A: the bound on u at x = 0
+    points = 2 * np.arange(len(delta))[:, None] + np.arange(3)  # the start, middle and end of each interval
+    d2 = second[points]
+    d1 = first[points] + (delta[:, None] * (0.0, 1.0, 2.0))[:, :, None] * d2  # (N, 3, n)
+    size = np.abs(d1)
+    reach = max_acceleration / size  # A: the bound on u at x = 0
     slope = d2 / d1  # B: how x shifts the bound on u
-    still = np.abs(d1) <= _STILL
+    still = size <= _STILL
     if still.any():
         # The joint's velocity is 0 there: its acceleration q'' x bounds x alone.
-        cap = np.minimum(cap, np.min(np.where(still, bound / np.abs(d2), np.inf), axis=1))
+        cap = np.minimum(cap, np.where(still, max_acceleration / np.abs(d2), np.inf).min(axis=(1, 2)))
         reach[still], slope[still] = np.inf, 0.0
-    cap = _acceleration_cap(reach, slope, cap)
-    two_delta = 2 * offset
-    return 1.0 - two_delta * slope, two_delta * reach, cap
+    reach, slope = reach.reshape(len(delta), -1), slope.reshape(len(delta), -1)
+    two_delta = 2 * delta[:, None]
+    return 1.0 - two_delta * slope, two_delta * reach, _acceleration_cap(reach, slope, cap)
 
 
 def _acceleration_cap(
@@ -131,84 +117,44 @@ def _acceleration_cap(
     """Return per interval the largest x <= cap for which some u meets every |u + B x| <= A.
 
     An upper bound A_k - B_k x on u and a lower one -A_j - B_j x cross where
-    (B_k - B_j) x = A_j + A_k; the smallest such x over all pairs is where u runs out.
+    (B_k - B_j) x = A_j + A_k: u runs out at 1 / the largest (B_k - B_j) / (A_j + A_k)
+    over all pairs (at least 0, from j = k; 1 / 0 = inf: it never does).
     """
-    gap = slope[:, None, :] - slope[:, :, None]  # B_k - B_j
-    crossing = (reach[:, None, :] + reach[:, :, None]) / gap
-    lowest: NDArray[np.float64] = np.min(np.where(gap > 0.0, crossing, np.inf), axis=(1, 2))
-    return np.minimum(cap, lowest)
-
-
-@dataclass(frozen=True)
-class _Lines:
-    """Per curved interval, the lines gain y + offset whose minimum bounds one pass step, flattened.
-
-    Attributes:
-        row: The interval of each line, non-decreasing, shape (L,).
-        gain: Shape (L,).
-        offset: Shape (L,).
-    """
-
-    row: NDArray[np.intp]
-    gain: NDArray[np.float64]
-    offset: NDArray[np.float64]
-
-    @classmethod
-    def lowest(
-        cls, rows: NDArray[np.intp], gain: NDArray[np.float64], offset: NDArray[np.float64], end: NDArray[np.float64]
-    ) -> _Lines:
-        """Return the lines of each row of `gain` and `offset` that can be lowest somewhere on [0, end].
-
-        The lowest at 0 and the lowest at `end` are kept, and any other line below both where
-        they cross: a line above the lowest at both ends of an interval stays above it in between.
-        """
-        index = np.arange(len(gain))
-        at_end = gain * end[:, None] + offset
-        low_start, low_end = np.argmin(offset, axis=1), np.argmin(at_end, axis=1)
-        g0, o0 = gain[index, low_start], offset[index, low_start]
-        g1, o1 = gain[index, low_end], offset[index, low_end]
-        cross = np.minimum(np.maximum((o1 - o0) / (g0 - g1), 0.0), end)
-        cross = np.where(np.isfinite(cross), cross, 0.0)
-        tent = np.minimum(g0 * cross + o0, g1 * cross + o1)
-        keep = gain * cross[:, None] + offset < tent[:, None]
-        keep[index, low_start] = True
-        keep[index, low_end] = True
-        row, column = np.nonzero(keep)
-        return cls(rows[row], gain[row, column], offset[row, column])
-
-    def lists(self, count: int) -> tuple[list[float], list[float], list[int]]:
-        """Return gains and offsets as lists, and per row i the index of its first line (row i ends at first[i + 1])."""
-        return self.gain.tolist(), self.offset.tolist(), np.searchsorted(self.row, np.arange(count + 1)).tolist()
+    rate = slope[:, None, :] - slope[:, :, None]  # B_k - B_j
+    rate /= reach[:, None, :] + reach[:, :, None]
+    largest: NDArray[np.float64] = rate.max(axis=(1, 2))
+    return np.minimum(cap, 1.0 / largest)
 
 
 # Python floats in plain loops: each step is a handful of scalar operations, which numpy
 # would make ten times slower.
 
-def _backward(cap: list[float], straight_step: list[float], lines: _Lines) -> list[float]:
+def _backward(cap: list[float], grows: list[list[float]], steps: list[list[float]]) -> list[float]:
     """Return the largest squared speeds K_i from which the motion can still stop at the end."""
-    gains, offsets, first = lines.lists(len(cap))
     controllable = [0.0] * (len(cap) + 1)
     bound = 0.0
     for i in range(len(cap) - 1, -1, -1):
-        best = min(cap[i], bound + straight_step[i])
-        for k in range(first[i], first[i + 1]):
-            value = gains[k] * bound + offsets[k]
-            if value < best:
-                best = value
+        best = cap[i]
+        for grow, step in zip(grows[i], steps[i], strict=True):
+            # Braking at u = -A - B x_i must reach at most K_{i+1}: grow x_i - step <= K_{i+1}
+            # (which bounds x_i only where grow > 0).
+            if grow > 0.0:
+                value = (bound + step) / grow
+                if value < best:
+                    best = value
         controllable[i] = bound = best
     return controllable
 
 
-def _forward(controllable: list[float], straight_step: list[float], lines: _Lines) -> NDArray[np.float64]:
+def _forward(controllable: list[float], grows: list[list[float]], steps: list[list[float]]) -> NDArray[np.float64]:
     """Return the squared speeds from rest, each step as fast as the limits and `controllable` allow."""
     count = len(controllable) - 1
-    gains, offsets, first = lines.lists(count)
     x = [0.0] * (count + 1)
     current = 0.0
     for i in range(count - 1):
-        best = min(controllable[i + 1], current + straight_step[i])
-        for k in range(first[i], first[i + 1]):
-            value = gains[k] * current + offsets[k]
+        best = controllable[i + 1]
+        for grow, step in zip(grows[i], steps[i], strict=True):
+            value = grow * current + step
             if value < best:
                 best = value
         x[i + 1] = current = max(best, 0.0)
@@ -226,17 +172,22 @@ def _with_switches(
     """Return the profile with the exact optimum along each straight interval: ramp up, cruise, ramp down."""
     i = np.flatnonzero(straight)
     speed = np.abs(velocity[i])
-    ramp = 2 * np.min(max_acceleration / speed, axis=1)  # dx/ds at full acceleration
-    cruise = np.min((max_velocity / speed) ** 2, axis=1)
-    start, end, x_start, x_end = grid[i], grid[i + 1], x[i], x[i + 1]
-    meet = (x_end - x_start + ramp * (start + end)) / (2 * ramp)  # where the two ramps cross
-    peak = x_start + ramp * (meet - start)
-    cruising = peak > cruise
-    up = np.minimum(np.maximum(np.where(cruising, start + (cruise - x_start) / ramp, meet), start), end)
-    down = np.minimum(np.maximum(np.where(cruising, end - (cruise - x_end) / ramp, meet), start), end)
-    top = np.minimum(peak, cruise)
-    s = np.concatenate((grid, up, down))
-    squared = np.concatenate((x, top, top))
+    ramps = 2 * np.min(max_acceleration / speed, axis=1)  # dx/ds at full acceleration
+    cruises = np.min((max_velocity / speed) ** 2, axis=1)
+    at, squares = grid.tolist(), x.tolist()
+    ups, downs, tops = [], [], []
+    for k, ramp, cruise in zip(i.tolist(), ramps.tolist(), cruises.tolist(), strict=True):
+        start, end, x_start, x_end = at[k], at[k + 1], squares[k], squares[k + 1]
+        meet = (x_end - x_start + ramp * (start + end)) / (2 * ramp)  # where the two ramps cross
+        peak = x_start + ramp * (meet - start)
+        up = down = meet
+        if peak > cruise:
+            up, down = start + (cruise - x_start) / ramp, end - (cruise - x_end) / ramp
+        ups.append(min(max(up, start), end))
+        downs.append(min(max(down, start), end))
+        tops.append(min(peak, cruise))
+    s = np.concatenate((grid, ups, downs))
+    squared = np.concatenate((x, tops, tops))
     order = np.argsort(s, kind="stable")
     s, squared = s[order], squared[order]
     # A switch at (or within rounding of) a grid point adds nothing: keep the grid point.

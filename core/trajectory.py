@@ -14,6 +14,7 @@ trajectory's start (a MoveIt goal has header.stamp 0, "start now").
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,7 +23,7 @@ from numpy.typing import NDArray
 
 from moveplan.core.types import JointTrajectory, frozen_array
 
-__all__ = ["PointBefore", "peak_rates", "sample", "shortest_angular_distance"]
+__all__ = ["PointBefore", "peak_rates", "quintic_peak_rates", "sample", "shortest_angular_distance"]
 
 Samples = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
 
@@ -107,26 +108,41 @@ def sample(
 
 
 def peak_rates(trajectory: JointTrajectory) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Return per joint the largest |velocity| and |acceleration| anywhere along the interpolation.
+    """Return per joint the largest |velocity| and |acceleration| anywhere along the interpolation."""
+    return quintic_peak_rates(trajectory.times_s, trajectory.positions, trajectory.velocities,
+                              trajectory.accelerations)
 
-    Exact (to rounding) for the controller's quintic segments: the acceleration of a
-    segment is a cubic, largest at an end or where the jerk (a quadratic) is zero; between
-    those points it is monotonic, so its zeros, where the velocity peaks, are found by a
-    safeguarded Newton iteration inside each bracket where it changes sign.
+
+# A joint at rest over a segment has no jerk: its quadratic's roots are 0 / 0.
+@np.errstate(divide="ignore", invalid="ignore")
+def quintic_peak_rates(
+    knots: NDArray[np.float64], p: NDArray[np.float64], v: NDArray[np.float64], a: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Return per joint the largest |velocity| and |acceleration| of the quintics through the points, as JTC's.
+
+    Exact (to rounding): the acceleration of a segment is a cubic, largest at an end or
+    where the jerk (a quadratic) is zero; between those points it is monotonic, so its
+    zeros, where the velocity peaks, are found by a safeguarded Newton iteration inside
+    each bracket where it changes sign.
+
+    Args:
+        knots: Times of the points in [s], strictly increasing, shape (N,).
+        p: Positions, shape (N, n).
+        v: Velocities, shape (N, n).
+        a: Accelerations, shape (N, n).
     """
-    knots, p = trajectory.times_s, trajectory.positions
     if len(knots) == 1:
-        return np.abs(trajectory.velocities[0]), np.abs(trajectory.accelerations[0])
-    v, a = trajectory.velocities, trajectory.accelerations
+        return np.abs(v[0]), np.abs(a[0])
     h = (knots[1:] - knots[:-1])[:, None]
     v0, a0 = v[:-1], a[:-1]
-    c3, c4, c5 = _quintic(h, p[1:] - p[:-1], v0, v[1:], a0, a[1:])
-    jerk = (6 * c3, 24 * c4, 60 * c5)
-    acceleration = (a0, jerk[0], jerk[1] / 2, jerk[2] / 3)
-    velocity = (v0, a0, acceleration[1] / 2, acceleration[2] / 3, acceleration[3] / 4)
+    jerk = _quintic(h, p[1:] - p[:-1], v0, v[1:], a0, a[1:]) * _JERK  # coefficients of x^0..2
+    higher_a = jerk / _POWER  # the acceleration's coefficients of x^1..3 (of x^0: a0)
+    higher_v = higher_a / (_POWER + 1)  # the velocity's of x^2..4 (of x^0 and x^1: v0 and a0)
+    acceleration, velocity = (a0, *higher_a), (v0, a0, *higher_v)
     r1, r2 = (np.where((r > 0.0) & (r < h), r, 0.0) for r in _quadratic_roots(jerk[2], jerk[1], jerk[0]))
-    inner = np.stack((np.minimum(r1, r2), np.maximum(r1, r2)))  # the jerk's zeros in the segment, else 0
-    bounds = np.concatenate((np.zeros_like(inner[:1]), inner, np.broadcast_to(h, v0.shape)[None]))
+    bounds = np.zeros((4, *v0.shape))  # 0, the jerk's zeros in the segment (else 0), h
+    bounds[1], bounds[2], bounds[3] = np.minimum(r1, r2), np.maximum(r1, r2), h
+    inner = bounds[1:3]
     # At the knots the segment meets its given velocity and acceleration; between, evaluate.
     a = np.concatenate((a0[None], _horner(acceleration, inner), a[None, 1:]))
     v = np.concatenate((v0[None], _horner(velocity, inner), v[None, 1:]))
@@ -141,49 +157,58 @@ def peak_rates(trajectory: JointTrajectory) -> tuple[NDArray[np.float64], NDArra
     crossing = (a[:-1] * a[1:] < 0.0) & (reach > peak_v * (1.0 + 1e-12))
     if crossing.any():
         _, segment, joint = np.nonzero(crossing)
-        roots = _monotone_root(tuple(c[segment, joint] for c in acceleration), bounds[:-1][crossing],
-                               bounds[1:][crossing], a[:-1][crossing], a[1:][crossing])
-        np.maximum.at(peak_v, joint, np.abs(_horner(tuple(c[segment, joint] for c in velocity), roots)))
+        brackets = np.stack((v0[segment, joint], a0[segment, joint], *higher_a[:, segment, joint],
+                             bounds[:-1][crossing], bounds[1:][crossing], a[:-1][crossing], a[1:][crossing]), axis=1)
+        peaks = peak_v.tolist()
+        for j, bracket in zip(joint.tolist(), brackets.tolist(), strict=True):
+            peaks[j] = max(peaks[j], abs(_velocity_extreme(*bracket)))
+        peak_v = np.array(peaks)
     return peak_v, peak_a
 
 
-def _monotone_root(
-    coefficients: tuple[NDArray[np.float64], ...],
-    lo: NDArray[np.float64],
-    hi: NDArray[np.float64],
-    f_lo: NDArray[np.float64],
-    f_hi: NDArray[np.float64],
-) -> NDArray[np.float64]:
-    """Return the zero of each polynomial sum_k coefficients[k] x^k, monotonic on [lo, hi] with a sign change."""
-    derivative = tuple(k * c for k, c in enumerate(coefficients))[1:]
-    x = lo - f_lo * (hi - lo) / (f_hi - f_lo)  # false position: exact for a linear polynomial
+# The jerk's coefficients from c3..c5, and the powers of x they multiply in the acceleration.
+_JERK = np.array([6.0, 24.0, 60.0])[:, None, None]
+_POWER = np.array([1.0, 2.0, 3.0])[:, None, None]
+
+
+# Python floats: a few brackets of a few Newton steps each, which numpy would make ten times slower.
+def _velocity_extreme(
+    v0: float, a0: float, a1: float, a2: float, a3: float, lo: float, hi: float, f_lo: float, f_hi: float
+) -> float:
+    """Return the velocity v0 + a0 x + a1 x^2 / 2 + a2 x^3 / 3 + a3 x^4 / 4 where the acceleration is 0.
+
+    The acceleration a0 + a1 x + a2 x^2 + a3 x^3 is monotonic on [lo, hi], where it goes from
+    f_lo to f_hi, of the other sign; its zero is found by Newton's method, kept in the bracket.
+    """
+    x = lo - f_lo * (hi - lo) / (f_hi - f_lo)  # false position: exact for a linear acceleration
     rising = f_hi > 0.0
     # The velocity is flat at the zero: locating it within 1e-7 of the bracket leaves an error
     # in the velocity of ~1e-14 of the bracket's velocity change.
     tolerance = 1e-7 * (hi - lo)
     for _ in range(64):  # Newton converges in a few steps; bisection, its fallback, within 24
-        f = _horner(coefficients, x)
-        left = (f < 0.0) == rising  # the zero lies right of x
-        lo, hi = np.where(left, x, lo), np.where(left, hi, x)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            newton = x - f / _horner(derivative, x)
-        step = np.where((newton >= lo) & (newton <= hi), newton, (lo + hi) / 2)
-        converged = np.abs(step - x) <= tolerance
+        f = a0 + x * (a1 + x * (a2 + x * a3))
+        if (f < 0.0) == rising:  # the zero lies right of x
+            lo = x
+        else:
+            hi = x
+        jerk = a1 + x * (2 * a2 + x * (3 * a3))
+        newton = x - f / jerk if jerk else math.inf
+        step = newton if lo <= newton <= hi else (lo + hi) / 2
+        converged = abs(step - x) <= tolerance
         x = step
-        if converged.all():
+        if converged:
             break
-    return x
+    return v0 + x * (a0 + x * (a1 / 2 + x * (a2 / 3 + x * (a3 / 4))))
 
 
 def _quadratic_roots(
     a: NDArray[np.float64], b: NDArray[np.float64], c: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Return the real roots of a x^2 + b x + c elementwise (NaN or inf where there are none)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        root = np.sqrt(b * b - 4 * a * c)
-        # The numerically stable form; with a = 0 the second root is the linear one, -c / b.
-        q = -0.5 * (b + np.copysign(root, b))
-        return q / a, c / q
+    """Return the real roots of a x^2 + b x + c elementwise (NaN or inf where there are none: ignore the warnings)."""
+    root = np.sqrt(b * b - 4 * a * c)
+    # The numerically stable form; with a = 0 the second root is the linear one, -c / b.
+    q = -0.5 * (b + np.copysign(root, b))
+    return q / a, c / q
 
 
 def _or_zeros(values: NDArray[np.float64] | None, n: int) -> NDArray[np.float64]:
@@ -284,7 +309,8 @@ def _quintic(
     """Return c3, c4, c5 (stacked) of the quintic with c0..c2 = p0, v0, a0 / 2 reaching p0 + dp, v1, a1 after h."""
     h2 = h * h
     terms = np.stack((dp, v0 * h, v1 * h, a0 * h2, a1 * h2))
-    return np.tensordot(_QUINTIC, terms, axes=1) / np.stack((2 * h2 * h, 2 * h2 * h2, 2 * h2 * h2 * h))
+    scaled: NDArray[np.float64] = np.dot(_QUINTIC, terms.reshape(5, -1)).reshape(terms[:3].shape)
+    return scaled / np.stack((2 * h2 * h, 2 * h2 * h2, 2 * h2 * h2 * h))
 
 
 # c3 h^3, c4 h^4, c5 h^5 times 2, from dp, v0 h, v1 h, a0 h^2, a1 h^2.

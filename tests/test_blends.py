@@ -35,6 +35,15 @@ def test_pieces_join_with_equal_position_direction_and_curvature(zigzag: tuple[n
         np.testing.assert_allclose(left, right, atol=tolerance)
 
 
+def test_derivatives_are_those_of_the_full_evaluation(zigzag: tuple[np.ndarray, BlendedPath]) -> None:
+    _, path = zigzag
+    s = np.linspace(-0.1, path.length + 0.1, 301)
+    _, first, second = path(s)
+    derivative, curvature = path.derivatives(s)
+    np.testing.assert_allclose(derivative, first, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(curvature, second, rtol=0, atol=1e-9)
+
+
 def test_corners_are_blends_and_the_rest_is_straight(zigzag: tuple[np.ndarray, BlendedPath]) -> None:
     waypoints, path = zigzag
     np.testing.assert_array_equal(path.blend, [False, True, False, True, False])
