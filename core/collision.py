@@ -39,6 +39,10 @@ logger = logging.getLogger(__name__)
 _HULLS: dict[tuple[str, tuple[float, ...]], coal.ConvexBase] = {}
 # The robot's own geometry by (URDF, config folder, package path, mode): reading its meshes costs
 # ~80 ms, and a benchmark builds a checker per problem for one robot.
+# Shapes closer than this count as touching. With no margin, coal's test as pinocchio asks it
+# called the Panda hand's convex hull free while it sank 62 um into a box (tests/test_collision.py);
+# with a positive margin it finds that contact, and is no slower.
+_MARGIN_M = 1e-6
 _ROBOT_GEOMETRY: dict[tuple[str, str, tuple[Path, ...], str], pin.GeometryModel] = {}
 
 
@@ -210,6 +214,9 @@ class CollisionChecker:
         self.data = geom.createData()
         # A broadphase (AABB tree) culls most pairs: 3-4x faster per state than testing each pair.
         self._pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(model, geom, 1)
+        for data in (self.data, *self._pool.getGeometryDatas()):
+            for request in data.collisionRequests:
+                request.security_margin = _MARGIN_M
         self._check_fixed_pairs(fixed_pairs, robot_count)
 
     def _placed(self, obj: CollisionObject, source: str) -> pin.GeometryObject:
@@ -228,6 +235,7 @@ class CollisionChecker:
         pin.updateGeometryPlacements(self.robot.model, self.robot.data, self.geometry, self.data,
                                      self.robot.neutral())
         request = coal.CollisionRequest()
+        request.security_margin = _MARGIN_M
         for i, j in pairs:
             if i < robot_count and j < robot_count:
                 continue  # links on one joint are rigidly attached: their contact is by design

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import TABLE_SCENE
+from conftest import ROOT, TABLE_SCENE
 
 from moveplan.core.collision import CollisionChecker
+from moveplan.core.config import load_robot_config
 from moveplan.core.errors import StartInCollision
 from moveplan.core.robot import Robot
 from moveplan.core.scene import load_scene
@@ -40,3 +41,16 @@ def test_object_through_the_fixed_base_is_reported_once_at_load(ur10e: Robot) ->
     post = CollisionObject("post", Shape("cylinder", (0.05, 1.0)), np.eye(4))
     with pytest.raises(StartInCollision, match="post"):
         CollisionChecker(ur10e, (post,))
+
+
+def test_a_hull_sinking_a_fraction_of_a_millimetre_into_a_box_collides_as_its_mesh_does() -> None:
+    robot = Robot(load_robot_config(ROOT / "configs" / "panda"))
+    scene = load_scene(ROOT / "tests" / "data" / "mbm" / "table_pick_scene0060.yaml", robot)
+    # The hand 62 um inside the box Object4: coal, asked with no margin, called its hull free here.
+    values = np.array([-0.03891427999411499, 1.1206303043892154, -1.7833035197227367, -1.278975843379327,
+                       -0.11043559560381563, 2.8973192103494365, -0.19995617263938992])
+    q = robot.configuration(values, robot.neutral())
+    for geometry in ("convex", "exact"):
+        checker = CollisionChecker(robot, scene.objects, scene.source, geometry=geometry, allowed=scene.allowed)
+        assert not checker.free_batch(q[:, None])[0], geometry
+        assert checker.colliding_pair(q) == ("panda_hand", "Object4")
