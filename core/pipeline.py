@@ -364,7 +364,7 @@ def _plan_step(
     return StepResult(
         name=spec.name,
         goal=_describe(spec.goal),
-        planner=planner,
+        planner=path.planner,
         planning_time_s=time.perf_counter() - began,
         trajectory=trajectory,
         fraction=fraction,

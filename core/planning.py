@@ -35,6 +35,15 @@ PLANNERS = tuple(
 )
 
 _RANGE_RAD = 1.0  # the longest edge a tree-growing planner adds in one step
+# RRTConnect grows each tree by whole edges of up to a range toward uniform samples. From a goal deep
+# in a shelf almost none is free (MotionBenchMaker bookshelf 0093: 0 of 1,000 at 1 rad, 11 % at
+# 0.1 rad), so the goal tree stays at 2-11 states while the start tree grows to thousands, and no
+# range, intermediate states or mesh checks fix that within 1 s. LBKPIECE1 expands from the least
+# explored cells and checks edges only on candidate paths: it solves those goals in tens of ms.
+# RRTConnect searches alone for the first part of the budget, where it solves all but such
+# problems; LBKPIECE1 then searches on.
+_FALLBACK = {"RRTConnect": "LBKPIECE1"}
+_FALLBACK_AFTER = 0.2  # of the planning time
 _seeded: list[int] = []
 
 
@@ -127,6 +136,17 @@ def repair_path(
     return PathResult(np.concatenate(pieces), planner, time.perf_counter() - began - simplify_s, simplify_s)
 
 
+def _planner(name: str, info: ob.SpaceInformation) -> ob.Planner:
+    """Return OMPL planner `name` on `info`, its range (if it has one) set."""
+    search = getattr(og, name)(info)
+    if hasattr(search, "setRange"):
+        # OMPL's default, a fifth of the space's diagonal (2.4 rad for a Panda), fails more often
+        # in clutter: 5 of 60 MotionBenchMaker bookshelf runs in 1 s, against 1 with 1 rad, which
+        # is as fast or faster on the box and table scenes too.
+        search.setRange(_RANGE_RAD)
+    return search
+
+
 def _plan(
     start: NDArray[np.float64],
     goal: NDArray[np.float64],
@@ -167,19 +187,19 @@ def _plan(
             state[i] = float(value)
         endpoints.append(state)
     setup.setStartAndGoalStates(endpoints[0], endpoints[1])
-    search = getattr(og, planner)(info)
-    if hasattr(search, "setRange"):
-        # OMPL's default, a fifth of the space's diagonal (2.4 rad for a Panda), fails more often
-        # in clutter: 5 of 60 MotionBenchMaker bookshelf runs in 1 s, against 1 with 1 rad, which
-        # is as fast or faster on the box and table scenes too.
-        search.setRange(_RANGE_RAD)
-    setup.setPlanner(search)
+    setup.setPlanner(_planner(planner, info))
 
     began = time.perf_counter()
     if validity.edge_free(start, goal):
         # A free straight segment is what any search plus shortcutting converges to.
         return PathResult(np.array([start, goal]), planner, time.perf_counter() - began, 0.0)
-    status = setup.solve(ob.timedPlannerTerminationCondition(time_s))
+    fallback = _FALLBACK.get(planner)
+    status = setup.solve(ob.timedPlannerTerminationCondition(time_s * _FALLBACK_AFTER if fallback else time_s))
+    if fallback and not setup.haveExactSolutionPath():
+        setup.getProblemDefinition().clearSolutionPaths()  # RRTConnect's approximate one
+        setup.setPlanner(_planner(fallback, info))
+        planner = f"{planner}+{fallback}"
+        status = setup.solve(ob.timedPlannerTerminationCondition(max(0.0, time_s - (time.perf_counter() - began))))
     planning_s = time.perf_counter() - began
     if not setup.haveExactSolutionPath():
         raise PlanningFailed(f"{planner} found no path in {time_s:g} s ({status})")

@@ -1,12 +1,13 @@
-"""Joint-space search: a path that crossed a thin obstacle between checked states is repaired where it crossed."""
+"""Joint-space search: RRTConnect's fallback, and a path that crossed a thin obstacle repaired where it crossed."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from moveplan.core import planning
 from moveplan.core.errors import PlanningFailed
-from moveplan.core.planning import Validity, interpolate, repair_path
+from moveplan.core.planning import Validity, interpolate, plan_path, repair_path
 
 LOWER, UPPER = np.array([-1.0, -1.0]), np.array([2.0, 2.0])
 
@@ -40,3 +41,23 @@ def test_a_waypoint_inside_the_wall_cannot_be_repaired() -> None:
     waypoints = np.array([[0.0, 0.0], [0.515, 0.0], [1.0, 0.0]])
     with pytest.raises(PlanningFailed, match="waypoint"):
         repair_path(waypoints, LOWER, UPPER, _wall(0.005), "RRTConnect", 1.0)
+
+
+def test_rrtconnect_hands_what_it_has_not_solved_to_its_fallback(monkeypatch: pytest.MonkeyPatch) -> None:
+    def free(q: np.ndarray) -> bool:  # a wall at x = 0 with a gap at |y| < 0.1
+        return bool(abs(q[0]) > 0.05 or abs(q[1]) < 0.1)
+
+    def edge(a: np.ndarray, b: np.ndarray) -> bool:
+        return all(free(q) for q in interpolate(a, b, 0.01))
+
+    validity = Validity(free, edge)
+    start, goal = np.array([-0.5, 0.8]), np.array([0.5, 0.8])
+    lower, upper = np.array([-1.0, -1.0]), np.array([1.0, 1.0])
+    monkeypatch.setattr(planning, "_FALLBACK_AFTER", 1e-6)  # RRTConnect stops at once, unsolved
+    path = plan_path(start, goal, lower, upper, validity, "RRTConnect", 1.0)
+    assert path.planner == "RRTConnect+LBKPIECE1"
+    np.testing.assert_array_equal(path.waypoints[[0, -1]], [start, goal])
+    assert all(edge(a, b) for a, b in zip(path.waypoints[:-1], path.waypoints[1:], strict=True))
+    monkeypatch.setattr(planning, "_FALLBACK", {})
+    with pytest.raises(PlanningFailed):
+        plan_path(start, goal, lower, upper, validity, "RRTConnect", 0.0)
