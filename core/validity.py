@@ -15,7 +15,6 @@ close that no point of the robot moves more than `step_m` between two of them
 
 from __future__ import annotations
 
-import math
 from typing import Protocol
 
 import numpy as np
@@ -23,6 +22,7 @@ from numpy.typing import NDArray
 
 from moveplan.core import certify
 from moveplan.core.collision import CollisionChecker
+from moveplan.core.planning import interpolate
 from moveplan.core.robot import Robot
 from moveplan.core.sphere_check import CLEAR, COLLIDES, MAYBE
 from moveplan.core.types import JointTrajectory
@@ -105,9 +105,8 @@ class MotionChecker:
         """
         final = conservative or len(self._stages) == 1
         if self.spheres is None:
-            count = max(1, math.ceil(float(np.abs(b - a).max()) / resolution))
-            states = a + (b - a) * (np.arange(1, count + 1) / count)[:, None]
-            worst, verdict, q = MAYBE, np.full(count, MAYBE), self.robot.configurations(states, self.base).T
+            states = interpolate(a, b, resolution)[1:]
+            worst, verdict, q = MAYBE, np.full(len(states), MAYBE), self.robot.configurations(states, self.base).T
         else:
             worst, verdict, q = self.spheres.edge(a, b, resolution, stop=final)
         if worst == CLEAR:

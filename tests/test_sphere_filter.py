@@ -16,6 +16,7 @@ from moveplan.core.robot import Robot
 from moveplan.core.scene import load_scene
 from moveplan.core.sphere_check import CLEAR, COLLIDES, SphereFilter
 from moveplan.core.sphere_model import fit_geometry, robot_spheres
+from moveplan.core.validity import MotionChecker
 
 PANDA = ROOT / "configs" / "panda"
 MBM = ROOT / "tests" / "data" / "mbm"
@@ -111,6 +112,20 @@ def test_an_edge_is_judged_at_every_state_between_its_ends_once(
         np.testing.assert_allclose(unclear_q[order], q[verdict != CLEAR][np.lexsort(q[verdict != CLEAR].T)])
         stopped = spheres.edge(a, b, resolution, stop=True)
         assert stopped[0] == worst and (worst != COLLIDES or stopped[1][-1] == COLLIDES)
+
+
+def test_edges_and_states_are_judged_alike_with_and_without_the_spheres_and_hulls(
+    panda_in_box: tuple[Robot, CollisionChecker, CollisionChecker, SphereFilter]
+) -> None:
+    robot, checker, hulls, spheres = panda_in_box
+    staged = MotionChecker(robot, checker, robot.neutral(), spheres, hulls)
+    meshes_only = MotionChecker(robot, checker, robot.neutral())
+    rng = np.random.default_rng(5)
+    starts = rng.uniform(robot.lower, robot.upper, size=(60, robot.dof))
+    ends = np.clip(starts + rng.normal(scale=0.3, size=starts.shape), robot.lower, robot.upper)
+    for a, b in zip(starts, ends, strict=True):
+        assert staged.edge_free(a, b, 0.05) == meshes_only.edge_free(a, b, 0.05)
+        assert staged.state_free(b) == meshes_only.state_free(b)
 
 
 def test_fitted_spheres_are_cached_on_disk_and_a_corrupt_cache_is_rebuilt(
