@@ -123,7 +123,7 @@ def repair_path(
     checked states of an edge), or a segment's search finds no path within what remains of `time_s`.
     """
     began = time.perf_counter()
-    pieces, simplify_s = [waypoints[:1]], 0.0
+    pieces, simplify_s, used = [waypoints[:1]], 0.0, planner
     for a, b in zip(waypoints[:-1], waypoints[1:], strict=True):
         if validity.edge_free(a, b):
             pieces.append(b[None, :])
@@ -133,7 +133,9 @@ def repair_path(
         detour = _plan(a, b, lower, upper, validity, planner, max(0.0, time_s - (time.perf_counter() - began)))
         pieces.append(detour.waypoints[1:])
         simplify_s += detour.simplify_s
-    return PathResult(np.concatenate(pieces), planner, time.perf_counter() - began - simplify_s, simplify_s)
+        if detour.planner != planner:
+            used = detour.planner  # the fallback found this detour
+    return PathResult(np.concatenate(pieces), used, time.perf_counter() - began - simplify_s, simplify_s)
 
 
 def _planner(name: str, info: ob.SpaceInformation) -> ob.Planner:
