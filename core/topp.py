@@ -123,7 +123,10 @@ def _acceleration_cap(
     rate = slope[:, None, :] - slope[:, :, None]  # B_k - B_j
     rate /= reach[:, None, :] + reach[:, :, None]
     largest: NDArray[np.float64] = rate.max(axis=(1, 2))
-    return np.minimum(cap, 1.0 / largest)
+    # The j = k pairs make `largest` at least 0, but a straight interval gives -0.0, and
+    # 1 / -0.0 is -inf: compare instead of dividing by the sign.
+    never = largest <= 0.0
+    return np.minimum(cap, np.where(never, np.inf, 1.0 / np.where(never, 1.0, largest)))
 
 
 # Python floats in plain loops: each step is a handful of scalar operations, which numpy
