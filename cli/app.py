@@ -1,6 +1,6 @@
 """The `moveplan` command line: parse flags, make one core call, render, exit with the documented code.
 
-Heavy libraries (pinocchio, coal, ompl, toppra, mcap) are imported inside the
+Heavy libraries (pinocchio, coal, ompl, mcap) are imported inside the
 commands, so `moveplan --help` stays fast.
 """
 
