@@ -11,7 +11,7 @@ from conftest import ROOT, Cli
 
 from moveplan.core.benchmark import Run, find_problems, summarize
 
-MBM = ROOT / "tests" / "data" / "mbm"
+MBM = ROOT / "tests" / "data" / "mbm" / "problems" / "box_panda"
 
 
 @pytest.fixture()

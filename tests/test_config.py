@@ -17,7 +17,7 @@ from moveplan.core.robot import Robot
 from moveplan.core.xacro import PackagePath, parse_xacro_args
 
 PANDA = ROOT / "configs" / "panda"
-MBM_PANDA = ROOT.parent / "shared" / "benchmarks" / "mbm" / "panda_robot"
+MBM_PANDA = ROOT / "tests" / "data" / "mbm" / "panda_robot"
 
 URDF = """<?xml version="1.0"?>
 <robot name="arm">
@@ -217,7 +217,6 @@ def test_xacro_find_resolves_packages_on_the_package_path(tmp_path: Path) -> Non
 # --- the mbm Panda folder and configs/panda ---------------------------------------------------
 
 
-@pytest.mark.skipif(not MBM_PANDA.is_dir(), reason="shared/benchmarks is not beside the repository")
 def test_the_motionbenchmaker_panda_folder_loads_without_moveplan_yaml() -> None:
     config = load_robot_config(MBM_PANDA)
     assert config.planning["group"] == "panda_arm" and config.missing_acceleration_limits() == ()

@@ -22,7 +22,7 @@ from moveplan.core.robot import Robot
 from moveplan.core.scene import load_scene
 
 MBM = ROOT / "tests" / "data" / "mbm"
-SCENE, REQUEST = MBM / "scene0001.yaml", MBM / "request0001.yaml"
+SCENE, REQUEST = MBM / "problems" / "box_panda" / "scene0001.yaml", MBM / "problems" / "box_panda" / "request0001.yaml"
 START = [0, -0.785, 0, -2.356, 0, 1.571, 0.785]
 GOAL = [0.4534448383669427, 1.7628, 0.1941262264518609, -0.8667848896139277, -0.3798524112731043,
         2.606927984171601, -0.1898611792470702]

@@ -47,7 +47,7 @@ def test_every_point_of_every_shape_lies_inside_its_spheres(config: Path) -> Non
 @pytest.fixture(scope="module")
 def panda_in_box() -> tuple[Robot, CollisionChecker, CollisionChecker, SphereFilter]:
     robot = Robot(load_robot_config(PANDA))
-    scene = load_scene(MBM / "scene0001.yaml", robot)
+    scene = load_scene(MBM / "problems" / "box_panda" / "scene0001.yaml", robot)
     checker = CollisionChecker(robot, scene.objects, scene.source, geometry="exact", allowed=scene.allowed)
     hulls = CollisionChecker(robot, scene.objects, scene.source, geometry="convex", allowed=scene.allowed)
     spheres = SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed, hulls=hulls.robot_geometry)
