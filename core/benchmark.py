@@ -2,9 +2,8 @@
 
 A problem is a MoveIt PlanningScene + MotionPlanRequest pair (`sceneNNNN.yaml`,
 `requestNNNN.yaml`, as MotionBenchMaker writes them) or a moveplan task file.
-OMPL's random generator is seeded once per process, so each (planner, seed)
-runs in a process of its own; within it the problems run in order, so a seed
-gives the same runs every time.
+Each (planner, seed) runs in a process of its own; every run is seeded anew,
+so a problem and seed give the same path here as with `moveplan plan`.
 """
 
 from __future__ import annotations

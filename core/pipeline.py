@@ -305,7 +305,7 @@ def _plan_step(
             start, goal, robot.lower, robot.upper, validity, planner, planning_time)
     v_scale, a_scale = _scaling(robot, request, spec)
     max_velocity, max_acceleration = robot.max_velocity * v_scale, robot.max_acceleration * a_scale
-    stats = {"plan_s": 0.0, "simplify_s": 0.0, "timing_s": 0.0, "certify_s": 0.0}
+    stats = {"plan_s": 0.0, "simplify_s": 0.0, "timing_s": 0.0, "certify_s": 0.0, "checks": 0.0}
     # The search checks the hulls, not the meshes, unless the start or goal is free only under the meshes.
     ends = start[None, :] if spec.linear else np.array([start, goal])
     conservative = checks.conservative_available and bool(checks.free(ends, conservative=True).all())
@@ -379,6 +379,7 @@ def _add(stats: dict[str, float], path: PathResult, timing_s: float, certify_s: 
     stats["simplify_s"] += path.simplify_s
     stats["timing_s"] += timing_s
     stats["certify_s"] += certify_s
+    stats["checks"] += path.checks
 
 
 def _rest_to_rest(

@@ -5,11 +5,17 @@ whole edges are checked by the caller's `Validity` (one call per edge, so the
 caller can check all its states in one batch). The straight segment from start
 to goal is tried first; a searched path is shortened by OMPL's rope shortcutting
 under the same checks.
+
+A search is bounded by work, not by the clock: it may check a number of motions
+(states and edges) proportional to its planning time, so the same seed gives the same
+path on any machine under any load. The planning time itself is kept as a wall-clock
+safety cap: a search that reaches it before its budget fails and says so.
 """
 
 from __future__ import annotations
 
 import logging
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -43,18 +49,21 @@ _RANGE_RAD = 1.0  # the longest edge a tree-growing planner adds in one step
 # RRTConnect searches alone for the first part of the budget, where it solves all but such
 # problems; LBKPIECE1 then searches on.
 _FALLBACK = {"RRTConnect": "LBKPIECE1"}
-_FALLBACK_AFTER = 0.2  # of the planning time
-_seeded: list[int] = []
-
-
+_FALLBACK_AFTER = 0.2  # of the search's budget
+# Checked motions a search may spend per second of planning time. A Panda search among
+# MotionBenchMaker obstacles checks 30,000-75,000 a second on one core of a 2-core machine, so
+# its budget is spent in under half the planning time quiet; a robot without a sphere filter
+# checks fewer, and reaches the wall-clock cap first. A path found is the same either way:
+# the clock only decides whether the search is cut short.
+_CHECKS_PER_S = 20_000
 def seed_planner(seed: int) -> None:
-    """Seed OMPL's process-wide random generator; it can only be seeded before first use."""
-    if _seeded:
-        if _seeded[0] != seed:
-            logger.warning("OMPL was already seeded with %d; seed %d is ignored", _seeded[0], seed)
-        return
-    ou.RNG.setSeed(seed + 1)  # OMPL refuses 0 as a seed
-    _seeded.append(seed)
+    """Seed OMPL's process-wide generator of seeds: every planner, sampler and simplifier made after draws from it."""
+    # OMPL logs an error when it is reseeded after first use, yet reseeds. Each search makes its
+    # planner, sampler and simplifier anew, so a plan seeded first draws from `seed` alone,
+    # whatever ran in the process before it. OMPL's seeds are 32-bit and never 0.
+    ou.setLogLevel(ou.LOG_NONE)
+    ou.RNG.setSeed(seed % (2**32 - 1) + 1)
+    ou.setLogLevel(ou.LOG_ERROR)
 
 
 @dataclass(frozen=True)
@@ -74,15 +83,45 @@ class PathResult:
         planner: The OMPL planner's name.
         planning_s: Wall time of the search in [s].
         simplify_s: Wall time of simplification in [s].
+        checks: Motions (states and edges) the search checked.
     """
 
     waypoints: NDArray[np.float64]
     planner: str
     planning_s: float
     simplify_s: float
+    checks: int = 0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "waypoints", frozen_array(self.waypoints, (None, None), "waypoints"))
+
+
+class _Work:
+    """The checked motions a search has spent against its budget, and its wall-clock cap."""
+
+    def __init__(self, time_s: float) -> None:
+        self.time_s = time_s
+        self.budget = max(1, math.ceil(time_s * _CHECKS_PER_S))
+        self.deadline = time.perf_counter() + time_s
+        self.used = 0
+
+    def until(self, checks: int) -> ob.PlannerTerminationCondition:
+        """Return OMPL's condition that ends a search after `checks` motions in all, or at the cap."""
+        return ob.PlannerTerminationCondition(lambda: self.used >= checks or self.out_of_time())
+
+    def out_of_time(self) -> bool:
+        """Return True once the wall-clock cap is reached."""
+        return time.perf_counter() > self.deadline
+
+    def failure(self, planner: str, status: object) -> PlanningFailed:
+        """Return the error for a search that found no path, naming what ended it."""
+        if self.used < self.budget and self.out_of_time():
+            return PlanningFailed(
+                f"{planner} reached the planning time cap of {self.time_s:g} s after {self.used} of its "
+                f"{self.budget} checked motions; the machine is slower or busier than the budget assumes: "
+                "raise --planning-time")
+        return PlanningFailed(f"{planner} found no path within {self.budget} checked motions "
+                              f"({self.time_s:g} s of planning time) ({status})")
 
 
 def interpolate(a: NDArray[np.float64], b: NDArray[np.float64], resolution: float) -> NDArray[np.float64]:
@@ -102,11 +141,12 @@ def plan_path(
 ) -> PathResult:
     """Return a collision-free path from `start` to `goal`, both given as group joint values.
 
-    Raises PlanningFailed when no path is found within `time_s` seconds.
+    The search may check `time_s` x 20,000 motions; it fails when those find no path, or
+    when `time_s` seconds of wall time pass first.
     """
     if planner not in PLANNERS:
         raise UsageError(f"unknown planner '{planner}'; OMPL geometric planners: {known(PLANNERS)}")
-    return _plan(start, goal, lower, upper, validity, planner, time_s)
+    return _plan(start, goal, lower, upper, validity, planner, _Work(time_s))
 
 
 def repair_path(
@@ -120,9 +160,11 @@ def repair_path(
     """Return `waypoints` with each segment `validity` rejects replaced by a path searched between its ends.
 
     Raises PlanningFailed when a waypoint is not free (a shortcut can put one between two
-    checked states of an edge), or a segment's search finds no path within what remains of `time_s`.
+    checked states of an edge), or a segment's search finds no path within what remains of the
+    budget of `time_s`.
     """
     began = time.perf_counter()
+    work = _Work(time_s)
     pieces, simplify_s, used = [waypoints[:1]], 0.0, planner
     for a, b in zip(waypoints[:-1], waypoints[1:], strict=True):
         if validity.edge_free(a, b):
@@ -130,12 +172,12 @@ def repair_path(
             continue
         if not validity.state_free(b):
             raise PlanningFailed("a waypoint of the path collides")
-        detour = _plan(a, b, lower, upper, validity, planner, max(0.0, time_s - (time.perf_counter() - began)))
+        detour = _plan(a, b, lower, upper, validity, planner, work)
         pieces.append(detour.waypoints[1:])
         simplify_s += detour.simplify_s
         if detour.planner != planner:
             used = detour.planner  # the fallback found this detour
-    return PathResult(np.concatenate(pieces), used, time.perf_counter() - began - simplify_s, simplify_s)
+    return PathResult(np.concatenate(pieces), used, time.perf_counter() - began - simplify_s, simplify_s, work.used)
 
 
 def _planner(name: str, info: ob.SpaceInformation) -> ob.Planner:
@@ -156,7 +198,7 @@ def _plan(
     upper: NDArray[np.float64],
     validity: Validity,
     planner: str,
-    time_s: float,
+    work: _Work,
 ) -> PathResult:
     dof = len(start)
     space = ob.RealVectorStateSpace(dof)
@@ -172,12 +214,17 @@ def _plan(
     def values(state: ob.State) -> NDArray[np.float64]:
         return np.array(coordinates(state), ndmin=1)
 
-    setup.setStateValidityChecker(lambda state: validity.state_free(values(state)))
+    def state_free(state: ob.State) -> bool:
+        work.used += 1
+        return validity.state_free(values(state))
+
+    setup.setStateValidityChecker(state_free)
 
     class EdgeValidator(ob.MotionValidator):  # type: ignore[misc]
         """Checks a whole edge in one call."""
 
         def checkMotion(self, s1: ob.State, s2: ob.State, *rest: object) -> bool:  # noqa: N802 - OMPL's name
+            work.used += 1
             return validity.edge_free(values(s1), values(s2))
 
     info = setup.getSpaceInformation()
@@ -191,20 +238,22 @@ def _plan(
     setup.setStartAndGoalStates(endpoints[0], endpoints[1])
     setup.setPlanner(_planner(planner, info))
 
-    began = time.perf_counter()
+    began, spent_before = time.perf_counter(), work.used
+    work.used += 1
     if validity.edge_free(start, goal):
         # A free straight segment is what any search plus shortcutting converges to.
-        return PathResult(np.array([start, goal]), planner, time.perf_counter() - began, 0.0)
+        return PathResult(np.array([start, goal]), planner, time.perf_counter() - began, 0.0, 1)
     fallback = _FALLBACK.get(planner)
-    status = setup.solve(ob.timedPlannerTerminationCondition(time_s * _FALLBACK_AFTER if fallback else time_s))
-    if fallback and not setup.haveExactSolutionPath():
+    first_share = work.used + math.ceil((work.budget - work.used) * _FALLBACK_AFTER) if fallback else work.budget
+    status = setup.solve(work.until(first_share))
+    if fallback and not setup.haveExactSolutionPath() and not work.out_of_time():
         setup.getProblemDefinition().clearSolutionPaths()  # RRTConnect's approximate one
         setup.setPlanner(_planner(fallback, info))
         planner = f"{planner}+{fallback}"
-        status = setup.solve(ob.timedPlannerTerminationCondition(max(0.0, time_s - (time.perf_counter() - began))))
+        status = setup.solve(work.until(work.budget))
     planning_s = time.perf_counter() - began
     if not setup.haveExactSolutionPath():
-        raise PlanningFailed(f"{planner} found no path in {time_s:g} s ({status})")
+        raise work.failure(planner, status)
     began = time.perf_counter()
     path = setup.getSolutionPath()
     # Rope shortcutting (OMPL 2.0) reaches the quality of the full simplify() on MotionBenchMaker
@@ -213,4 +262,4 @@ def _plan(
     waypoints = np.array([values(path.getState(k)) for k in range(path.getStateCount())])
     simplify_s = time.perf_counter() - began
     waypoints[0], waypoints[-1] = start, goal
-    return PathResult(waypoints, planner, planning_s, simplify_s)
+    return PathResult(waypoints, planner, planning_s, simplify_s, work.used - spent_before)

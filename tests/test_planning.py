@@ -1,6 +1,8 @@
-"""Joint-space search: RRTConnect's fallback, and a path that crossed a thin obstacle repaired where it crossed."""
+"""Joint-space search: bounded by work, seeded, RRTConnect's fallback, and a crossed thin obstacle repaired."""
 
 from __future__ import annotations
+
+import time
 
 import numpy as np
 import pytest
@@ -61,3 +63,36 @@ def test_rrtconnect_hands_what_it_has_not_solved_to_its_fallback(monkeypatch: py
     monkeypatch.setattr(planning, "_FALLBACK", {})
     with pytest.raises(PlanningFailed):
         plan_path(start, goal, lower, upper, validity, "RRTConnect", 0.0)
+
+
+def _boxed_in(delay_s: float = 0.0) -> Validity:
+    """Return checks with the goal (0.5, 0.5) walled in; each check takes at least `delay_s`."""
+
+    def free(q: np.ndarray) -> bool:
+        time.sleep(delay_s)
+        distance = np.max(np.abs(np.atleast_2d(q) - 0.5), axis=1)
+        return bool(((distance < 0.3) | (distance > 0.35)).all())
+
+    return Validity(free, lambda a, b: free(interpolate(a, b, 0.01)[1:]))
+
+
+def test_a_search_stops_after_its_budget_of_checked_motions(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(planning, "_CHECKS_PER_S", 2000)  # 100 checks: well within the clock's cap
+    with pytest.raises(PlanningFailed, match="found no path within 100 checked motions"):
+        plan_path(np.array([-0.5, -0.5]), np.array([0.5, 0.5]), LOWER, UPPER, _boxed_in(), "RRTConnect", 0.05)
+
+
+def test_a_slow_search_stops_at_the_wall_clock_cap_and_says_so() -> None:
+    with pytest.raises(PlanningFailed, match=r"planning time cap of 0.05 s after \d+ of its 1000 checked motions"):
+        plan_path(np.array([-0.5, -0.5]), np.array([0.5, 0.5]), LOWER, UPPER, _boxed_in(0.002), "RRTConnect", 0.05)
+
+
+def test_the_same_seed_gives_the_same_path_whatever_ran_before() -> None:
+    start, goal = np.array([0.0, 0.0]), np.array([1.0, 0.0])
+    paths = []
+    for seed in (3, 4, 3):
+        planning.seed_planner(seed)
+        paths.append(plan_path(start, goal, LOWER, UPPER, _wall(0.005), "RRTConnect", 1.0))
+    np.testing.assert_array_equal(paths[0].waypoints, paths[2].waypoints)
+    assert paths[0].checks == paths[2].checks > 1
+    assert not np.array_equal(paths[0].waypoints, paths[1].waypoints)
