@@ -14,7 +14,7 @@ and MotionPlanRequest per problem, read here as YAML) and each seed 0..S-1:
   cylinders are world geometry objects paired with every robot geometry the matrix does not
   allow them to touch. Plan time is `plan()`, simplify time `shortcut_path()`.
 - `moveplan benchmark --json` runs as a subprocess on the same problems and seeds; its runs are
-  read as they are (its own plan_s, simplify_s and exact_valid). Without that command, pyroboplan
+  read as they are (its own search_s, simplify_s and exact_valid). Without that command, pyroboplan
   runs alone and the report says so.
 - Valid: pyroboplan's returned path (after shortcutting) re-checked with moveplan's
   CollisionChecker on the exact meshes, at states at most `--step-mm` of robot motion apart
@@ -206,7 +206,7 @@ def run_pyroboplan(
     run = {
         "problem": problem.name, "planner": "pyroboplan RRTConnect" if connect else "pyroboplan RRT",
         "seed": seed, "ok": path is not None,
-        "plan_s": plan_s, "simplify_s": simplify_s, "total_s": plan_s + simplify_s,
+        "search_s": plan_s, "simplify_s": simplify_s, "total_s": plan_s + simplify_s,
         "path_length": float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1))) if path else None,
         "duration_s": None, "exact_valid": None,
         "error": None if path else next((m for m in reversed(messages) if m.strip()), "no path"),
@@ -252,8 +252,8 @@ def run_moveplan(command: list[str], keys: set[tuple[str, int]]) -> tuple[list[d
 def summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
     """Return runs, successes, median and p95 of plan and plan+simplify time [s], valid count, median length."""
     solved = [r for r in runs if r["ok"]]
-    plan = [r["plan_s"] for r in solved]
-    total = [r["plan_s"] + r["simplify_s"] for r in solved]
+    plan = [r["search_s"] for r in solved]
+    total = [r["search_s"] + r["simplify_s"] for r in solved]
     lengths = [r["path_length"] for r in solved if r["path_length"] is not None]
     return {
         "runs": len(runs),
@@ -340,7 +340,7 @@ def main() -> None:
             pyroboplan_runs.append(run)
             outcome = (f"valid {run['exact_valid']} (before shortcutting: {run.get('unshortcut_exact_valid')})"
                        if run["ok"] else f"failed: {run['error']}")
-            print(f"{problem.name} seed {seed}: plan {milliseconds(run['plan_s'])}, "
+            print(f"{problem.name} seed {seed}: plan {milliseconds(run['search_s'])}, "
                   f"simplify {milliseconds(run['simplify_s'])}, {outcome}", file=sys.stderr)
 
     runs = {"pyroboplan": pyroboplan_runs}

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
@@ -286,10 +287,10 @@ def benchmark_summary(runs: list[Run], rows: list[dict[str, Any]], as_json: bool
         return
     if quiet:
         return
-    table = Table(title=f"{len(runs)} runs; times in ms (median / p95)")
-    for column in ("scenario", "planner", "solved", "plan", "simplify", "plan+simplify", "timing", "path [rad]",
-                   "duration [s]", "exact-valid"):
-        table.add_column(column, justify="left" if column in ("scenario", "planner") else "right")
+    table = Table(title=f"{len(runs)} runs; times in ms (median / p95); total = search + simplify + certify + timing")
+    for column in ("scenario", "planner", "solved", "search", "simplify", "certify", "timing", "total",
+                   "path [rad]", "duration [s]", "exact-valid"):
+        table.add_column(escape(column), justify="left" if column in ("scenario", "planner") else "right")
 
     def ms(row: dict[str, Any], key: str) -> str:
         median, p95 = row[f"{key}_median_s"], row[f"{key}_p95_s"]
@@ -299,8 +300,9 @@ def benchmark_summary(runs: list[Run], rows: list[dict[str, Any]], as_json: bool
         return "-" if value is None else f"{value:.{digits}f}"
 
     for row in sorted(rows, key=lambda r: (r["scenario"] == "all", r["scenario"], r["planner"])):
-        table.add_row(row["scenario"], row["planner"], f"{row['succeeded']}/{row['runs']}", ms(row, "plan"),
-                      ms(row, "simplify"), ms(row, "total"), ms(row, "timing"), number(row["path_length_median"], 2),
+        table.add_row(row["scenario"], row["planner"], f"{row['succeeded']}/{row['runs']}",
+                      *(ms(row, stage) for stage in ("search", "simplify", "certify", "timing", "total")),
+                      number(row["path_length_median"], 2),
                       number(row["duration_median_s"], 2), f"{row['exact_valid']}/{row['succeeded']}")
     # Piped to a file, rich would fold the table into 80 columns.
     (_console if _console.is_terminal else Console(width=160)).print(table)

@@ -44,7 +44,10 @@ def test_benchmark_runs_every_problem_with_every_seed_and_writes_csv_and_plot(
         ("box_panda/0001", 0), ("box_panda/0002", 0), ("box_panda/0001", 1), ("box_panda/0002", 1)]
     for run in runs:
         assert run["ok"] and run["exact_valid"], run
-        assert 0 < run["plan_s"] <= run["total_s"] and run["duration_s"] > 0 and run["path_length"] > 0
+        stages = [run[f"{stage}_s"] for stage in ("search", "simplify", "certify", "timing")]
+        assert run["total_s"] == pytest.approx(sum(stages)) and run["search_s"] > 0 and run["certify_s"] > 0
+        assert run["total_s"] <= run["planning_time_s"] and run["checks"] > 0
+        assert run["duration_s"] > 0 and run["path_length"] > 0
     overall = next(r for r in document["summary"] if r["scenario"] == "all")
     assert overall["runs"] == 4 and overall["success_rate"] == 1.0 and overall["exact_valid"] == 4
     with table.open() as stream:
@@ -53,7 +56,7 @@ def test_benchmark_runs_every_problem_with_every_seed_and_writes_csv_and_plot(
 
 
 def test_failed_runs_count_against_success_and_not_in_times() -> None:
-    runs = [Run("s/1", "s", "RRTConnect", 0, True, plan_s=0.001, simplify_s=0.001, total_s=0.002),
+    runs = [Run("s/1", "s", "RRTConnect", 0, True, search_s=0.001, simplify_s=0.001, total_s=0.002),
             Run("s/2", "s", "RRTConnect", 0, False, error="no path")]
     [row, _] = summarize(runs)
     assert row["success_rate"] == 0.5 and row["total_median_s"] == pytest.approx(0.002)
