@@ -206,7 +206,11 @@ def check_tolerances(
     quiet: QuietOpt = False,
     verbose: VerboseOpt = False,
 ) -> None:
-    """Check a recording (a ros2 bag of a real robot, or an executed file) against a plan's tolerances."""
+    """Check a recording (a ros2 bag of a real robot, or an executed file) against a plan's tolerances.
+
+    Exit 0 within tolerances, 5 on a violation, 3 if the recording cuts the execution (with --start all,
+    every execution) off before a verdict; with --start all, cut-off cycles are INCOMPLETE and not counted.
+    """
     _logging(verbose, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render
@@ -217,8 +221,9 @@ def check_tolerances(
             raise UsageError(f"--time-source: expected header or log, got '{time_source}'")
         when: str | float = start if start in ("auto", "all") else parse_number(start, "--start (auto, all or seconds)")
         report = check(CheckRequest(plan_file, recording_file, topic, controllers, when, time_source))
-    render.check_summary(report, as_json, quiet)
-    raise typer.Exit(0 if report.ok else 5)
+    render.check_summary(report, recording_file, as_json, quiet)
+    # Cut off before any verdict: the check could not be done on this recording (bad input).
+    raise typer.Exit(0 if report.ok else 5 if report.complete else 3)
 
 
 @app.command("robot")

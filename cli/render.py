@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import logging
+import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -210,31 +211,45 @@ def execution_summary(outcome: PlanExecution, output: Path | None, as_json: bool
     _console.print(f"executed {len(outcome.steps)} of {len(outcome.plan.steps)} steps in {outcome.duration_s:.3f} s")
 
 
-def check_summary(report: CheckReport, as_json: bool, quiet: bool) -> None:
-    """Print the verdict on a recording (per cycle with --start all), or its JSON document."""
+def check_summary(report: CheckReport, recording: Path, as_json: bool, quiet: bool) -> None:
+    """Print the verdict on a recording (per cycle with --start all), or its JSON document.
+
+    "ok" of a step or cycle is null when the recording cuts it off before a verdict (INCOMPLETE).
+    A check with no complete execution is bad input (exit 3): the document says so under "error".
+    """
     for warning in report.warnings:
         logger.warning("%s", warning)
+    error = None if report.complete else {"exit_code": 3, "kind": "InputError",
+                                          "message": f"{recording}: {report.result.message}"}
     document: dict[str, Any] = {
         "ok": report.ok, "result": _result(report.result), "violations": _violations(report.violations),
         "margins": report.margins, "duration_s": report.duration_s, "start_s": report.start_s,
-        "steps": [{"name": s.name, "ok": s.ok, "result": s.report.result.name, "start_s": s.start_s,
-                   "duration_s": s.duration_s, "aligned_by": s.aligned_by} for s in report.steps],
+        "steps": [{"name": s.name, "ok": s.ok if s.complete else None, "result": s.report.result.name,
+                   "start_s": s.start_s, "duration_s": s.duration_s, "aligned_by": s.aligned_by}
+                  for s in report.steps],
         "gaps": [{"start_s": start, "length_s": length} for start, length in report.gaps],
         "warnings": list(report.warnings),
+        "error": error,
     }
     if report.cycles:
-        document["cycles"] = [{"index": c.index, "start_s": c.start_s, "ok": c.ok, "result": _result(c.result),
-                               "worst_margin": c.worst_margin} for c in report.cycles]
+        document["cycles"] = [{"index": c.index, "start_s": c.start_s, "ok": c.ok if c.complete else None,
+                               "result": _result(c.result), "worst_margin": c.worst_margin} for c in report.cycles]
         document["failing_cycles"] = list(report.failing_cycles)
+        document["incomplete_cycles"] = list(report.incomplete_cycles)
     if as_json:
         _emit(document)
         return
+    if error is not None:
+        print(f"moveplan: error: {error['message']}", file=sys.stderr)
     if quiet:
         return
     _verdict(document, "smallest margin to tolerance")
     if report.cycles:
         failing = ", ".join(str(i) for i in report.failing_cycles) or "none"
-        _console.print(f"{len(report.cycles)} executions found; failing: {failing}")
+        incomplete = len(report.incomplete_cycles)
+        cut = ", ".join(map(str, report.incomplete_cycles))
+        cut = f" (cycle {cut}, cut off by the recording)" if incomplete else ""
+        _console.print(f"{len(report.cycles)} executions found; failing: {failing}; incomplete: {incomplete}{cut}")
         for cycle in report.cycles:
             if not cycle.ok:
                 _console.print(f"  cycle {cycle.index} at {cycle.start_s:.3f} s: {cycle.result.name}: "
@@ -244,7 +259,7 @@ def check_summary(report: CheckReport, as_json: bool, quiet: bool) -> None:
 def _verdict(document: dict[str, Any], margins_title: str) -> None:
     """Print a result line, the violations table and the margins table."""
     result = document["result"]
-    colour = "green" if document["ok"] else "red"
+    colour = "green" if document["ok"] else "yellow" if result["name"] == "INCOMPLETE" else "red"
     _console.print(f"[{colour}]{result['name']}[/{colour}] ({result['code']}): {result['message']}")
     if document["violations"]:
         table = Table(title="violations")

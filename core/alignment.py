@@ -16,7 +16,9 @@ largest joint distance, shortest angle for continuous joints, in [rad]:
   decided; a step whose departure is not seen starts at that sample.
 * Fallbacks: a recording that never rests near the first point is aligned by its first
   departure from its first sample (MoveIt's start check then fails); one that never
-  moves starts at its first sample.
+  moves starts at its first sample. A robot already departing at the recording's first
+  sample (its rest is not recorded) is aligned by where it leaves the zone instead: the
+  goal started as long before that as the plan takes to leave it.
 """
 
 from __future__ import annotations
@@ -346,4 +348,12 @@ def _departure_start(samples: Samples, profile: StepProfile, exit_index: int, lo
     departure = _crossing(times[rest : exit_index + 1], moved, profile.threshold, 0)
     if departure is None:
         departure = float(times[exit_index])
-    return departure - profile.time_to(profile.threshold)
+    start = departure - profile.time_to(profile.threshold)
+    if rest == 0 and start < times[0]:
+        # Moving already at the first sample, which is then no rest to measure from.
+        home = profile.trajectory.positions[0]
+        away = samples.distance(0, exit_index + 1, home)
+        leaves = _crossing(times[: exit_index + 1], away, profile.zone_out, 0)
+        if leaves is not None:
+            start = min(start, leaves - profile.time_to(profile.zone_out))
+    return start

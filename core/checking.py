@@ -13,6 +13,12 @@ concatenation on the plan's timeline: a real robot pauses between goals for as l
 MoveIt takes to send the next one.) Where each goal started is core.alignment's to find;
 a number for `start` puts the first step there instead, in seconds from the recording's
 first sample.
+
+An execution the recording cuts off is INCOMPLETE, not failed: one still undecided when
+the recording ends, one whose goal was sent before the recording's first sample (its start
+state is not recorded, so MoveIt's start check is skipped), and, with `start="all"`, one
+already running when the recording began. A violation seen before the cut is still that
+failure.
 """
 
 from __future__ import annotations
@@ -35,8 +41,10 @@ from moveplan.core.alignment import (
     next_start,
 )
 from moveplan.core.config import ControllerConfig, ExecutionConfig
+from moveplan.core.controller import WAIT_LIMIT_S
 from moveplan.core.errors import InputError, UsageError
 from moveplan.core.tolerances import (
+    INCOMPLETE,
     SUCCESSFUL,
     TIMED_OUT,
     ExecutionResult,
@@ -48,6 +56,7 @@ from moveplan.core.tolerances import (
     expected_duration_s,
     in_controller_order,
     judge_spans,
+    position_error,
     segment_tolerances,
     velocity_error_computable,
 )
@@ -98,24 +107,41 @@ class StepCheck:
         """Return True if the step succeeded."""
         return self.report.ok
 
+    @property
+    def complete(self) -> bool:
+        """Return False if the recording cuts the step off before a verdict (INCOMPLETE)."""
+        return self.report.result.code != INCOMPLETE
+
 
 @dataclass(frozen=True)
 class CycleCheck:
-    """One execution of the plan found in the recording (`start="all"`)."""
+    """One execution of the plan found in the recording (`start="all"`).
+
+    Attributes:
+        index: Its place in the recording, in time order from 0.
+        start_s: Where its first goal started, in [s] from the recording's first sample; for
+            one already running when the recording began, the first sample's time.
+        steps: Its steps judged, up to the first that did not succeed (none for one already
+            running when the recording began).
+        result: Its verdict: the failing step's result, else INCOMPLETE if the recording cuts
+            it off, else SUCCESSFUL.
+
+    """
 
     index: int
     start_s: float
     steps: tuple[StepCheck, ...]
+    result: ExecutionResult
 
     @property
     def ok(self) -> bool:
-        """Return True if every step of this execution succeeded."""
-        return all(step.ok for step in self.steps)
+        """Return True if the execution succeeded."""
+        return self.result.code == SUCCESSFUL
 
     @property
-    def result(self) -> ExecutionResult:
-        """Return the result of the step that ended the execution."""
-        return self.steps[-1].report.result
+    def complete(self) -> bool:
+        """Return False if the recording cuts the execution off before a verdict (INCOMPLETE)."""
+        return self.result.code != INCOMPLETE
 
     @property
     def margins(self) -> dict[str, float]:
@@ -130,6 +156,8 @@ class CycleCheck:
     @property
     def duration_s(self) -> float:
         """Return the time from the execution's start to its last decision in [s]."""
+        if not self.steps:
+            return 0.0
         last = self.steps[-1]
         return last.start_s + last.duration_s - self.start_s
 
@@ -139,9 +167,11 @@ class CheckReport:
     """The verdict on a recording.
 
     Attributes:
-        ok: True if every checked execution succeeded.
-        result: How the execution ended; with `start="all"`, the first failing cycle's code
-            with a message naming it, else SUCCESSFUL.
+        ok: True if the execution succeeded; with `start="all"`, if no cycle failed and at
+            least one is complete (INCOMPLETE cycles count neither way).
+        result: How the execution ended, INCOMPLETE if the recording cuts it off before a
+            verdict; with `start="all"`, the first failing cycle's code with a message naming
+            it, else SUCCESSFUL, or INCOMPLETE if no cycle is complete.
         violations: (step name, violation) of the execution reported (the first failing
             cycle's, with `start="all"`); violation times are from that step's start.
         margins: Per joint the smallest tolerance - |error| over all checks, in [rad].
@@ -150,6 +180,7 @@ class CheckReport:
         steps: The steps of the single execution (empty with `start="all"`).
         cycles: Every execution found (`start="all"` only), in time order.
         failing_cycles: Indices of the cycles that failed.
+        incomplete_cycles: Indices of the cycles the recording cuts off (INCOMPLETE).
         gaps: (start_s, length_s) of pauses between samples longer than GAP_FACTOR median
             periods, start in [s] from the recording's first sample.
         warnings: Things the user should know: gaps, sparse samples, alignment fallbacks.
@@ -166,9 +197,15 @@ class CheckReport:
     steps: tuple[StepCheck, ...]
     cycles: tuple[CycleCheck, ...]
     failing_cycles: tuple[int, ...]
+    incomplete_cycles: tuple[int, ...]
     gaps: tuple[tuple[float, float], ...]
     warnings: tuple[str, ...]
     recording_start_ns: int
+
+    @property
+    def complete(self) -> bool:
+        """Return False if the recording cuts the execution (every execution) off before a verdict."""
+        return self.result.code != INCOMPLETE
 
 
 def check_recording(
@@ -208,6 +245,9 @@ def check_recording(
         if start != "auto":
             raise UsageError(f"start must be 'auto', 'all' or a time in seconds, got '{start}'")
         first, aligned_by = first_start(context.samples, context.profiles[0])
+        running = _already_running(context) if aligned_by == "departure" else ""
+        if running:
+            warnings.append(f"{running}; the first execution found starts at {first:.3f} s")
     else:
         first, aligned_by = float(start), "given"
         if not math.isfinite(first):
@@ -218,9 +258,10 @@ def check_recording(
             warnings.append(f"step '{step.name}': start at {step.start_s:.3f} s found by "
                             f"{step.aligned_by} (no departure from its first point was seen)")
     last = steps[-1]
+    result = _verdict(context, first, steps)
     return CheckReport(
-        ok=last.ok,
-        result=last.report.result,
+        ok=result.code == SUCCESSFUL,
+        result=result,
         violations=tuple((s.name, v) for s in steps for v in s.report.violations),
         margins=_merged_margins(steps),
         duration_s=last.start_s + last.duration_s - first,
@@ -228,6 +269,7 @@ def check_recording(
         steps=steps,
         cycles=(),
         failing_cycles=(),
+        incomplete_cycles=(),
         gaps=gaps,
         warnings=tuple(warnings),
         recording_start_ns=series.start_ns,
@@ -298,7 +340,11 @@ _BATCH_ROWS = 1 << 15
 
 @dataclass(frozen=True)
 class _Window:
-    """A step's goal sent at `start` [s]: judged from sample `first` on, never at or past `end`."""
+    """A step's goal sent at `start` [s]: judged from sample `first` on, never at or past `end`.
+
+    `runs_out`: the recording ends at `end` before MoveIt would give up, so a verdict of
+    TIMED_OUT there only means the recording cut the step off.
+    """
 
     start: float
     first: int
@@ -306,18 +352,80 @@ class _Window:
     at_send: int
     current: NDArray[np.float64]
     timeout: Timeout
+    runs_out: bool
 
 
 def _all_cycles(context: _Context) -> tuple[CycleCheck, ...]:
     """Return every execution of the plan found in the recording, judged."""
+    times = context.samples.times
     starts = cycle_starts(context.samples, context.profiles)
     # Each execution ends where the next one starts.
-    ends = np.searchsorted(context.samples.times, starts[1:], side="left").tolist()
-    ends.append(len(context.samples.times))
+    ends = np.searchsorted(times, starts[1:], side="left").tolist()
+    ends.append(len(times))
     reasons = ["next cycle"] * (len(starts) - 1) + ["recording"]
     executions = _executions(context, starts, ["departure"] * len(starts), ends, reasons)
-    return tuple(CycleCheck(index, start, steps)
-                 for index, (start, steps) in enumerate(zip(starts, executions, strict=True)))
+    cycles = [(start, steps, _verdict(context, start, steps))
+              for start, steps in zip(starts, executions, strict=True)]
+    running = _already_running(context)
+    if running:
+        cycles.insert(0, (float(times[0]), (), ExecutionResult(INCOMPLETE, "INCOMPLETE", running)))
+    return tuple(CycleCheck(index, start, steps, result)
+                 for index, (start, steps, result) in enumerate(cycles))
+
+
+def _verdict(context: _Context, start: float, steps: Sequence[StepCheck]) -> ExecutionResult:
+    """Return an execution's result: its failure, else INCOMPLETE if the recording cuts it off."""
+    last = steps[-1]
+    result = last.report.result
+    times = context.samples.times
+    if result.code == INCOMPLETE:
+        number = len(steps) - 1
+        remaining = (last.start_s + context.profiles[number].trajectory.duration_s - times[-1]
+                     + sum(p.trajectory.duration_s for p in context.profiles[number + 1 :]))
+        if remaining > 0.0:
+            return replace(result, message=(
+                f"the recording ends {remaining:.3f} s before the plan's execution could finish "
+                f"(step '{last.name}': {result.message})"))
+        return replace(result, message=f"the recording ends before the controller decided step "
+                                       f"'{last.name}' ({result.message})")
+    if result.code == SUCCESSFUL and _before_recording(context, start):
+        return ExecutionResult(INCOMPLETE, "INCOMPLETE", (
+            f"the recording begins about {times[0] - start:.3f} s after the execution started: "
+            "its start state and first motion are not recorded"))
+    return result
+
+
+def _before_recording(context: _Context, start: float) -> bool:
+    """Return True if a goal started at `start` [s] was sent before the recording's first sample.
+
+    A sample period of slack: an execution recorded from its send time (an executed file)
+    is aligned to within a period of its first sample, on either side.
+    """
+    return start < float(context.samples.times[0]) - context.samples.period_s
+
+
+def _already_running(context: _Context) -> str:
+    """Return why the recording begins inside an execution already running, "" if it does not.
+
+    It does if, at its first sample, the robot is away from the plan's first point but on
+    the plan's path: within the largest path tolerance (at least ZONE_RAD) of a planned
+    position. Such an execution has no departure to align it by; it is not judged.
+    """
+    samples, home = context.samples, context.profiles[0]
+    robot = samples.rows(0, 1)[0]
+    away = np.abs(position_error(home.trajectory.positions[0], robot, samples.continuous))
+    if away.max() <= home.zone_in:  # at rest at the first point, or departing from it
+        return ""
+    radius = max(ZONE_RAD, *context.controller.trajectory_tolerance.values())
+    for profile in context.profiles:
+        planned, _, _ = sample(profile.trajectory, profile.times, derivatives=0)
+        off = np.abs(position_error(planned, robot, samples.continuous)).max(axis=1)
+        closest = int(np.argmin(off))
+        if off[closest] <= radius:
+            return (f"the recording begins during an execution already running (the robot is "
+                    f"on the plan's path, nearest step '{profile.name}' at "
+                    f"{profile.times[closest]:.3f} s): it is not checked")
+    return ""
 
 
 def _executions(
@@ -375,6 +483,10 @@ def _judge_steps(
         while undecided:
             grown *= 4.0
             ((report, decided_s, undecided),) = _judge_windows(context, profile, [window], grown)
+        if window.runs_out and report.result.code == TIMED_OUT:
+            # Not a failed check: the goal-tolerance state at the cut is no violation yet.
+            result = replace(report.result, code=INCOMPLETE, name="INCOMPLETE")
+            report = replace(report, result=result, violations=())
         verdicts[slot] = (report, decided_s)
     return [verdicts[slot] for slot in range(len(starts))]
 
@@ -389,15 +501,22 @@ def _open(
     first = int(np.searchsorted(times, start, side="left"))
     at_send = max(first - 1, 0) if first >= len(times) or times[first] > start else first
     current = samples.rows(at_send, at_send + 1)[0]
-    refused = check_start_state(trajectory.joint_names, current, trajectory.positions[0],
-                                context.execution.allowed_start_tolerance, samples.continuous)
-    if refused is not None:
-        return refused, 0.0
+    if not _before_recording(context, start):  # else the state at the send was not recorded
+        refused = check_start_state(trajectory.joint_names, current, trajectory.positions[0],
+                                    context.execution.allowed_start_tolerance, samples.continuous)
+        if refused is not None:
+            return refused, 0.0
+    cut = end_reason == "recording"
     if first >= end:
         message = f"the {end_reason} ends before the step's start at {start:.3f} s"
-        return ToleranceReport(ExecutionResult(TIMED_OUT, "TIMED_OUT", message), (), {}, 0), 0.0
-    timeout = _timeout(context, trajectory.duration_s, float(times[end - 1]) - start, end_reason)
-    return _Window(start, first, end, at_send, current, timeout)
+        result = ExecutionResult(INCOMPLETE, "INCOMPLETE", message) if cut else \
+            ExecutionResult(TIMED_OUT, "TIMED_OUT", message)
+        return ToleranceReport(result, (), {}, 0), 0.0
+    last_s = float(times[end - 1]) - start
+    timeout = _timeout(context, trajectory.duration_s, last_s, end_reason)
+    # The recording ends before MoveIt would give up: its end cannot be a real timeout.
+    runs_out = cut and last_s <= timeout.time_s
+    return _Window(start, first, end, at_send, current, timeout, runs_out)
 
 
 def _judge_windows(
@@ -487,13 +606,23 @@ def _velocities(
 
 
 def _timeout(context: _Context, duration: float, last_s: float, end_reason: str) -> Timeout:
-    """Return when MoveIt gives up, with the message for a recording that ends undecided."""
+    """Return when MoveIt gives up, with the message for a recording that ends undecided.
+
+    Without MoveIt's duration monitor, a controller with goal_time 0 never gives up: the
+    check then stops where the simulation does, WAIT_LIMIT_S after the last point.
+    """
     expected = expected_duration_s(duration, context.execution)
-    limit = expected if context.execution.execution_duration_monitoring else math.inf
+    if context.execution.execution_duration_monitoring:
+        limit = expected
+        stops = (f"Controller is taking too long to execute trajectory (the expected upper bound "
+                 f"for the trajectory execution was {expected:.6f} seconds). Stopping trajectory.")
+    else:
+        limit = max(expected, duration + WAIT_LIMIT_S)
+        stops = (f"no result {limit:.6f} s after the step's start: the controller was still "
+                 f"waiting for the goal tolerance and MoveIt's execution_duration_monitoring "
+                 f"is off (checked up to {WAIT_LIMIT_S:g} s after the last point, as execute does)")
     if last_s > limit:
-        return Timeout(expected, (
-            f"Controller is taking too long to execute trajectory (the expected upper bound for "
-            f"the trajectory execution was {expected:.6f} seconds). Stopping trajectory."))
+        return Timeout(limit, stops)
     goal_time = context.controller.goal_time_s
     waits = "forever" if goal_time == 0.0 else f"{goal_time:g} s after the last point"
     return Timeout(limit, (
@@ -528,22 +657,31 @@ def _cycles_report(
     cycles: tuple[CycleCheck, ...], gaps: tuple[tuple[float, float], ...], warnings: list[str],
     start_ns: int,
 ) -> CheckReport:
-    failing = tuple(c.index for c in cycles if not c.ok)
+    failing = tuple(c.index for c in cycles if not c.ok and c.complete)
+    incomplete = tuple(c.index for c in cycles if not c.complete)
+    complete = len(cycles) - len(incomplete)
     margins = _merged_margins(step for cycle in cycles for step in cycle.steps)
     first, last = cycles[0], cycles[-1]
+    cut = (f"; {len(incomplete)} incomplete (cut off by the recording): cycle "
+           f"{', '.join(map(str, incomplete))}") if incomplete else ""
+    kind = "complete execution" if incomplete else "execution"
+    violations: tuple[tuple[str, Violation], ...] = ()
     if failing:
         bad = cycles[failing[0]]
         step = bad.steps[-1]
-        message = (f"{len(failing)} of {len(cycles)} executions failed; the first: cycle "
+        message = (f"{len(failing)} of {complete} {kind}s failed; the first: cycle "
                    f"{bad.index} at {bad.start_s:.3f} s, step '{step.name}': {bad.result.message}")
         result = replace(bad.result, message=message)
         violations = tuple((s.name, v) for s in bad.steps for v in s.report.violations)
+    elif complete == 0:
+        message = (f"no complete execution in the recording{cut}; cycle {first.index}: "
+                   f"{first.result.message}")
+        result = ExecutionResult(INCOMPLETE, "INCOMPLETE", message)
     else:
-        counted = f"all {len(cycles)} executions" if len(cycles) > 1 else "the one execution"
-        result = ExecutionResult(SUCCESSFUL, "SUCCESSFUL", f"{counted} within tolerances")
-        violations = ()
+        counted = f"all {complete} {kind}s" if complete > 1 else f"the one {kind}"
+        result = ExecutionResult(SUCCESSFUL, "SUCCESSFUL", f"{counted} within tolerances{cut}")
     return CheckReport(
-        ok=not failing,
+        ok=not failing and complete > 0,
         result=result,
         violations=violations,
         margins=margins,
@@ -552,6 +690,7 @@ def _cycles_report(
         steps=(),
         cycles=cycles,
         failing_cycles=failing,
+        incomplete_cycles=incomplete,
         gaps=gaps,
         warnings=tuple(warnings),
         recording_start_ns=start_ns,

@@ -25,6 +25,7 @@ from moveplan.core.types import JointTrajectory
 __all__ = [
     "in_controller_order",
     "GOAL_TOLERANCE_VIOLATED",
+    "INCOMPLETE",
     "PATH_TOLERANCE_VIOLATED",
     "START_STATE_INVALID",
     "SUCCESSFUL",
@@ -50,12 +51,14 @@ PATH_TOLERANCE_VIOLATED = -4
 GOAL_TOLERANCE_VIOLATED = -5
 TIMED_OUT = -6
 START_STATE_INVALID = -26
+INCOMPLETE = -100
 _NAMES = {
     SUCCESSFUL: "SUCCESSFUL",
     PATH_TOLERANCE_VIOLATED: "PATH_TOLERANCE_VIOLATED",
     GOAL_TOLERANCE_VIOLATED: "GOAL_TOLERANCE_VIOLATED",
     TIMED_OUT: "TIMED_OUT",
     START_STATE_INVALID: "START_STATE_INVALID",
+    INCOMPLETE: "INCOMPLETE",
 }
 
 
@@ -70,6 +73,9 @@ class ExecutionResult:
     start state too far from the plan's first point as ABORTED / CONTROL_FAILED (-4),
     which would read as a path violation here, so it is START_STATE_INVALID (-26), the
     MoveIt code for an unusable start state, with MoveIt's "start point deviates" message.
+    INCOMPLETE (-100) is moveplan's own, outside both ranges (control_msgs uses 0 to -5,
+    MoveItErrorCodes 1, 99999 and -1 to -31): a recording that cuts an execution off
+    before the controller or MoveIt decided it, so there is no verdict to report.
     """
 
     code: int
@@ -365,12 +371,16 @@ def judge_spans(
     aborts_goal = ~before & ~succeeds & late & (tolerances.goal_time_s > 0.0)
     lengths = stops - starts
     limit = np.repeat(np.array([t.time_s for t in timeouts], dtype=np.float64), lengths)
-    times_out = series.times_s > limit
+    decided = aborts_path | succeeds | aborts_goal | (series.times_s > limit)
+    times_out = decided.copy()
     times_out[stops - 1] = True
-    decisive = np.flatnonzero(aborts_path | succeeds | aborts_goal | times_out)
+    decisive = np.flatnonzero(times_out)
     # Every span's last cycle decides, so each span's first decisive cycle lies inside it.
     ends = decisive[np.searchsorted(decisive, starts)]
-    margins = _margins(series, magnitude, tolerances, path_checked, starts, ends, ~before[ends])
+    # A span that runs out of cycles undecided says nothing of its goal: the robot may
+    # still be on its way in.
+    goal_checked = ~before[ends] & decided[ends]
+    margins = _margins(series, magnitude, tolerances, path_checked, starts, ends, goal_checked)
     return [
         _report(series, tolerances, int(end) - int(start), int(end), last_point_s, timeout,
                 bool(aborts_path[end]), bool(succeeds[end]), bool(aborts_goal[end]),

@@ -11,7 +11,7 @@ from mcap.writer import Writer
 
 from moveplan.core.checking import CheckReport, check_recording, uses_velocities
 from moveplan.core.config import ControllerConfig, ExecutionConfig
-from moveplan.core.controller import Disturbance, simulate
+from moveplan.core.controller import WAIT_LIMIT_S, Disturbance, simulate
 from moveplan.core.errors import InputError, UsageError
 from moveplan.core.jointstates import (
     JOINT_STATE_TYPE,
@@ -21,6 +21,7 @@ from moveplan.core.jointstates import (
 )
 from moveplan.core.plants import MirrorPlant
 from moveplan.core.recording import PlanStepRecord
+from moveplan.core.tolerances import INCOMPLETE
 from moveplan.core.trajectory import sample
 from moveplan.core.types import JointTrajectory
 
@@ -156,11 +157,63 @@ def test_start_far_from_the_plan_is_refused_as_moveit_does() -> None:
     assert report.violations[0][1].joint == "shoulder_lift_joint"
 
 
-def test_recording_that_ends_early_is_undecided() -> None:
+def test_recording_that_ends_early_is_incomplete_not_timed_out() -> None:
     times = grid(1.5)
     positions, _ = follow(times, [(0.5, OUT)])
     report = check(ONE_STEP, series(times, positions))
-    assert report.result.name == "TIMED_OUT" and "recording ends" in report.result.message
+    assert report.result.code == INCOMPLETE and report.result.name == "INCOMPLETE"
+    assert not report.ok and not report.complete and report.violations == ()
+    assert "recording ends 1.004 s before the plan's execution could finish" in report.result.message
+    assert not report.steps[0].complete
+
+
+def test_recording_that_ends_inside_goal_time_is_incomplete_without_a_goal_margin() -> None:
+    times = grid(2.8)  # ends 0.3 s after the last point, inside goal_time 0.5 s
+    positions, _ = follow(times, [(0.5, OUT)])
+    positions[:, 0] -= np.interp(times, [1.5, 2.5], [0.0, 0.15])  # 0.15 short: outside the goal
+    report = check(ONE_STEP, series(times, positions))
+    assert report.result.name == "INCOMPLETE" and report.violations == ()
+    assert "before the controller decided step 'out'" in report.result.message
+    # The path margin 0.2 - 0.15 counts; the goal margin 0.1 - 0.15 at the cut does not.
+    assert report.margins["shoulder_pan_joint"] == pytest.approx(0.05, abs=0.005)
+
+
+def test_without_any_time_limit_a_robot_stuck_short_times_out_where_execute_gives_up() -> None:
+    # goal_time 0 and no duration monitor: nothing ever stops the wait, so the check stops
+    # where `execute --fake` does, WAIT_LIMIT_S after the last point.
+    unmonitored = ExecutionConfig(execution_duration_monitoring=False)
+    for length, verdict in ((6.0, "INCOMPLETE"), (13.0, "TIMED_OUT")):
+        times = grid(length)
+        positions, _ = follow(times, [(0.5, OUT)])
+        positions[:, 0] -= np.interp(times, [1.5, 2.5], [0.0, 0.15])  # never within the goal
+        report = check_recording(ONE_STEP, series(times, positions), jtc(goal_time=0.0), unmonitored)
+        assert report.result.name == verdict
+    assert report.steps[0].duration_s == pytest.approx(2.0 + WAIT_LIMIT_S, abs=0.01)
+
+
+def test_violation_before_the_recording_ends_still_fails() -> None:
+    times = grid(1.5)
+    positions, _ = follow(times, [(0.5, OUT)])
+    positions[(times >= 1.2) & (times < 1.22), 2] += 0.3
+    report = check(ONE_STEP, series(times, positions))
+    assert report.result.name == "PATH_TOLERANCE_VIOLATED" and report.complete
+    assert report.violations[0][1].joint == "elbow_joint"
+
+
+def test_recording_that_begins_after_the_goal_was_sent_is_incomplete() -> None:
+    times = grid(3.5)
+    positions, _ = follow(times, [(-0.2, OUT)])  # 12 mrad from the first point at the first sample
+    report = check(ONE_STEP, series(times, positions))
+    assert report.result.name == "INCOMPLETE" and "recording begins" in report.result.message
+    assert report.start_s == pytest.approx(-0.2, abs=5e-3)  # aligned by where it leaves the zone
+    assert report.steps[0].ok  # judged, but MoveIt's start check has no state to check
+
+
+def test_recording_from_the_send_time_is_complete() -> None:
+    times = grid(3.0)
+    positions, _ = follow(times, [(0.0, OUT)])
+    report = check(ONE_STEP, series(times, positions))
+    assert report.ok and report.complete and report.start_s == pytest.approx(0.0, abs=1e-3)
 
 
 def test_execution_longer_than_moveit_allows_times_out() -> None:
@@ -271,6 +324,66 @@ def test_start_all_reports_exactly_the_bad_cycle() -> None:
     assert report.result.name == "PATH_TOLERANCE_VIOLATED" and "cycle 2" in report.result.message
     assert report.violations[0][0] == "back" and report.violations[0][1].joint == "wrist_1_joint"
     assert all(c.worst_margin > 0.09 for c in report.cycles if c.ok)
+
+
+def cut(times, positions, velocities, begin: float, end: float):
+    keep = (times >= begin) & (times < end)
+    return series(times[keep] - begin, positions[keep], velocities[keep])
+
+
+def test_start_all_counts_a_last_cycle_cut_by_the_end_as_incomplete_not_failing() -> None:
+    starts = [0.6, 6.61, 12.6]
+    recorded = cut(*cycles_recording(starts), 0.0, starts[2] + 1.0)  # ends in step out
+    report = check(CYCLE, recorded, start="all")
+    assert report.ok and report.complete and report.result.name == "SUCCESSFUL"
+    assert report.failing_cycles == () and report.incomplete_cycles == (2,)
+    last = report.cycles[2]
+    assert not last.ok and not last.complete and last.result.code == INCOMPLETE
+    assert "before the plan's execution could finish" in last.result.message
+    assert [s.name for s in last.steps] == ["out"] and last.worst_margin > 0.09
+    assert "2 complete executions within tolerances; 1 incomplete" in report.result.message
+
+
+def test_start_all_counts_a_first_cycle_begun_before_the_recording_as_incomplete() -> None:
+    starts = [0.6, 6.61, 12.6]
+    recorded = cut(*cycles_recording(starts), 0.8, 20.0)  # 0.2 s into cycle 0, near its start
+    report = check(CYCLE, recorded, start="all")
+    assert report.ok and report.failing_cycles == () and report.incomplete_cycles == (0,)
+    first = report.cycles[0]
+    assert first.result.name == "INCOMPLETE" and "recording begins about 0.198 s" in first.result.message
+    assert first.start_s == pytest.approx(-0.198, abs=2e-3)  # the robot lags its command by 2 ms
+    assert [s.ok for s in first.steps] == [True, True]  # judged, as far as recorded
+    assert [c.ok for c in report.cycles[1:]] == [True, True]
+
+
+def test_start_all_lists_a_cycle_already_running_at_the_first_sample_as_incomplete() -> None:
+    starts = [0.6, 6.61, 12.6]
+    recorded = cut(*cycles_recording(starts), 2.0, 20.0)  # mid step out: no departure recorded
+    report = check(CYCLE, recorded, start="all")
+    assert report.ok and report.incomplete_cycles == (0,)
+    assert [c.index for c in report.cycles] == [0, 1, 2]
+    running = report.cycles[0]
+    assert running.steps == () and running.start_s == 0.0 and running.worst_margin is None
+    assert "already running" in running.result.message
+    np.testing.assert_allclose([c.start_s for c in report.cycles[1:]],
+                               np.subtract(starts[1:], 2.0 - 0.002), atol=2e-3)
+    auto = check(CYCLE, recorded)
+    assert auto.ok and any("already running" in w for w in auto.warnings)
+
+
+def test_start_all_fails_a_cut_cycle_that_violated_before_the_cut() -> None:
+    starts = [0.6, 6.61, 12.6]
+    times, positions, velocities = cycles_recording(starts, bad=2)  # spike 3.0 s into cycle 2
+    report = check(CYCLE, cut(times, positions, velocities, 0.0, starts[2] + 3.5), start="all")
+    assert not report.ok and report.failing_cycles == (2,) and report.incomplete_cycles == ()
+    assert report.cycles[2].result.name == "PATH_TOLERANCE_VIOLATED"
+
+
+def test_start_all_with_no_complete_cycle_is_incomplete() -> None:
+    starts = [0.6]
+    report = check(CYCLE, cut(*cycles_recording(starts), 0.0, 2.0), start="all")
+    assert not report.ok and not report.complete and report.incomplete_cycles == (0,)
+    assert report.result.name == "INCOMPLETE" and "no complete execution" in report.result.message
 
 
 def test_start_all_without_any_execution_is_an_input_error() -> None:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from conftest import SAMPLES, Cli, write_bag
 
-from moveplan.core.jointstates import encode_joint_states, read_joint_states
+from moveplan.core.jointstates import JointStateSeries, encode_joint_states, read_joint_states
 
 RECORDINGS = SAMPLES / "recordings"
 PLAN = RECORDINGS / "tool_up_plan.mcap"
@@ -90,3 +90,105 @@ def test_truncated_recording_is_read_as_far_as_it_goes_with_a_warning(cli: Cli, 
     result = cli("check-tolerances", PLAN, cut, "--start", "0")
     assert result.exit_code in (3, 5), result.stderr
     assert "cut.mcap" in result.stderr and "Traceback" not in result.stderr
+
+
+# --- executions cut off by the recording ---------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def cycle(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, JointStateSeries]:
+    """The joint-goals cycle (home -> two goals -> home) planned, and one fake execution of it."""
+    folder = tmp_path_factory.mktemp("cycle")
+    cli = Cli()
+    plan = folder / "cycle.mcap"
+    assert cli("plan", SAMPLES / "ur10e_joint_goals.yaml", "-o", plan).exit_code == 0
+    executed = folder / "executed.mcap"
+    assert cli("execute", plan, "--fake", "-o", executed).exit_code == 0
+    return plan, read_joint_states(executed)
+
+
+def shift_recording(one: JointStateSeries, path: Path, cycles: int, begin: float = 0.0, end: float = 1.0,
+                    bump: float | None = None) -> Path:
+    """Write `cycles` executions with 1 s at rest after each, from `begin` to `end` (fractions of
+    an execution) into the first and last; `bump` (a fraction) kicks the last one's elbow."""
+    period = float(np.median(np.diff(one.times_s)))
+    count = len(one.positions)
+    cycle = np.concatenate([one.positions, np.repeat(one.positions[-1:], int(1.0 / period), axis=0)])
+    positions = np.concatenate([cycle] * cycles)
+    last = (cycles - 1) * len(cycle)
+    if bump is not None:
+        at = last + int(bump * count)
+        positions[at : at + 5, 2] += 0.3
+    positions = positions[int(begin * count) : last + int(end * count)]
+    stamps = (np.arange(len(positions)) * period * 1e9).astype(np.int64) + 1_700_000_000_000_000_000
+    payloads = encode_joint_states(one.names, stamps, positions)
+    return write_bag(path, [("/joint_states", "sensor_msgs/msg/JointState", int(s), p)
+                            for s, p in zip(stamps, payloads, strict=True)])
+
+
+def test_start_all_counts_a_last_cycle_cut_by_the_recording_as_incomplete(
+        cli: Cli, cycle: tuple[Path, JointStateSeries], tmp_path: Path) -> None:
+    plan, one = cycle
+    recording = shift_recording(one, tmp_path / "shift.mcap", cycles=3, end=0.5)
+    code, document = cli.json("check-tolerances", plan, recording, "--start", "all")
+    assert code == 0
+    assert document["ok"] is True and document["error"] is None
+    assert document["failing_cycles"] == [] and document["incomplete_cycles"] == [2]
+    assert [c["ok"] for c in document["cycles"]] == [True, True, None]
+    assert document["cycles"][2]["result"]["name"] == "INCOMPLETE"
+    assert document["cycles"][2]["result"]["code"] == -100
+    assert "1 incomplete" in document["result"]["message"]
+    text = cli("check-tolerances", plan, recording, "--start", "all")
+    assert text.exit_code == 0
+    words = " ".join(text.stdout.split())  # rich wraps lines at the terminal's width
+    assert "3 executions found; failing: none; incomplete: 1 (cycle 2, cut off by the recording)" in words
+
+
+def test_start_all_counts_a_first_cycle_already_running_as_incomplete(
+        cli: Cli, cycle: tuple[Path, JointStateSeries], tmp_path: Path) -> None:
+    plan, one = cycle
+    recording = shift_recording(one, tmp_path / "shift.mcap", cycles=3, begin=0.4)
+    code, document = cli.json("check-tolerances", plan, recording, "--start", "all")
+    assert code == 0, document
+    assert document["incomplete_cycles"] == [0] and document["failing_cycles"] == []
+    assert [c["ok"] for c in document["cycles"]] == [None, True, True]
+    assert "already running" in document["cycles"][0]["result"]["message"]
+
+
+def test_start_all_fails_a_cut_cycle_that_violated_before_the_cut(
+        cli: Cli, cycle: tuple[Path, JointStateSeries], tmp_path: Path) -> None:
+    plan, one = cycle
+    recording = shift_recording(one, tmp_path / "shift.mcap", cycles=3, end=0.5, bump=1 / 3)
+    code, document = cli.json("check-tolerances", plan, recording, "--start", "all")
+    assert code == 5
+    assert document["failing_cycles"] == [2] and document["incomplete_cycles"] == []
+    assert document["cycles"][2]["ok"] is False
+    assert document["cycles"][2]["result"]["name"] == "PATH_TOLERANCE_VIOLATED"
+    text = cli("check-tolerances", plan, recording, "--start", "all")
+    assert text.exit_code == 5 and "failing: 2; incomplete: 0" in " ".join(text.stdout.split())
+
+
+@pytest.mark.parametrize("start", ["auto", "0", "all"])
+def test_check_with_no_complete_execution_is_bad_input(
+        cli: Cli, cycle: tuple[Path, JointStateSeries], tmp_path: Path, start: str) -> None:
+    plan, one = cycle
+    recording = shift_recording(one, tmp_path / "cut.mcap", cycles=1, end=0.5)
+    code, document = cli.json("check-tolerances", plan, recording, "--start", start)
+    assert code == 3
+    assert document["ok"] is False and document["result"]["name"] == "INCOMPLETE"
+    assert document["violations"] == []
+    error = document["error"]
+    assert error["exit_code"] == 3 and error["kind"] == "InputError"
+    assert "cut.mcap" in error["message"] and "recording ends" in error["message"]
+    text = cli("check-tolerances", plan, recording, "--start", start)
+    assert text.exit_code == 3
+    assert "moveplan: error:" in text.stderr and "cut.mcap" in text.stderr and "Traceback" not in text.stderr
+
+
+def test_single_check_cut_after_a_violation_fails(
+        cli: Cli, cycle: tuple[Path, JointStateSeries], tmp_path: Path) -> None:
+    plan, one = cycle
+    recording = shift_recording(one, tmp_path / "cut.mcap", cycles=1, end=0.5, bump=1 / 3)
+    code, document = cli.json("check-tolerances", plan, recording)
+    assert code == 5
+    assert document["result"]["name"] == "PATH_TOLERANCE_VIOLATED" and document["error"] is None
