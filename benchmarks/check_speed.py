@@ -26,8 +26,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import make_recording  # noqa: E402  (the cycle, controller and joints the file was made with)
 
-from moveplan.core.checking import check_recording, uses_velocities  # noqa: E402
-from moveplan.core.jointstates import read_joint_states  # noqa: E402
+from moveplan.core.bag.jointstates import read_joint_states  # noqa: E402
+from moveplan.core.control.checking import check_recording, uses_velocities  # noqa: E402
 
 
 def peak_rss_mb() -> float:

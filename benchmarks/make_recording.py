@@ -27,9 +27,9 @@ import numpy as np
 from mcap.writer import CompressionType, Writer
 from numpy.typing import NDArray
 
-from moveplan.core.config import ControllerConfig, ExecutionConfig
-from moveplan.core.jointstates import JOINT_STATE_TYPE, encode_joint_states
-from moveplan.core.recording import PlanStepRecord
+from moveplan.core.bag.jointstates import JOINT_STATE_TYPE, encode_joint_states
+from moveplan.core.bag.recording import PlanStepRecord
+from moveplan.core.config.robot_config import ControllerConfig, ExecutionConfig
 from moveplan.core.trajectory import sample
 from moveplan.core.types import JointTrajectory
 
@@ -41,7 +41,7 @@ MOVE_S, PAUSE_S, DWELL_S = 4.0, 0.3, 1.7
 PERIOD_S = 2 * MOVE_S + PAUSE_S + DWELL_S
 DELAY_S, NOISE_RAD = 0.002, 1e-5
 FIRST_S = 1.0
-SCHEMA = Path(__file__).resolve().parents[1] / "core/msgs/jazzy/sensor_msgs__msg__JointState.msg"
+SCHEMA = Path(__file__).resolve().parents[1] / "core/bag/msgs/jazzy/sensor_msgs__msg__JointState.msg"
 QOS = ("- history: 3\n  depth: 0\n  reliability: 1\n  durability: 2\n  deadline:\n    sec: 0\n"
        "    nsec: 0\n  lifespan:\n    sec: 0\n    nsec: 0\n  liveliness: 1\n"
        "  liveliness_lease_duration:\n    sec: 0\n    nsec: 0\n"

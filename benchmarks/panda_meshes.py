@@ -33,11 +33,11 @@ import numpy as np
 import yaml
 from numpy.typing import NDArray
 
-from moveplan.core.collision import CollisionChecker
-from moveplan.core.config import load_robot_config
-from moveplan.core.recording import read_plan
-from moveplan.core.robot import Robot
-from moveplan.core.scene import load_scene
+from moveplan.core.bag.recording import read_plan
+from moveplan.core.collision.checker import CollisionChecker
+from moveplan.core.config.robot_config import load_robot_config
+from moveplan.core.model.robot import Robot
+from moveplan.core.model.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 PANDA = ROOT / "configs" / "panda"

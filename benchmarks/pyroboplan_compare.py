@@ -43,10 +43,10 @@ import pinocchio as pin
 import yaml
 from numpy.typing import NDArray
 
-from moveplan.core.certify import reach, segment_states
-from moveplan.core.collision import CollisionChecker, coal_geometry
-from moveplan.core.config import load_robot_config
-from moveplan.core.robot import Robot
+from moveplan.core.collision.certify import reach, segment_states
+from moveplan.core.collision.checker import CollisionChecker, coal_geometry
+from moveplan.core.config.robot_config import load_robot_config
+from moveplan.core.model.robot import Robot
 from moveplan.core.types import CollisionObject, Shape
 
 MBM = Path("/work/shared/benchmarks/mbm")

@@ -49,9 +49,9 @@ import toppra.constraint
 import toppra.parametrizer
 from numpy.typing import NDArray
 
-from moveplan.core.config import load_robot_config
+from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import PlanningFailed
-from moveplan.core.timing import time_parameterize
+from moveplan.core.timing.parameterize import time_parameterize
 from moveplan.core.trajectory import peak_rates, sample
 from moveplan.core.types import JointTrajectory
 

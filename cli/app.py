@@ -86,8 +86,9 @@ def plan(
     with exit_codes(as_json):
         flags = _plan_flags(locals())
         from moveplan.cli import render
-        from moveplan.core import pipeline, recording
-        from moveplan.core.tasks import load_task
+        from moveplan.core.bag import recording
+        from moveplan.core.config.tasks import load_task
+        from moveplan.core.pipeline import plan as pipeline
 
         request = pipeline.resolve_request(load_task(task) if task else None, flags)
         result = pipeline.plan(request)
@@ -97,9 +98,9 @@ def plan(
 
 def _plan_flags(args: dict[str, Any]) -> dict[str, Any]:
     """Return the plan flags as typed values, None where not given."""
+    from moveplan.core.config.tasks import StepSpec
+    from moveplan.core.config.xacro import parse_xacro_args
     from moveplan.core.errors import UsageError
-    from moveplan.core.tasks import StepSpec
-    from moveplan.core.xacro import parse_xacro_args
 
     starts = [k for k in ("start_joints", "start_named", "start_from") if args[k] is not None]
     goals = [k for k in ("joints", "named", "pose", "shift") if args[k] is not None]
@@ -174,8 +175,8 @@ def execute(
         if not fake:
             raise UsageError("only fake execution exists yet: add --fake to replay through a simulated controller")
         from moveplan.cli import render
-        from moveplan.core.execution import ExecuteRequest
-        from moveplan.core.execution import execute as run
+        from moveplan.core.pipeline.execute import ExecuteRequest
+        from moveplan.core.pipeline.execute import execute as run
 
         request = ExecuteRequest(
             plan=plan_file, plant=plant, plant_params=parse_params(plant_param or [], "--plant-param"),
@@ -187,9 +188,9 @@ def execute(
             raise UsageError("--start-joints: give joint=value pairs")
         outcome = run(request)
         if output is not None:
-            from moveplan.core import recording
+            from moveplan.core.pipeline import report
 
-            recording.write_execution(output, outcome, ros_distro, tf=outcome.tf)
+            report.write_execution(output, outcome, ros_distro, tf=outcome.tf)
     render.execution_summary(outcome, output, as_json, quiet)
     raise typer.Exit(0 if outcome.ok else 5)
 
@@ -215,7 +216,7 @@ def check_tolerances(
     with exit_codes(as_json):
         from moveplan.cli import render
         from moveplan.core.errors import UsageError
-        from moveplan.core.execution import CheckRequest, check
+        from moveplan.core.pipeline.execute import CheckRequest, check
 
         if time_source not in ("header", "log"):
             raise UsageError(f"--time-source: expected header or log, got '{time_source}'")
@@ -239,8 +240,8 @@ def robot_info(
     _logging(False, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render
-        from moveplan.core.config import load_robot_config
-        from moveplan.core.xacro import parse_xacro_args
+        from moveplan.core.config.robot_config import load_robot_config
+        from moveplan.core.config.xacro import parse_xacro_args
 
         loaded = load_robot_config(config, tuple(package_path or ()), parse_xacro_args(xacro_arg or ()))
         loaded.collision_meshes()  # a missing mesh is reported here too, not only when planning
@@ -257,7 +258,7 @@ def inspect(
     _logging(False, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render
-        from moveplan.core import recording
+        from moveplan.core.bag import recording
 
         summary = recording.summarize(file)
         plan_file = recording.read_plan(file) if "moveplan" in summary.metadata else None
@@ -284,9 +285,9 @@ def benchmark(
     _logging(False, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render
-        from moveplan.core import benchmark as bench
-        from moveplan.core.config import load_robot_config
+        from moveplan.core.config.robot_config import load_robot_config
         from moveplan.core.errors import UsageError
+        from moveplan.core.pipeline import benchmark as bench
 
         seed_list = parse_seeds(seeds)
         time_s = parse_number(planning_time, "--planning-time")

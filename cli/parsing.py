@@ -108,7 +108,7 @@ def parse_params(items: list[str], what: str) -> dict[str, float]:
 
 def parse_disturbance(text: str) -> Any:
     """Return a Disturbance from "t=1.2,joint=elbow_joint,delta=0.05"."""
-    from moveplan.core.controller import Disturbance
+    from moveplan.core.control.controller import Disturbance
 
     fields = dict(item.partition("=")[::2] for item in text.split(","))
     fields = {k.strip(): v.strip() for k, v in fields.items()}

@@ -19,11 +19,11 @@ from rich.table import Table
 from moveplan.core.trajectory import peak_rates
 
 if TYPE_CHECKING:  # each command imports only the core modules it runs
-    from moveplan.core.benchmark import Run
-    from moveplan.core.checking import CheckReport
-    from moveplan.core.config import RobotConfig
-    from moveplan.core.execution import PlanExecution
-    from moveplan.core.recording import BagSummary, PlanFile
+    from moveplan.core.bag.recording import BagSummary, PlanFile
+    from moveplan.core.config.robot_config import RobotConfig
+    from moveplan.core.control.checking import CheckReport
+    from moveplan.core.pipeline.benchmark import Run
+    from moveplan.core.pipeline.execute import PlanExecution
     from moveplan.core.types import Plan
 
 __all__ = [

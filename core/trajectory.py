@@ -21,9 +21,12 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from moveplan.core.types import JointTrajectory, frozen_array
+from .types import JointTrajectory, frozen_array
 
-__all__ = ["PointBefore", "peak_rates", "quintic_peak_rates", "sample", "shortest_angular_distance"]
+__all__ = [
+    "PointBefore", "interpolate", "peak_rates", "quintic_peak_rates", "sample", "shortest_angular_distance",
+    "straight_states",
+]
 
 Samples = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
 
@@ -315,3 +318,13 @@ def _quintic(
 
 # c3 h^3, c4 h^4, c5 h^5 times 2, from dp, v0 h, v1 h, a0 h^2, a1 h^2.
 _QUINTIC = np.array([[20.0, -12.0, -8.0, -3.0, 1.0], [-30.0, 16.0, 14.0, 3.0, -2.0], [12.0, -6.0, -6.0, -1.0, 1.0]])
+
+
+def straight_states(a: NDArray[np.float64], b: NDArray[np.float64], count: int) -> NDArray[np.float64]:
+    """Return `count` + 1 evenly spaced states on the straight segment from `a` to `b`, both included."""
+    return a + (b - a) * (np.arange(count + 1) / count)[:, None]
+
+
+def interpolate(a: NDArray[np.float64], b: NDArray[np.float64], resolution: float) -> NDArray[np.float64]:
+    """Return states from `a` to `b` (both included), no joint moving more than `resolution` [rad] per step."""
+    return straight_states(a, b, max(1, int(np.ceil(np.max(np.abs(b - a)) / resolution))))

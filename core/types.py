@@ -6,7 +6,7 @@ cannot change after it has been checked.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any, Literal
 
 import numpy as np
@@ -14,6 +14,8 @@ import numpy.typing as npt
 from numpy.typing import NDArray
 
 __all__ = [
+    "ControllerStates",
+    "PointSeries",
     "CollisionObject",
     "Frame",
     "JointStateSeries",
@@ -262,3 +264,61 @@ class Plan:
     limits: dict[str, dict[str, float]] = field(default_factory=dict)
     attachments: dict[str, bytes] = field(default_factory=dict)
     metadata: dict[str, str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class PointSeries:
+    """A trajectory_msgs/JointTrajectoryPoint per cycle: each field (K, n), or None = left empty.
+
+    As in JTC's state message, a field holds a value for every joint or is empty.
+    """
+
+    positions: NDArray[np.float64] | None = None
+    velocities: NDArray[np.float64] | None = None
+    accelerations: NDArray[np.float64] | None = None
+    effort: NDArray[np.float64] | None = None
+
+    def filled(self) -> list[NDArray[np.float64] | None]:
+        """Return positions, velocities, accelerations, effort in message field order."""
+        return [self.positions, self.velocities, self.accelerations, self.effort]
+
+
+@dataclass(frozen=True)
+class ControllerStates:
+    """A JointTrajectoryController's state over K cycles, one JointTrajectoryControllerState each.
+
+    Attributes:
+        joint_names: The controller's joints, the column order of every array (n).
+        stamps_ns: header.stamp of each cycle in [ns], shape (K,).
+        times_from_start_ns: time_from_start of each cycle's points in [ns], shape (K,).
+        reference, feedback, error, output: The message's points, fields (K, n) or None.
+
+    """
+
+    joint_names: tuple[str, ...]
+    stamps_ns: NDArray[np.int64]
+    times_from_start_ns: NDArray[np.int64]
+    reference: PointSeries
+    feedback: PointSeries
+    error: PointSeries
+    output: PointSeries
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "joint_names", tuple(self.joint_names))
+        stamps = np.array(self.stamps_ns, dtype=np.int64).reshape(-1)
+        times = np.array(self.times_from_start_ns, dtype=np.int64).reshape(-1)
+        if times.shape != stamps.shape:
+            raise ValueError(
+                f"times_from_start_ns: expected shape {stamps.shape}, got {times.shape}"
+            )
+        object.__setattr__(self, "stamps_ns", stamps)
+        object.__setattr__(self, "times_from_start_ns", times)
+        shape = (len(stamps), len(self.joint_names))
+        for name in ("reference", "feedback", "error", "output"):
+            series: PointSeries = getattr(self, name)
+            checked = {
+                field.name: frozen_array(value, shape, f"{name}.{field.name}")
+                for field, value in zip(fields(series), series.filled(), strict=True)
+                if value is not None
+            }
+            object.__setattr__(self, name, PointSeries(**checked))

@@ -15,8 +15,8 @@ from mcap.writer import CompressionType, Writer
 from typer.testing import CliRunner
 
 from moveplan.cli.app import app
-from moveplan.core.config import RobotConfig, load_robot_config
-from moveplan.core.robot import Robot
+from moveplan.core.config.robot_config import RobotConfig, load_robot_config
+from moveplan.core.model.robot import Robot
 from moveplan.core.trajectory import sample
 from moveplan.core.types import JointTrajectory
 
@@ -71,7 +71,7 @@ def dense_peaks(trajectory: JointTrajectory, per_segment: int = 64) -> tuple[np.
     return np.abs(velocities).max(axis=0), np.abs(accelerations).max(axis=0)
 
 
-MSGS = ROOT / "core" / "msgs" / "jazzy"
+MSGS = ROOT / "core" / "bag" / "msgs" / "jazzy"
 SCHEMAS = {
     "sensor_msgs/msg/JointState": (MSGS / "sensor_msgs__msg__JointState.msg").read_bytes(),
     "std_msgs/msg/String": (MSGS / "std_msgs__msg__String.msg").read_bytes(),

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from conftest import ROOT, Cli
 
-from moveplan.core.benchmark import Run, find_problems, summarize
+from moveplan.core.pipeline.benchmark import Run, find_problems, summarize
 
 MBM = ROOT / "tests" / "data" / "mbm" / "problems" / "box_panda"
 

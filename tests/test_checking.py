@@ -9,19 +9,19 @@ import numpy as np
 import pytest
 from mcap.writer import Writer
 
-from moveplan.core.checking import CheckReport, check_recording, uses_velocities
-from moveplan.core.config import ControllerConfig, ExecutionConfig
-from moveplan.core.controller import WAIT_LIMIT_S, Disturbance, simulate
-from moveplan.core.errors import InputError, UsageError
-from moveplan.core.jointstates import (
+from moveplan.core.bag.jointstates import (
     JOINT_STATE_TYPE,
     JointStateSeries,
     encode_joint_states,
     read_joint_states,
 )
-from moveplan.core.plants import MirrorPlant
-from moveplan.core.recording import PlanStepRecord
-from moveplan.core.tolerances import INCOMPLETE
+from moveplan.core.bag.recording import PlanStepRecord
+from moveplan.core.config.robot_config import ControllerConfig, ExecutionConfig
+from moveplan.core.control.checking import CheckReport, check_recording, uses_velocities
+from moveplan.core.control.controller import WAIT_LIMIT_S, Disturbance, simulate
+from moveplan.core.control.plants import MirrorPlant
+from moveplan.core.control.tolerances import INCOMPLETE
+from moveplan.core.errors import InputError, UsageError
 from moveplan.core.trajectory import sample
 from moveplan.core.types import JointTrajectory
 
@@ -31,7 +31,7 @@ HOME = np.array([0.0, -np.pi / 2, -np.pi / 2, 0.0, 0.0, 0.0])
 PICK = HOME + np.array([1.0, 0.5, -0.8, 1.2, -1.0, 1.5])
 RATE = 250.0
 EXECUTION = ExecutionConfig()
-SCHEMA = (Path(__file__).resolve().parents[1] / "core/msgs/jazzy/sensor_msgs__msg__JointState.msg")
+SCHEMA = (Path(__file__).resolve().parents[1] / "core/bag/msgs/jazzy/sensor_msgs__msg__JointState.msg")
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from conftest import SAMPLES, Cli, write_bag
 
-from moveplan.core.jointstates import JointStateSeries, encode_joint_states, read_joint_states
+from moveplan.core.bag.jointstates import JointStateSeries, encode_joint_states, read_joint_states
 
 RECORDINGS = SAMPLES / "recordings"
 PLAN = RECORDINGS / "tool_up_plan.mcap"

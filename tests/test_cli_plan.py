@@ -10,10 +10,10 @@ import pytest
 from conftest import SAMPLES, TABLE_SCENE, UR10E, Cli, dense_peaks, run_process
 from rosbags.highlevel import AnyReader
 
-from moveplan.core.collision import CollisionChecker
-from moveplan.core.recording import read_plan
-from moveplan.core.robot import Robot
-from moveplan.core.scene import load_scene
+from moveplan.core.bag.recording import read_plan
+from moveplan.core.collision.checker import CollisionChecker
+from moveplan.core.model.robot import Robot
+from moveplan.core.model.scene import load_scene
 from moveplan.core.trajectory import sample
 
 GOAL = [0.5, -1.2, -1.8, 0.0, 1.57, 0.0]

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from conftest import ROOT, TABLE_SCENE
 
-from moveplan.core.collision import CollisionChecker
-from moveplan.core.config import load_robot_config
+from moveplan.core.collision.checker import CollisionChecker
+from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import StartInCollision
-from moveplan.core.robot import Robot
-from moveplan.core.scene import load_scene
+from moveplan.core.model.robot import Robot
+from moveplan.core.model.scene import load_scene
 from moveplan.core.types import CollisionObject, Shape
 
 

@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 from conftest import ROOT, SAMPLES, Cli
 
-from moveplan.core import pipeline
-from moveplan.core.collision import CollisionChecker
-from moveplan.core.config import load_robot_config
+from moveplan.core.collision.checker import CollisionChecker
+from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import ConfigError
-from moveplan.core.robot import Robot
-from moveplan.core.scene import load_scene
+from moveplan.core.model.robot import Robot
+from moveplan.core.model.scene import load_scene
+from moveplan.core.pipeline import plan as pipeline
 
 PANDA = ROOT / "configs" / "panda"
 SHELF_SCENE = SAMPLES / "panda_shelf_scene.yaml"

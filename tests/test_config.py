@@ -9,12 +9,12 @@ import pytest
 import yaml
 from conftest import ROOT, UR10E, Cli
 
-from moveplan.core import recording
-from moveplan.core.collision import CollisionChecker
-from moveplan.core.config import RobotConfig, load_robot_config, resolve_config_path, search_path
+from moveplan.core.bag import recording
+from moveplan.core.collision.checker import CollisionChecker
+from moveplan.core.config.robot_config import RobotConfig, load_robot_config, resolve_config_path, search_path
+from moveplan.core.config.xacro import PackagePath, parse_xacro_args
 from moveplan.core.errors import ConfigError, UnknownName, UsageError
-from moveplan.core.robot import Robot
-from moveplan.core.xacro import PackagePath, parse_xacro_args
+from moveplan.core.model.robot import Robot
 
 PANDA = ROOT / "configs" / "panda"
 MBM_PANDA = ROOT / "tests" / "data" / "mbm" / "panda_robot"

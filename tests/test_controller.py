@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from moveplan.core.config import ControllerConfig, ExecutionConfig
-from moveplan.core.controller import WAIT_LIMIT_S, Disturbance, simulate
+from moveplan.core.config.robot_config import ControllerConfig, ExecutionConfig
+from moveplan.core.control.controller import WAIT_LIMIT_S, Disturbance, simulate
+from moveplan.core.control.plants import FrozenPlant, LagPlant, MirrorPlant, PidPlant, make_plant
 from moveplan.core.errors import InputError, UnknownName, UsageError
-from moveplan.core.plants import FrozenPlant, LagPlant, MirrorPlant, PidPlant, make_plant
 from moveplan.core.types import JointTrajectory
 
 # The upstream fixture (test_trajectory_controller_utils.hpp): three joints at 1.1, 2.1, 3.1.

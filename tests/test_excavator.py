@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 from conftest import ROOT, SAMPLES, Cli
 
-from moveplan.core.collision import CollisionChecker
-from moveplan.core.config import load_robot_config
-from moveplan.core.recording import PlanFile, read_plan
-from moveplan.core.robot import Robot
-from moveplan.core.scene import load_scene
+from moveplan.core.bag.recording import PlanFile, read_plan
+from moveplan.core.collision.checker import CollisionChecker
+from moveplan.core.config.robot_config import load_robot_config
+from moveplan.core.model.robot import Robot
+from moveplan.core.model.scene import load_scene
 from moveplan.core.trajectory import sample
 
 EXCAVATOR = ROOT / "configs" / "excavator"

@@ -1,4 +1,4 @@
-"""Executed files from recording.write_execution, checked by rosbags and the generic encoder."""
+"""Executed files from report.write_execution, checked by rosbags and the generic encoder."""
 
 from __future__ import annotations
 
@@ -18,20 +18,22 @@ from mcap_ros2._dynamic import serialize_dynamic
 from rosbags.highlevel import AnyReader
 from rosbags.interfaces import ConnectionExtRosbag2, QosDurability
 
-from moveplan.core import recording
-from moveplan.core import ros_messages as msgs
-from moveplan.core.config import ControllerConfig, ExecutionConfig
-from moveplan.core.controller import ExecutionReport, simulate
+from moveplan.core.bag import messages as msgs
+from moveplan.core.bag import recording
+from moveplan.core.bag.jointstate_cdr import encode_joint_states
+from moveplan.core.config.robot_config import ControllerConfig, ExecutionConfig
+from moveplan.core.control.controller import ExecutionReport, simulate
+from moveplan.core.control.plants import FrozenPlant, MirrorPlant, make_plant
+from moveplan.core.control.published import controller_states
+from moveplan.core.control.tolerances import Violation
 from moveplan.core.errors import InputError, UsageError
-from moveplan.core.execution import PlanExecution, StepExecution
-from moveplan.core.jointstate_cdr import encode_joint_states
-from moveplan.core.plants import FrozenPlant, MirrorPlant, make_plant
-from moveplan.core.tolerances import Violation
+from moveplan.core.pipeline.execute import PlanExecution, StepExecution
+from moveplan.core.pipeline.report import write_execution
 from moveplan.core.types import JointTrajectory, Plan, StepResult, TfSamples
 
 DISTROS = sorted(
     entry.name
-    for entry in files("moveplan.core.msgs").iterdir()
+    for entry in files("moveplan.core.bag.msgs").iterdir()
     if entry.is_dir() and entry.name.isalpha()
 )
 JOINTS = ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint")
@@ -108,7 +110,7 @@ def two_steps() -> PlanExecution:
 
 def write(tmp_path: Path, execution: PlanExecution, distro: str = "jazzy", **kwargs: Any) -> Path:
     path = tmp_path / f"executed_{distro}.mcap"
-    recording.write_execution(path, execution, distro, **kwargs)
+    write_execution(path, execution, distro, **kwargs)
     return path
 
 
@@ -137,7 +139,7 @@ def cycle_stamps(execution: PlanExecution) -> list[int]:
 
 def generic(msgtype: str, distro: str, message: dict[str, Any]) -> bytes:
     """CDR of `message` from mcap_ros2's schema-driven encoder, the reference."""
-    schema = files("moveplan.core.msgs").joinpath(distro, msgtype.replace("/", "__") + ".msg")
+    schema = files("moveplan.core.bag.msgs").joinpath(distro, msgtype.replace("/", "__") + ".msg")
     return bytes(serialize_dynamic(msgtype, schema.read_text())[msgtype](message))
 
 
@@ -156,7 +158,7 @@ def test_executed_file_has_the_topics_types_counts_and_schemas_of_its_distro(
 ) -> None:
     path = write(tmp_path, two_steps, distro)
     cycles = sum(len(s.report.times_s) for s in two_steps.steps)
-    shipped = files("moveplan.core.msgs").joinpath(distro)
+    shipped = files("moveplan.core.bag.msgs").joinpath(distro)
     with AnyReader([path]) as reader:
         counts = {topic: info.msgcount for topic, info in reader.topics.items()}
         types = {c.topic: c.msgtype for c in reader.connections}
@@ -444,8 +446,8 @@ def test_plan_file_without_urdf_argument_still_builds() -> None:
 def test_same_execution_written_twice_gives_identical_bytes(
     tmp_path: Path, two_steps: PlanExecution
 ) -> None:
-    recording.write_execution(tmp_path / "a.mcap", two_steps, "humble")
-    recording.write_execution(tmp_path / "b.mcap", two_steps, "humble")
+    write_execution(tmp_path / "a.mcap", two_steps, "humble")
+    write_execution(tmp_path / "b.mcap", two_steps, "humble")
     assert (tmp_path / "a.mcap").read_bytes() == (tmp_path / "b.mcap").read_bytes()
 
 
@@ -457,7 +459,7 @@ def test_failed_write_leaves_no_file_behind(
 
     monkeypatch.setattr(mcap.writer.Writer, "add_metadata", fail)
     with pytest.raises(RuntimeError, match="disk on fire"):
-        recording.write_execution(tmp_path / "executed.mcap", two_steps)
+        write_execution(tmp_path / "executed.mcap", two_steps)
     assert list(tmp_path.iterdir()) == []
 
 
@@ -468,7 +470,7 @@ def test_failed_write_keeps_the_previous_file(
     path.write_bytes(b"previous run")
     monkeypatch.setattr(mcap.writer.Writer, "finish", lambda self: 1 / 0)
     with pytest.raises(ZeroDivisionError):
-        recording.write_execution(path, two_steps)
+        write_execution(path, two_steps)
     assert [p.name for p in tmp_path.iterdir()] == ["executed.mcap"]
     assert path.read_bytes() == b"previous run"
 
@@ -478,14 +480,14 @@ def test_write_into_a_missing_folder_raises_input_error_naming_it(
 ) -> None:
     path = tmp_path / "no" / "executed.mcap"
     with pytest.raises(InputError, match=re.escape(str(path)) + ".*cannot write"):
-        recording.write_execution(path, two_steps)
+        write_execution(path, two_steps)
 
 
 def test_unknown_distro_raises_usage_error_and_writes_nothing(
     tmp_path: Path, two_steps: PlanExecution
 ) -> None:
     with pytest.raises(UsageError, match="rolling.*humble, jazzy"):
-        recording.write_execution(tmp_path / "executed.mcap", two_steps, "rolling")
+        write_execution(tmp_path / "executed.mcap", two_steps, "rolling")
     assert list(tmp_path.iterdir()) == []
 
 
@@ -591,7 +593,7 @@ def test_every_written_message_is_what_the_generic_encoder_writes(
     start = 0
     for report in reports:
         times = np.rint(report.times_s * 1e9).astype(np.int64)
-        states = recording._controller_states(report, controller, start + times, times)
+        states = controller_states(report, controller, start + times, times)
         expected_states += [
             generic(CONTROLLER_STATE, distro, msgs.controller_state(states, k, distro))
             for k in range(len(times))
@@ -615,10 +617,10 @@ def test_ten_seconds_at_one_kilohertz_are_written_in_well_under_half_a_second(
     report = simulate(trajectory, controller, ExecutionConfig(), MirrorPlant(6))
     assert len(report.times_s) >= 10_000
     execution = execution_of([("move", report)], controller)
-    recording.write_execution(tmp_path / "warm.mcap", execution, distro)
+    write_execution(tmp_path / "warm.mcap", execution, distro)
     best = float("inf")
     for _ in range(3):
         start = time.perf_counter()
-        recording.write_execution(tmp_path / "executed.mcap", execution, distro)
+        write_execution(tmp_path / "executed.mcap", execution, distro)
         best = min(best, time.perf_counter() - start)
     assert best < 0.5

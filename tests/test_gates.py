@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from conftest import ROOT, SAMPLES, Cli, run_process
 
-from moveplan.core.benchmark import find_problems, run_benchmark
+from moveplan.core.pipeline.benchmark import find_problems, run_benchmark
 
 MBM = ROOT / "tests" / "data" / "mbm"
 TASKS = sorted(p for p in SAMPLES.glob("*.yaml") if "steps:" in p.read_text())

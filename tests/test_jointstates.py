@@ -12,16 +12,16 @@ from mcap.writer import CompressionType, Writer
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 
-from moveplan.core.errors import InputError
-from moveplan.core.jointstates import (
+from moveplan.core.bag.jointstates import (
     JOINT_STATE_TYPE,
     JointStateSeries,
     encode_joint_states,
     read_joint_states,
 )
+from moveplan.core.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[1]
-MSGS = ROOT / "core" / "msgs" / "jazzy"
+MSGS = ROOT / "core" / "bag" / "msgs" / "jazzy"
 SCHEMAS = {
     JOINT_STATE_TYPE: (MSGS / "sensor_msgs__msg__JointState.msg").read_bytes(),
     "std_msgs/msg/String": (MSGS / "std_msgs__msg__String.msg").read_bytes(),

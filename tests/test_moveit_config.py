@@ -12,11 +12,11 @@ import pytest
 import yaml
 from conftest import ROOT, Cli
 
-from moveplan.core import recording
-from moveplan.core.config import RobotConfig, load_robot_config
+from moveplan.core.bag import recording
+from moveplan.core.config.robot_config import RobotConfig, load_robot_config
 from moveplan.core.errors import ConfigError, UsageError
-from moveplan.core.execution import plan_config
-from moveplan.core.robot import Robot
+from moveplan.core.model.robot import Robot
+from moveplan.core.pipeline.execute import plan_config
 
 DATA = ROOT / "tests" / "data"
 PACKAGE = DATA / "ur10e_moveit_config"

@@ -13,13 +13,13 @@ import yaml
 from conftest import ROOT, Cli
 from rosbags.highlevel import AnyReader
 
-from moveplan.core.collision import CollisionChecker, coal_geometry
-from moveplan.core.config import load_robot_config
+from moveplan.core.bag.recording import read_plan
+from moveplan.core.collision.checker import CollisionChecker, coal_geometry
+from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import ConfigError, FrameNotFound
-from moveplan.core.moveit_request import load_motion_plan_request, planner_name
-from moveplan.core.recording import read_plan
-from moveplan.core.robot import Robot
-from moveplan.core.scene import load_scene
+from moveplan.core.model.moveit_request import load_motion_plan_request, planner_name
+from moveplan.core.model.robot import Robot
+from moveplan.core.model.scene import load_scene
 
 MBM = ROOT / "tests" / "data" / "mbm"
 SCENE, REQUEST = MBM / "problems" / "box_panda" / "scene0001.yaml", MBM / "problems" / "box_panda" / "request0001.yaml"

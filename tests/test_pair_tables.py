@@ -8,12 +8,12 @@ import pinocchio as pin
 import pytest
 from conftest import UR10E
 
-from moveplan.core import pair_tables
-from moveplan.core.collision import CollisionChecker
-from moveplan.core.config import load_robot_config
-from moveplan.core.robot import Robot
-from moveplan.core.sphere_check import CLEAR, COLLIDES, _table_arrays
-from moveplan.core.sphere_kernels import tabled
+from moveplan.core.collision import pair_tables
+from moveplan.core.collision._kernels import tabled
+from moveplan.core.collision.checker import CollisionChecker
+from moveplan.core.collision.sphere_filter import CLEAR, COLLIDES, _table_arrays
+from moveplan.core.config.robot_config import load_robot_config
+from moveplan.core.model.robot import Robot
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from conftest import dense_peaks
 
-from moveplan.core.pipeline import _rest_to_rest
+from moveplan.core.pipeline.plan import _rest_to_rest
 from moveplan.core.trajectory import sample
 
 

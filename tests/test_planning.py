@@ -7,9 +7,10 @@ import time
 import numpy as np
 import pytest
 
-from moveplan.core import planning
 from moveplan.core.errors import PlanningFailed
-from moveplan.core.planning import Validity, interpolate, plan_path, repair_path
+from moveplan.core.planning import search as planning
+from moveplan.core.planning.search import Validity, plan_path, repair_path
+from moveplan.core.trajectory import interpolate
 
 LOWER, UPPER = np.array([-1.0, -1.0]), np.array([2.0, 2.0])
 
@@ -96,3 +97,12 @@ def test_the_same_seed_gives_the_same_path_whatever_ran_before() -> None:
     np.testing.assert_array_equal(paths[0].waypoints, paths[2].waypoints)
     assert paths[0].checks == paths[2].checks > 1
     assert not np.array_equal(paths[0].waypoints, paths[1].waypoints)
+
+
+def test_the_planners_known_without_ompl_are_the_ompl_packages_own() -> None:
+    from ompl import base as ob
+    from ompl import geometric as og
+
+    found = {name for name in dir(og)
+             if name[0].isupper() and isinstance(getattr(og, name), type) and issubclass(getattr(og, name), ob.Planner)}
+    assert set(planning.PLANNERS) == found

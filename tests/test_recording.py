@@ -16,8 +16,8 @@ from mcap_ros2._dynamic import serialize_dynamic
 from rosbags.highlevel import AnyReader
 from rosbags.interfaces import ConnectionExtRosbag2, QosDurability
 
-from moveplan.core import recording
-from moveplan.core import ros_messages as msgs
+from moveplan.core.bag import messages as msgs
+from moveplan.core.bag import recording
 from moveplan.core.errors import InputError, UsageError
 from moveplan.core.types import (
     CollisionObject,
@@ -41,7 +41,7 @@ TYPES = {
 }
 DISTROS = sorted(
     entry.name
-    for entry in files("moveplan.core.msgs").iterdir()
+    for entry in files("moveplan.core.bag.msgs").iterdir()
     if entry.is_dir() and entry.name.isalpha()
 )
 
@@ -233,7 +233,7 @@ def test_every_channel_is_cdr_with_the_shipped_schema_text_byte_for_byte(
 ) -> None:
     path = tmp_path / "plan.mcap"
     recording.write_plan(path, plan, distro=distro)
-    shipped = files("moveplan.core.msgs").joinpath(distro)
+    shipped = files("moveplan.core.bag.msgs").joinpath(distro)
     schemas = {}
     for opcode, fields in top_level_records(path):
         if opcode == 0x03:
@@ -584,7 +584,7 @@ ODD_NAMES = ("j", "jo", "joi", "join", "joint", "joint_", "joint_1", "joint_12",
 
 def generic(msgtype: str, distro: str, message: dict[str, Any]) -> bytes:
     """CDR of `message` from mcap_ros2's schema-driven encoder, the reference."""
-    schema = files("moveplan.core.msgs").joinpath(distro, msgtype.replace("/", "__") + ".msg")
+    schema = files("moveplan.core.bag.msgs").joinpath(distro, msgtype.replace("/", "__") + ".msg")
     return bytes(serialize_dynamic(msgtype, schema.read_text())[msgtype](message))
 
 

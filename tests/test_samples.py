@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from conftest import SAMPLES, Cli
 
-from moveplan.core.recording import PlanFile, read_plan
-from moveplan.core.robot import Robot
+from moveplan.core.bag.recording import PlanFile, read_plan
+from moveplan.core.model.robot import Robot
 from moveplan.core.trajectory import sample
 
 WORKSHOP = {

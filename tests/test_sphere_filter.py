@@ -9,14 +9,14 @@ import pinocchio as pin
 import pytest
 from conftest import ROOT, UR10E
 
-from moveplan.core import sphere_model
-from moveplan.core.collision import CollisionChecker
-from moveplan.core.config import load_robot_config
-from moveplan.core.robot import Robot
-from moveplan.core.scene import load_scene
-from moveplan.core.sphere_check import CLEAR, COLLIDES, SphereFilter
-from moveplan.core.sphere_model import fit_geometry, robot_spheres
-from moveplan.core.validity import MotionChecker
+from moveplan.core.collision import sphere_fit as sphere_model
+from moveplan.core.collision.checker import CollisionChecker
+from moveplan.core.collision.motion import MotionChecker
+from moveplan.core.collision.sphere_filter import CLEAR, COLLIDES, SphereFilter
+from moveplan.core.collision.sphere_fit import fit_geometry, robot_spheres
+from moveplan.core.config.robot_config import load_robot_config
+from moveplan.core.model.robot import Robot
+from moveplan.core.model.scene import load_scene
 
 PANDA = ROOT / "configs" / "panda"
 MBM = ROOT / "tests" / "data" / "mbm"

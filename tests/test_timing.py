@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from conftest import dense_peaks
 
-from moveplan.core.timing import time_parameterize
+from moveplan.core.timing.parameterize import time_parameterize
 from moveplan.core.trajectory import peak_rates, sample
 from moveplan.core.types import JointTrajectory
 

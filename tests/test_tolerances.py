@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from moveplan.core.config import ControllerConfig, ExecutionConfig
-from moveplan.core.tolerances import (
+from moveplan.core.config.robot_config import ControllerConfig, ExecutionConfig
+from moveplan.core.control.tolerances import (
     GOAL_TOLERANCE_VIOLATED,
     PATH_TOLERANCE_VIOLATED,
     START_STATE_INVALID,

@@ -1,0 +1,371 @@
+"""Joint states from any MCAP file: sensor_msgs/msg/JointState messages as numpy columns.
+
+Fast enough for hour-long 1 kHz recordings: core.mcapreader hands over a topic's
+payloads chunk by chunk, and the rows whose bytes up to the position array equal a
+template row's (same frame_id, same names, same array sizes) are decoded together with
+numpy. Rows laid out differently get their own template, or are decoded one by one.
+The CDR layout itself is core.jointstate_cdr's, which also encodes payloads
+(`encode_joint_states`, re-exported here with JOINT_STATE_TYPE and JointStateSeries).
+"""
+
+from __future__ import annotations
+
+import logging
+import mmap
+import struct
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError, known
+from ..types import JointStateSeries, TimeSource
+from .jointstate_cdr import (
+    JOINT_STATE_TYPE,
+    JointStateLayout,
+    check_definition,
+    encode_joint_states,
+    parse_layout,
+)
+from .reader import Channel, CorruptData, byte_rows, read_topic
+
+__all__ = ["JOINT_STATE_TYPE", "JointStateSeries", "encode_joint_states", "read_joint_states"]
+
+logger = logging.getLogger(__name__)
+
+# Templates tried per batch before the remaining rows are decoded one by one: enough for
+# a few publishers sharing a topic (arm and gripper), bounded for pathological files.
+_MAX_LAYOUTS = 8
+
+
+def read_joint_states(
+    path: str | Path,
+    topic: str = "/joint_states",
+    joints: Sequence[str] | None = None,
+    time_source: TimeSource = "header",
+    velocities: bool = True,
+) -> JointStateSeries:
+    """Return the joint states recorded on `topic`, columns in the order of `joints`.
+
+    Messages may list joints in any order and carry extra joints. Messages that lack one
+    of `joints` (another publisher on the same topic, a gripper) are skipped, with a
+    warning when some are. Samples are sorted by time.
+
+    Args:
+        path: An MCAP file, or a rosbag2 folder whose *.mcap files are read in split order.
+        topic: The sensor_msgs/msg/JointState topic.
+        joints: Joints to keep, in column order; None = those of the first message.
+        time_source: "header" for header.stamp (falls back to log time, with a warning,
+            when every stamp is zero), "log" for the MCAP log time (receive time).
+        velocities: False to leave the recorded velocities unread (series.velocities is None):
+            an hour at 1 kHz holds 170 MB of them.
+
+    Raises:
+        InputError: The file is missing, not MCAP, truncated or corrupt; the topic is
+            absent (the message lists the topics present) or not JointState; or no
+            message carries all of `joints` (the message lists the joints present).
+
+    """
+    if time_source not in ("header", "log"):
+        raise ValueError(f"time_source must be 'header' or 'log', got {time_source!r}")
+    source = Path(path)
+    decoder = _Decoder(source, topic, tuple(joints) if joints is not None else None, velocities)
+    read_topic(source, topic, decoder)
+    return decoder.series(time_source)
+
+
+class _Decoder:
+    """Collects decoded columns across chunks and files: the MessageSink of read_topic."""
+
+    def __init__(
+        self, source: Path, topic: str, joints: tuple[str, ...] | None, velocities: bool = True
+    ) -> None:
+        self.source, self.topic, self.joints = source, topic, joints
+        self.columns = _Columns(velocities)
+        # The layout of the last rows decoded together, and a row laid out so.
+        self.template: tuple[NDArray[np.uint8], JointStateLayout] | None = None
+        self.joint_columns: dict[tuple[str, ...], NDArray[np.intp] | None] = {}
+        self.seen_joints: set[str] = set()
+        self.skipped = 0
+        self.messages = 0
+
+    def check(self, path: Path, channel: Channel) -> None:
+        """Raise InputError unless `channel` carries CDR JointState messages."""
+        name, topic = channel.schema_name, channel.topic
+        if name != JOINT_STATE_TYPE:
+            raise InputError(f"{path}: topic {topic} has type {name or '(no schema)'}, "
+                             f"expected {JOINT_STATE_TYPE}")
+        if channel.message_encoding != "cdr":
+            raise InputError(f"{path}: topic {topic} is encoded as "
+                             f"'{channel.message_encoding}', expected cdr")
+        if channel.schema_encoding == "ros2msg":
+            check_definition(path, topic, channel.schema_data)
+
+    def reserve(self, count: int) -> None:
+        """Expect about `count` more messages."""
+        self.columns.reserve(count)
+
+    def add_rows(self, rows: NDArray[np.uint8], log_times: NDArray[np.int64]) -> bool:
+        """Decode payloads of equal length, one per row; return False if they differ in layout."""
+        # Rows laid out as the previous batch's take its layout without parsing one again.
+        template = self.template
+        if (template is None or template[1].length != rows.shape[1]
+                or not _matches(rows, *template).all()):
+            layout = self._layout(rows[0], 0, rows.shape[1])
+            if not layout.little or not _matches(rows, rows[0], layout).all():
+                return False
+            template = self.template = (np.array(rows[0]), layout)
+        self.messages += len(rows)
+        self._add_rows(rows, template[1], log_times)
+        return True
+
+    def add(
+        self, buf: NDArray[np.uint8], starts: NDArray[np.int64], lengths: NDArray[np.int64],
+        log_times: NDArray[np.int64],
+    ) -> None:
+        """Decode the payloads buf[starts[i] : starts[i] + lengths[i]]."""
+        self.messages += len(starts)
+        remaining = np.arange(len(starts))
+        for _ in range(_MAX_LAYOUTS):
+            if len(remaining) == 0:
+                return
+            template = self._layout(buf, int(starts[remaining[0]]), int(lengths[remaining[0]]))
+            if not template.little:
+                break
+            same = remaining[lengths[remaining] == template.length]
+            rows = byte_rows(buf, starts[same], template.length)
+            match = _matches(rows, rows[0], template)
+            self._add_rows(rows if match.all() else rows[match], template, log_times[same[match]])
+            matched = np.zeros(len(starts), dtype=bool)
+            matched[same[match]] = True
+            remaining = remaining[~matched[remaining]]
+        self._add_each(buf, starts[remaining], lengths[remaining], log_times[remaining])
+
+    def _layout(self, buf: NDArray[np.uint8], start: int, length: int) -> JointStateLayout:
+        try:
+            return parse_layout(bytes(buf[start : start + length]))
+        except (struct.error, UnicodeDecodeError):
+            raise CorruptData("a JointState message is malformed") from None
+        except ValueError as exc:
+            raise CorruptData(str(exc)) from None
+
+    def _columns(self, names: tuple[str, ...], size: int) -> NDArray[np.intp] | None:
+        """Return the columns of the wanted joints in a message with `names`, or None."""
+        if names not in self.joint_columns:
+            self.seen_joints.update(names)
+            if self.joints is None and size == len(names) and names:
+                self.joints = tuple(dict.fromkeys(names))
+            found = {name: i for i, name in reversed(list(enumerate(names)))}
+            usable = self.joints is not None and all(j in found for j in self.joints)
+            self.joint_columns[names] = (
+                np.array([found[j] for j in self.joints or ()], dtype=np.intp) if usable else None
+            )
+        columns = self.joint_columns[names]
+        # JointState arrays must match the names; a message without positions is unusable.
+        return columns if columns is not None and size == len(names) else None
+
+    def _add_rows(
+        self, rows: NDArray[np.uint8], layout: JointStateLayout, log_times: NDArray[np.int64]
+    ) -> None:
+        columns = self._columns(layout.names, layout.position_size)
+        if columns is None:
+            self.skipped += len(rows)
+            return
+        n = layout.position_size
+        seconds = rows[:, 4:8].view("<i4")[:, 0].astype(np.int64)
+        times = seconds * 1_000_000_000 + rows[:, 8:12].view("<u4")[:, 0]
+        velocities = None
+        if layout.velocity_size == n:
+            velocities = _floats(rows, layout.velocity_at, n, columns)
+        self.columns.append(times, log_times, _floats(rows, layout.position_at, n, columns),
+                            velocities)
+
+    def _add_each(
+        self, buf: NDArray[np.uint8], starts: NDArray[np.int64], lengths: NDArray[np.int64],
+        log_times: NDArray[np.int64],
+    ) -> None:
+        """Decode payloads one by one: big-endian ones, or layouts beyond the templates tried."""
+        times, kept_log_times, positions, velocities = [], [], [], []
+        for start, length, log_time in zip(starts.tolist(), lengths.tolist(), log_times.tolist(),
+                                           strict=True):
+            layout = self._layout(buf, start, length)
+            columns = self._columns(layout.names, layout.position_size)
+            if columns is None:
+                self.skipped += 1
+                continue
+            data = bytes(buf[start : start + length])
+            kind = ("<" if layout.little else ">") + "f8"
+            n = layout.position_size
+            times.append(layout.stamp_ns)
+            kept_log_times.append(log_time)
+            positions.append(np.frombuffer(data, kind, n, layout.position_at)[columns])
+            if layout.velocity_size == n:
+                velocities.append(np.frombuffer(data, kind, n, layout.velocity_at)[columns])
+        if times:
+            complete = len(velocities) == len(positions)
+            self.columns.append(np.array(times, dtype=np.int64),
+                                np.array(kept_log_times, dtype=np.int64),
+                                np.array(positions, dtype=np.float64),
+                                np.array(velocities, dtype=np.float64) if complete else None)
+
+    def series(self, time_source: TimeSource) -> JointStateSeries:
+        """Return the collected samples as a series, sorted by time."""
+        source = self.source
+        if self.columns.count == 0:
+            wanted = self.joints or ()
+            missing = [j for j in wanted if not any(j in names for names in self.joint_columns)]
+            if missing or not wanted:
+                raise InputError(
+                    f"{source}: {self.topic} has no joint {', '.join(missing) or '(any)'}; joints "
+                    f"present: {known(self.seen_joints)}")
+            raise InputError(f"{source}: no message on {self.topic} carries all of "
+                             f"{', '.join(wanted)} with positions; joints present: "
+                             f"{known(self.seen_joints)}")
+        if self.skipped:
+            logger.warning("%s: skipped %d of %d messages on %s that lack one of the joints %s",
+                           source, self.skipped, self.messages, self.topic,
+                           ", ".join(self.joints or ()))
+        times, log_times, positions, velocities = self.columns.take()
+        if time_source == "log" or not times.any():
+            if time_source == "header":
+                logger.warning("%s: every header stamp on %s is zero; using log times", source,
+                               self.topic)
+                time_source = "log"
+            times = log_times
+        del log_times
+        if not self.columns.all_velocities and self.columns.some_velocities:
+            logger.warning("%s: only some messages on %s carry velocities; ignoring velocities",
+                           source, self.topic)
+        if np.any(times[1:] < times[:-1]):
+            order = np.argsort(times, kind="stable")
+            times, positions = times[order], positions[order]
+            velocities = velocities[order] if velocities is not None else None
+        start_ns = int(times[0])
+        times -= start_ns  # in place: a fresh hour-long array costs more in page faults
+        times_s = times / 1e9
+        for array in (times_s, positions, velocities):
+            if array is not None:
+                array.setflags(write=False)
+        return JointStateSeries(tuple(self.joints or ()), times_s, positions, velocities, start_ns,
+                                time_source, str(source))
+
+
+class _Columns:
+    """Decoded samples, appended per batch into arrays sized from the file's statistics.
+
+    Filling preallocated arrays keeps the peak near one copy of the result (an hour at
+    1 kHz is 170 MB per float array); batches beyond the reserved size are kept apart and
+    concatenated at the end. Velocities are kept only if `velocities`; whether every
+    batch had them is noted either way.
+    """
+
+    def __init__(self, velocities: bool = True) -> None:
+        self.keep_velocities = velocities
+        self.capacity = 0
+        self.count = 0
+        self._filled = 0
+        self._arrays: list[np.ndarray] | None = None
+        self._velocities: NDArray[np.float64] | None = None
+        self._extra: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]] = []
+        self.some_velocities = False
+        self.all_velocities = True
+
+    def reserve(self, count: int) -> None:
+        """Expect `count` more samples (an upper bound)."""
+        if self._arrays is None:
+            self.capacity += count
+
+    def append(
+        self, times: NDArray[np.int64], log_times: NDArray[np.int64],
+        positions: NDArray[np.float64], velocities: NDArray[np.float64] | None,
+    ) -> None:
+        """Add a batch: stamps and log times [ns], (m, n) positions and velocities or None."""
+        m, n = positions.shape
+        self.count += m
+        self.some_velocities |= velocities is not None
+        self.all_velocities &= velocities is not None
+        if not self.keep_velocities:
+            velocities = None
+        if self._arrays is None and self.capacity >= m:
+            self._arrays = [_touched((self.capacity,), np.int64),
+                            _touched((self.capacity,), np.int64),
+                            _touched((self.capacity, n), np.float64)]
+        if self._arrays is None or self._filled + m > self.capacity or self._extra:
+            # Copies: values may be views of a chunk buffer that is about to be reused.
+            kept = None if velocities is None else np.array(velocities)
+            self._extra.append((np.array(times), np.array(log_times), np.array(positions), kept))
+            return
+        rows = slice(self._filled, self._filled + m)
+        for array, values in zip(self._arrays, (times, log_times, positions), strict=True):
+            array[rows] = values
+        if velocities is not None and self.all_velocities:
+            if self._velocities is None:
+                self._velocities = _touched((self.capacity, n), np.float64)
+            self._velocities[rows] = velocities
+        self._filled += m
+
+    def take(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+        """Return times, log times, positions and velocities (None unless every batch had them)."""
+        parts = list(self._extra)
+        if self._arrays is not None:
+            filled = self._filled
+            velocities = self._velocities[:filled] if self._velocities is not None else None
+            times, log_times, positions = (array[:filled] for array in self._arrays)
+            parts.insert(0, (times, log_times, positions, velocities))
+        self._arrays, self._velocities, self._extra = None, None, []
+        if len(parts) == 1:
+            times, log_times, positions, velocities = parts[0]
+        else:
+            times, log_times, positions = (np.concatenate([p[i] for p in parts]) for i in range(3))
+            velocities = None
+            if self.all_velocities and self.keep_velocities:
+                velocities = np.concatenate([p[3] for p in parts if p[3] is not None])
+        return times, log_times, positions, velocities if self.all_velocities else None
+
+
+def _touched(shape: tuple[int, ...], dtype: type[np.generic]) -> np.ndarray:
+    """Return a zeroed array whose pages are already mapped.
+
+    Pages first touched one batch at a time, between the decompressor's allocations,
+    cost ten times more than one sweep over them; where the system maps them all in one
+    call (Linux MAP_POPULATE), that costs about half a sweep.
+    """
+    size = int(np.prod(shape)) * np.dtype(dtype).itemsize
+    populate = getattr(mmap, "MAP_POPULATE", 0)
+    if populate and size:
+        memory = mmap.mmap(-1, size, flags=mmap.MAP_PRIVATE | mmap.MAP_ANONYMOUS | populate)
+        return np.frombuffer(memory, dtype=dtype).reshape(shape)
+    # A bytearray is zero-filled, which touches every page.
+    return np.frombuffer(bytearray(size), dtype=dtype).reshape(shape)
+
+
+def _matches(rows: np.ndarray, template: np.ndarray, layout: JointStateLayout) -> NDArray[np.bool_]:
+    """Return per row whether it is laid out as `template`: same bytes except stamp and values.
+
+    Compared 8 bytes at a time (frame_id, names and the position count), then the
+    encapsulation and the other arrays' sizes.
+    """
+    end = layout.position_at
+    words = (end - 12) // 8
+    key = slice(12, 12 + 8 * words)
+    equal = rows[:, key].view("<u8") == template[key].view("<u8")
+    # Usually every row is alike: one test of the whole block beats a test per row.
+    same: NDArray[np.bool_] = np.ones(len(rows), dtype=bool) if equal.all() else equal.all(axis=1)
+    for at, size in ((end - 8, "<u8"), (0, "<u2"), (layout.velocity_count_at, "<u4"),
+                     (layout.effort_count_at, "<u4")):
+        width = np.dtype(size).itemsize
+        same &= rows[:, at : at + width].view(size)[:, 0] == template[at : at + width].view(size)[0]
+    return same
+
+
+def _floats(rows: np.ndarray, at: int, n: int, columns: NDArray[np.intp]) -> NDArray[np.float64]:
+    """Return the float64 array of n values at byte `at` of each row, `columns` of it.
+
+    Joints in the recorded order come back as a view of the rows, copied once where kept.
+    """
+    values = rows[:, at : at + 8 * n].view("<f8")
+    if len(columns) == n and np.array_equal(columns, np.arange(n)):
+        return values
+    return values[:, columns]
+

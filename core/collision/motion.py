@@ -1,0 +1,150 @@
+"""Collision checks of group motions: states, edges for the search, and certification of what is written.
+
+Up to three geometries answer, cheapest first. A sphere model (core/collision/sphere_filter.py)
+clears most states in microseconds; what it cannot clear goes to coal with the robot's
+meshes as convex hulls (~14 us a state), and what those cannot clear to coal with the
+real collision geometry (~55 us). The spheres enclose the hulls' meshes and the hulls
+enclose the meshes, so a state an earlier stage clears is free, and every answer is the
+real geometry's answer. The search may stop at the hulls (`conservative`): it then
+loses only the little space between a mesh and its hull.
+
+Certification checks a trajectory as the controller interpolates it, at states so
+close that no point of the robot moves more than `step_m` between two of them
+(core/collision/certify.py bounds that motion).
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..model.robot import Robot
+from ..trajectory import interpolate
+from ..types import JointTrajectory
+from . import certify
+from .checker import CollisionChecker
+from .sphere_filter import CLEAR, COLLIDES, MAYBE
+
+__all__ = ["CERTIFY_STEP_M", "MotionChecker"]
+
+CERTIFY_STEP_M = 0.005  # the most any robot point moves between two certified states [m]
+
+
+class Filter(Protocol):
+    """A pre-check: per group state, certainly free (CLEAR), unsure, or surely colliding under the hulls."""
+
+    def classify(self, values: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+        """Return per group state (rows of `values`) CLEAR, MAYBE or COLLIDES, and the configurations (k, nq)."""
+        ...
+
+    def edge(
+        self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, stop: bool
+    ) -> tuple[int, NDArray[np.int8], NDArray[np.float64]]:
+        """Return the worst verdict on the edge's states, and the verdicts and configurations not CLEAR."""
+        ...
+
+
+class MotionChecker:
+    """Answers whether group states, straight edges and timed trajectories are collision-free."""
+
+    def __init__(
+        self,
+        robot: Robot,
+        checker: CollisionChecker,
+        base: NDArray[np.float64],
+        spheres: Filter | None = None,
+        hulls: CollisionChecker | None = None,
+    ) -> None:
+        """Check `robot` with its other joints at `base`, by `checker`'s geometry.
+
+        `spheres` and `hulls` (the robot's meshes as convex hulls) are conservative geometries
+        asked first, in that order: a state they clear is free under `checker`'s geometry. A
+        state `spheres` finds surely colliding collides under the hulls (or, without them,
+        under `checker`'s geometry).
+        """
+        self.robot = robot
+        self.checker = checker
+        self.base = base
+        self.spheres = spheres
+        self.reach = certify.reach(robot, checker.geometry)
+        self._stages = (checker,) if hulls is None else (hulls, checker)
+        self.conservative_available = hulls is not None
+
+    def free(self, values: NDArray[np.float64], conservative: bool = False) -> NDArray[np.bool_]:
+        """Return per group state (rows of `values`) True if it is collision-free.
+
+        With `conservative`, a state is free only if the spheres or the hulls clear it; one
+        that only the real geometry would free reads as colliding. The search uses this:
+        a hull check costs a quarter of a mesh check.
+        """
+        verdict, q = self._classified(values)
+        free = verdict == CLEAR
+        maybe = np.flatnonzero(verdict == MAYBE)
+        if len(maybe):
+            free[maybe] = self._stages[0].free_batch(q[maybe].T)
+        if conservative or len(self._stages) == 1:
+            return free
+        rest = np.flatnonzero(~free)  # colliding under the hulls: only the meshes can tell
+        if len(rest):
+            free[rest] = self._stages[1].free_batch(q[rest].T)
+        return free
+
+    def state_free(self, values: NDArray[np.float64], conservative: bool = False) -> bool:
+        """Return True if one group state is collision-free (see `free` for `conservative`)."""
+        return self.edge_free(values, values, 1.0, conservative)
+
+    def edge_free(
+        self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, conservative: bool = False
+    ) -> bool:
+        """Return True if the straight edge from `a` to `b` is free at states `resolution` [rad] apart.
+
+        The states checked are `b` and those between, not `a`: a search asks about an edge
+        from a state it already knows to be free.
+        """
+        final = conservative or len(self._stages) == 1
+        if self.spheres is None:
+            states = interpolate(a, b, resolution)[1:]
+            worst, verdict, q = MAYBE, np.full(len(states), MAYBE), self.robot.configurations(states, self.base).T
+        else:
+            worst, verdict, q = self.spheres.edge(a, b, resolution, stop=final)
+        if worst == CLEAR:
+            return True
+        if final:
+            return worst != COLLIDES and bool(self._stages[0].free_batch(q.T, stop_at_first=True).all())
+        free = np.zeros(len(verdict), dtype=bool)
+        maybe = verdict == MAYBE
+        if maybe.any():
+            free[maybe] = self._stages[0].free_batch(q[maybe].T)
+        return bool(free.all()) or bool(self._stages[1].free_batch(q[~free].T, stop_at_first=True).all())
+
+    def _classified(self, values: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+        """Return the spheres' verdict per state, and the states' configurations (k, nq)."""
+        if self.spheres is None:
+            q = self.robot.configurations(np.atleast_2d(values), self.base).T
+            return np.full(len(q), MAYBE, dtype=np.int8), q
+        return self.spheres.classify(values)
+
+    def edge_free_certified(self, a: NDArray[np.float64], b: NDArray[np.float64]) -> bool:
+        """Return True if the straight edge is free at the states certification checks on it."""
+        return self.first_collision_on_path(np.array([a, b])) is None
+
+    def first_collision_on_trajectory(self, trajectory: JointTrajectory) -> NDArray[np.float64] | None:
+        """Return the first colliding state along the interpolated trajectory, or None if it is free."""
+        return self._first_collision(certify.trajectory_states(trajectory, self.reach, CERTIFY_STEP_M))
+
+    def first_collision_on_path(self, waypoints: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """Return the first colliding state along the straight segments between waypoints, or None."""
+        states = [certify.segment_states(a, b, self.reach, CERTIFY_STEP_M)
+                  for a, b in zip(waypoints[:-1], waypoints[1:], strict=True)]
+        return self._first_collision(np.concatenate(states) if states else waypoints)
+
+    def _first_collision(self, states: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        free = self.free(states)
+        return None if free.all() else states[int(np.argmin(free))]
+
+    def colliding_pair(self, values: NDArray[np.float64]) -> tuple[str, str] | None:
+        """Return the names of a colliding pair at a group state, or None."""
+        return self.checker.colliding_pair(self.robot.configuration(values, self.base))
+

@@ -1,0 +1,240 @@
+"""A fast conservative collision filter: the robot's enclosing spheres against the scene and themselves.
+
+Compiled with numba (imported only when a filter is built, so commands that do not plan
+never pay its start-up). One call checks a batch of configurations: forward kinematics
+of the joint tree, then per owner (link or attached object) its bounding ball first and
+its spheres only if that ball touches something. Link pairs whose distance depends on
+one or two joints are looked up in distance tables instead (core/collision/pair_tables.py). A
+state is "clear" only if no sphere touches an obstacle or another owner's sphere and
+every tabulated pair is apart; since the spheres enclose the real geometry
+(core/collision/sphere_fit.py), a clear state is collision-free. A state where a ball inside a
+convex hull touches an obstacle or another link's inner ball, or a table says a pair
+overlaps, surely collides under the hulls. Anything else is "maybe": the caller asks coal.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from ..model.robot import Robot
+from ..types import CollisionObject
+from .inner_spheres import inner_spheres
+from .pair_tables import PairTable, pair_tables
+from .sphere_fit import SphereSet, fit_shape, robot_spheres
+
+__all__ = ["CLEAR", "COLLIDES", "MAYBE", "SphereFilter", "UnsupportedJoint"]
+
+# A state's verdict: its spheres touch nothing; unsure; a convex hull (or table pair) surely touches something.
+CLEAR, MAYBE, COLLIDES = 1, 0, -1
+
+# Joint kinds the kernel knows; anything else (planar, free-flyer, ...) makes the filter unavailable.
+_REVOLUTE, _PRISMATIC, _UNBOUNDED = 1, 2, 3
+_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+_BOX, _SPHERE, _CYLINDER = 0, 1, 2
+
+
+class UnsupportedJoint(ValueError):
+    """The robot has a joint the filter's kinematics do not handle."""
+
+
+def _joint_kind(model: pin.Model, jid: int) -> tuple[int, tuple[float, float, float]]:
+    """Return (kind, axis) of a pinocchio joint."""
+    name = model.joints[jid].shortname().removeprefix("JointModel")
+    for prefix, kind in (("RUB", _UNBOUNDED), ("R", _REVOLUTE), ("P", _PRISMATIC)):
+        if name.startswith(prefix) and name[len(prefix):] in _AXES:
+            return kind, _AXES[name[len(prefix):]]
+    joint = model.joints[jid]
+    if name in ("RevoluteUnaligned", "RevoluteUnboundedUnaligned", "PrismaticUnaligned"):
+        kind = {"RevoluteUnaligned": _REVOLUTE, "RevoluteUnboundedUnaligned": _UNBOUNDED}.get(name, _PRISMATIC)
+        return kind, tuple(float(v) for v in np.asarray(joint.extract().axis))  # type: ignore[return-value]
+    raise UnsupportedJoint(f"joint '{model.names[jid]}' ({name}) is not handled by the sphere filter")
+
+
+class SphereFilter:
+    """Clears robot configurations whose enclosing spheres touch nothing."""
+
+    def __init__(
+        self,
+        robot: Robot,
+        geometry: pin.GeometryModel,
+        objects: tuple[CollisionObject, ...],
+        allowed: frozenset[frozenset[str]] = frozenset(),
+        base: NDArray[np.float64] | None = None,
+        hulls: pin.GeometryModel | None = None,
+    ) -> None:
+        """Fit spheres to `robot` (its `geometry`), add attached objects, and list what to check.
+
+        States are the group's joint values; the other joints stay at `base` (default: the neutral
+        configuration). Link pairs with distance tables are tabulated from `hulls` (the robot's
+        shapes as convex hulls; default `geometry`).
+
+        Raises:
+            UnsupportedJoint: The robot has a joint kind the kernel does not handle.
+        """
+        model = robot.model
+        kinds = [(0, (0.0, 0.0, 1.0))] + [_joint_kind(model, j) for j in range(1, model.njoints)]
+        robot_set = robot_spheres(model, geometry, robot.config.urdf)
+        centres, radii = [robot_set.centres], [robot_set.radii]
+        joints, owners = [robot_set.joints], list(robot_set.owners)
+        touch: dict[str, frozenset[str]] = {}
+        world = [obj for obj in objects if not obj.link]
+        for obj in objects:
+            if obj.link:
+                frame = model.frames[model.getFrameId(obj.link)]
+                c, r = fit_shape(obj.shape, np.asarray(frame.placement.homogeneous) @ obj.transform)
+                centres.append(c)
+                radii.append(r)
+                joints.append(np.full(len(r), frame.parentJoint))
+                owners.extend([obj.name] * len(r))
+                touch[obj.name] = frozenset((obj.link, *obj.touch_links))
+        names = list(dict.fromkeys(owners))
+        owner_index = np.array([names.index(o) for o in owners], dtype=np.int64)
+        order = np.argsort(owner_index, kind="stable")
+        centre, radius = np.concatenate(centres)[order], np.concatenate(radii)[order]
+        joint = np.concatenate(joints)[order]
+        start = np.searchsorted(owner_index[order], np.arange(len(names) + 1))
+        # Each owner's bounding ball, in its joint's frame.
+        owner_joint = joint[start[:-1]]
+        owner_centre, owner_radius = np.zeros((len(names), 3)), np.zeros(len(names))
+        for k in range(len(names)):
+            c, r = centre[start[k]:start[k + 1]], radius[start[k]:start[k + 1]]
+            owner_centre[k] = (c.min(axis=0) + c.max(axis=0)) / 2
+            owner_radius[k] = np.max(np.linalg.norm(c - owner_centre[k], axis=1) + r)
+
+        disabled = robot.config.srdf.disabled_pairs | allowed
+        pairs = []
+        for a in range(len(names)):
+            for b in range(a + 1, len(names)):
+                na, nb = names[a], names[b]
+                if owner_joint[a] == owner_joint[b] or frozenset((na, nb)) in disabled:
+                    continue
+                if na in touch.get(nb, ()) or nb in touch.get(na, ()):
+                    continue
+                pairs.append((a, b))
+        # Pairs whose distance depends on one or two joints (a wrist's links) are looked up in tables.
+        tables = [t for t in pair_tables(model, hulls or geometry, robot.config.srdf.disabled_pairs, robot.config.urdf)
+                  if frozenset((t.upper, t.lower)) not in disabled]
+        tabulated = {frozenset((t.upper, t.lower)) for t in tables}
+        pairs = [(a, b) for a, b in pairs if frozenset((names[a], names[b])) not in tabulated]
+        self.tabulated = tuple((t.upper, t.lower) for t in tables)
+        # A link fixed to the world (a base) never moves relative to world obstacles: the collision
+        # checker tests those pairs once, when the scene loads, so no state needs to.
+        check = np.array([[frozenset((name, obj.name)) not in allowed and owner_joint[k] != 0 for obj in world]
+                          for k, name in enumerate(names)]).reshape(len(names), len(world))
+        from . import _kernels as sphere_kernels  # numba: compiled once, then loaded from its disk cache
+
+        self._kernels = sphere_kernels
+        base = robot.neutral() if base is None else base
+        inner = inner_spheres(model, hulls or geometry, robot.config.urdf)
+        # Packed once: the kernels run thousands of times per search, and a call costs per argument.
+        self._packed = sphere_kernels.pack({
+            "base": base, "group": robot.q_index, "continuous": robot.continuous, **_table_arrays(tables),
+            "parents": model.parents, "kinds": [k for k, _ in kinds], "axes": [a for _, a in kinds],
+            "iq": model.idx_qs, "prot": [np.asarray(p.rotation) for p in model.jointPlacements],
+            "ptrans": [np.asarray(p.translation) for p in model.jointPlacements],
+            "centres": centre, "radii": radius, "sjoint": joint, "start": start,
+            "ojoint": owner_joint, "ocentre": owner_centre, "oradius": owner_radius,
+            **_inner_arrays(inner, names), "pairs": np.reshape(pairs, (-1, 2)), **_obstacles(world), "check": check})
+        self._nq = model.nq
+        # Reused by every `edge` call: returning fresh arrays from compiled code costs more than judging a state.
+        self._verdicts, self._unclear = np.empty(64, dtype=np.int8), np.empty((64, model.nq))
+        self.classify(robot.values(base)[None, :])  # compile (or load) the kernels now, not mid-search
+        self.edge(robot.values(base), robot.values(base), 1.0)
+
+    def classify(
+        self, values: NDArray[np.float64], stop: bool = False
+    ) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+        """Return per group state (rows of `values`) CLEAR, MAYBE or COLLIDES, and the configurations (k, nq).
+
+        With `stop`, only the states up to the first that COLLIDES are judged and returned.
+        """
+        q = np.empty((len(values), self._nq))
+        out = np.empty(len(values), dtype=np.int8)
+        judged = self._kernels.classify(values, stop, *self._packed, q, out)
+        return out[:judged], q[:judged]
+
+    def edge(
+        self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, stop: bool = False
+    ) -> tuple[int, NDArray[np.int8], NDArray[np.float64]]:
+        """Return the worst verdict on the edge from `a` to `b`, and the verdicts and configurations not CLEAR.
+
+        The edge's states are `resolution` [rad] apart in every joint, `b` included, `a` not.
+        With `stop`, judging ends at the first state that COLLIDES. The arrays returned are
+        overwritten by the next call.
+        """
+        worst, kept = self._kernels.edge(a, b, resolution, stop, *self._packed, self._verdicts, self._unclear)
+        if kept < 0:  # more states than the buffers hold
+            self._verdicts, self._unclear = np.empty(-kept, dtype=np.int8), np.empty((-kept, self._nq))
+            return self.edge(a, b, resolution, stop)
+        return worst, self._verdicts[:kept], self._unclear[:kept]
+
+
+def _inner_arrays(inner: SphereSet, names: list[str]) -> dict[str, NDArray[Any]]:
+    """Return the inner balls as the kernel's arrays, grouped by owner as `names` orders them."""
+    index = np.array([names.index(o) if o in names else len(names) for o in inner.owners], dtype=np.int64)
+    order = np.argsort(index, kind="stable")
+    start = np.searchsorted(index[order], np.arange(len(names) + 1)).astype(np.int64)
+    return {"icentres": inner.centres[order], "iradii": inner.radii[order], "ijoint": inner.joints[order],
+            "istart": start}
+
+
+def _table_arrays(tables: list[PairTable]) -> dict[str, NDArray[Any]]:
+    """Return the tables as the kernel's arrays.
+
+    Per table and axis: q index (-1: no such axis), start, step, count; per table: offset
+    into the flat distances, margin; then the flat distances.
+    """
+    axes = np.full((len(tables), 2), -1, dtype=np.int64)
+    start, step = np.zeros((len(tables), 2)), np.ones((len(tables), 2))
+    count = np.ones((len(tables), 2), dtype=np.int64)
+    for k, table in enumerate(tables):
+        n = len(table.q_index)
+        axes[k, :n], start[k, :n], step[k, :n], count[k, :n] = table.q_index, table.start, table.step, \
+            table.distances.shape
+    sizes = [t.distances.size for t in tables]
+    offset = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64) if tables else np.zeros(0, np.int64)
+    margin = np.array([t.margin for t in tables], dtype=float)
+    flat = np.concatenate([t.distances.ravel() for t in tables]) if tables else np.zeros(0)
+    return {"table_axes": axes, "table_start": start, "table_step": step, "table_count": count,
+            "table_offset": offset, "table_margin": margin, "table_distance": flat}
+
+
+def _obstacles(world: list[CollisionObject]) -> dict[str, NDArray[Any]]:
+    """Return world obstacles as arrays: kind, centre, rotation, size, and whether each is that solid.
+
+    Sizes: a box's half sides; a sphere's radius; a cylinder's radius and half length. A
+    mesh is its bounding box, which is not solid: a ball touching it proves nothing.
+    """
+    from .checker import coal_geometry
+
+    kinds, centres, rotations, sizes = [], [], [], []
+    solid = [obj.shape.kind in ("box", "sphere", "cylinder") for obj in world]
+    for obj in world:
+        shape, transform = obj.shape, np.asarray(obj.transform)
+        rotation, centre = transform[:3, :3], transform[:3, 3]
+        if shape.kind == "box":
+            kind, size = _BOX, np.array([*shape.dims]) / 2
+        elif shape.kind == "sphere":
+            kind, size = _SPHERE, np.array([shape.dims[0], 0.0, 0.0])
+        elif shape.kind == "cylinder":
+            kind, size = _CYLINDER, np.array([shape.dims[0], shape.dims[1] / 2, 0.0])
+        else:
+            # A mesh counts as its bounding box in its own frame: it encloses the mesh.
+            mesh = coal_geometry(shape, obj.name)
+            mesh.computeLocalAABB()
+            lo, hi = np.asarray(mesh.aabb_local.min_), np.asarray(mesh.aabb_local.max_)
+            kind, size = _BOX, (hi - lo) / 2
+            centre = centre + rotation @ ((hi + lo) / 2)
+        kinds.append(kind)
+        centres.append(centre)
+        rotations.append(rotation)
+        sizes.append(size)
+    count = len(world)
+    return {"okind": np.array(kinds, dtype=np.int64), "opos": np.array(centres, dtype=float).reshape(count, 3),
+            "orot": np.array(rotations, dtype=float).reshape(count, 3, 3),
+            "osize": np.array(sizes, dtype=float).reshape(count, 3), "osolid": np.array(solid, dtype=np.bool_)}
+

@@ -1,0 +1,203 @@
+"""Task files (DESIGN section 4) and the step specifications they and the flags produce.
+
+A task names a robot and scene, a start, defaults, and steps; each step is one
+motion goal. Paths in a task resolve relative to the task file.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..errors import ConfigError
+from .robot_config import check_keys, load_yaml, mapping, number
+
+__all__ = [
+    "GOAL_KINDS", "SHIFT_AXES", "StepSpec", "TaskFile", "load_task", "parse_goal", "parse_pose", "parse_scaling",
+    "parse_shift",
+]
+
+GOAL_KINDS = ("joints", "named", "pose", "shift")
+SHIFT_AXES = ("x", "y", "z", "roll", "pitch", "yaw")
+_TASK_KEYS = {"robot", "scene", "group", "start", "defaults", "steps", "seed"}
+_DEFAULT_KEYS = {"velocity_scaling", "acceleration_scaling", "planner", "planning_time"}
+_STEP_KEYS = {"name", "linear", "min_fraction", *GOAL_KINDS, *_DEFAULT_KEYS}
+_POSE_KEYS = {"frame", "xyz", "rpy", "quat", "link"}
+
+
+@dataclass(frozen=True)
+class StepSpec:
+    """One requested motion: a goal plus per-step overrides (None = use the plan's default).
+
+    `goal` holds exactly one kind: {"joints": [values] | {joint: value}}, {"named": name},
+    {"pose": {"frame", "xyz", "rpy" | "quat", "link"}} or {"shift": {axis: value, "frame"}}.
+    A `linear` step moves the tip along a straight line; below `min_fraction` of it, it fails.
+    """
+
+    name: str
+    goal: dict[str, Any]
+    velocity_scaling: float | None = None
+    acceleration_scaling: float | None = None
+    planner: str | None = None
+    planning_time: float | None = None
+    linear: bool = False
+    min_fraction: float | None = None
+
+
+@dataclass(frozen=True)
+class TaskFile:
+    """A parsed task file; paths are already resolved against its folder."""
+
+    source: Path
+    robot: Path | None
+    scene: Path | None
+    group: str | None
+    start: dict[str, Any]
+    defaults: dict[str, Any]
+    steps: tuple[StepSpec, ...]
+    seed: int | None = None
+    raw: bytes = field(default=b"", repr=False)
+
+
+def parse_scaling(value: Any, where: str) -> float:
+    """Return a velocity or acceleration scaling factor, checked to lie in (0, 1]."""
+    factor = number(value, where)
+    if not 0.0 < factor <= 1.0:
+        raise ConfigError(f"{where}: expected a scaling factor in (0, 1], got {value!r}")
+    return factor
+
+
+def parse_goal(entry: dict[str, Any], where: str) -> dict[str, Any]:
+    """Return the one goal of a step or start entry, checked for shape."""
+    kinds = [k for k in GOAL_KINDS if k in entry]
+    if len(kinds) != 1:
+        raise ConfigError(f"{where}: give exactly one goal of: {', '.join(GOAL_KINDS)}")
+    kind = kinds[0]
+    value = entry[kind]
+    if kind == "pose":
+        return {"pose": parse_pose(mapping(value, f"{where}.pose"), f"{where}.pose")}
+    if kind == "shift":
+        return {"shift": parse_shift(mapping(value, f"{where}.shift"), f"{where}.shift")}
+    if kind == "named":
+        if not isinstance(value, str):
+            raise ConfigError(f"{where}.named: expected a group_state name, got {value!r}")
+        return {"named": value}
+    if isinstance(value, list):
+        return {"joints": [number(v, f"{where}.joints[{i}]") for i, v in enumerate(value)]}
+    if isinstance(value, dict):
+        return {"joints": {str(k): number(v, f"{where}.joints.{k}") for k, v in value.items()}}
+    raise ConfigError(f"{where}.joints: expected a list of values or a mapping joint: value, got {value!r}")
+
+
+def parse_pose(entry: dict[str, Any], where: str) -> dict[str, Any]:
+    """Return a pose goal {frame, xyz, rpy | quat, link}, numbers checked; missing keys are None."""
+    check_keys(entry, _POSE_KEYS, where)
+    pose: dict[str, Any] = {"frame": entry.get("frame"), "link": entry.get("link"), "rpy": None, "quat": None}
+    for key in ("frame", "link"):
+        if pose[key] is not None and not isinstance(pose[key], str):
+            raise ConfigError(f"{where}.{key}: expected a frame or link name, got {pose[key]!r}")
+    for key, size in (("xyz", 3), ("rpy", 3), ("quat", 4)):
+        value = entry.get(key, [0.0, 0.0, 0.0] if key == "xyz" else None)
+        if value is None:
+            continue
+        if not isinstance(value, list) or len(value) != size:
+            raise ConfigError(f"{where}.{key}: expected a list of {size} numbers, got {value!r}")
+        pose[key] = [number(v, f"{where}.{key}[{i}]") for i, v in enumerate(value)]
+    if pose["rpy"] is not None and pose["quat"] is not None:
+        raise ConfigError(f"{where}: give rpy or quat, not both")
+    if pose["quat"] is not None and sum(v * v for v in pose["quat"]) < 1e-12:
+        raise ConfigError(f"{where}.quat: a quaternion [x, y, z, w] of zero norm is not a rotation")
+    return pose
+
+
+def parse_shift(entry: dict[str, Any], where: str) -> dict[str, Any]:
+    """Return a shift goal: displacement per axis (x, y, z in [m]; roll, pitch, yaw in [rad]) and frame."""
+    check_keys(entry, {*SHIFT_AXES, "frame"}, where)
+    shift: dict[str, Any] = {axis: number(entry[axis], f"{where}.{axis}") for axis in SHIFT_AXES if axis in entry}
+    if not shift:
+        raise ConfigError(f"{where}: give at least one of {', '.join(SHIFT_AXES)}")
+    frame = entry.get("frame", "tool")
+    if not isinstance(frame, str):
+        raise ConfigError(f"{where}.frame: expected tool, base, moveit or a frame name, got {frame!r}")
+    shift["frame"] = frame
+    return shift
+
+
+def _defaults(entry: dict[str, Any], where: str) -> dict[str, Any]:
+    result: dict[str, Any] = {}
+    for key in ("velocity_scaling", "acceleration_scaling"):
+        if key in entry:
+            result[key] = parse_scaling(entry[key], f"{where}.{key}")
+    if "planner" in entry:
+        if not isinstance(entry["planner"], str):
+            raise ConfigError(f"{where}.planner: expected a planner name, got {entry['planner']!r}")
+        result["planner"] = entry["planner"]
+    if "planning_time" in entry:
+        result["planning_time"] = number(entry["planning_time"], f"{where}.planning_time", positive=True)
+    return result
+
+
+def load_task(path: Path) -> TaskFile:
+    """Return the task in a task file."""
+    source = str(path)
+    top = mapping(load_yaml(path), source)
+    check_keys(top, _TASK_KEYS, source)
+    folder = path.parent
+
+    def relative(key: str) -> Path | None:
+        if key not in top:
+            return None
+        if not isinstance(top[key], str):
+            raise ConfigError(f"{source}: {key}: expected a path, got {top[key]!r}")
+        return folder / top[key]
+
+    start = mapping(top.get("start"), f"{source}: start")
+    check_keys(start, {"named", "joints", "from"}, f"{source}: start")
+    if "from" in start:
+        start = {"from": folder / str(start["from"])}
+    elif start:
+        start = parse_goal(start, f"{source}: start")
+    defaults = mapping(top.get("defaults"), f"{source}: defaults")
+    check_keys(defaults, _DEFAULT_KEYS, f"{source}: defaults")
+    steps_raw = top.get("steps") or []
+    if not isinstance(steps_raw, list):
+        raise ConfigError(f"{source}: steps: expected a list of steps")
+    steps = []
+    for k, entry in enumerate(steps_raw):
+        where = f"{source}: steps[{k}]"
+        entry = mapping(entry, where)
+        check_keys(entry, _STEP_KEYS, where)
+        name = str(entry.get("name", f"step{k + 1}"))
+        linear = entry.get("linear", False)
+        if not isinstance(linear, bool):
+            raise ConfigError(f"{where}.linear: expected true or false, got {linear!r}")
+        min_fraction = None
+        if "min_fraction" in entry:
+            min_fraction = number(entry["min_fraction"], f"{where}.min_fraction")
+            if not 0.0 <= min_fraction <= 1.0:
+                raise ConfigError(f"{where}.min_fraction: expected a number in [0, 1], got {min_fraction!r}")
+        goal = parse_goal(entry, where)
+        if linear and ("joints" in goal or "named" in goal):
+            raise ConfigError(f"{where}: linear applies to pose and shift goals, not {next(iter(goal))}")
+        steps.append(StepSpec(name=name, goal=goal, linear=linear, min_fraction=min_fraction,
+                              **_defaults(entry, where)))
+    names = [s.name for s in steps]
+    for name in names:
+        if names.count(name) > 1:
+            raise ConfigError(f"{source}: step name '{name}' is used twice")
+    seed = top.get("seed")
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
+        raise ConfigError(f"{source}: seed: expected a non-negative integer, got {seed!r}")
+    group = top.get("group")
+    return TaskFile(
+        source=path,
+        robot=relative("robot"),
+        scene=relative("scene"),
+        group=str(group) if group is not None else None,
+        start=start,
+        defaults=_defaults(defaults, f"{source}: defaults"),
+        steps=tuple(steps),
+        seed=seed,
+        raw=path.read_bytes(),
+    )

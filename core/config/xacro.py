@@ -1,0 +1,269 @@
+"""ROS resources without ROS: finding packages on a package path, and xacro to URDF/SRDF.
+
+A package is found as ROS finds it on ROS_PACKAGE_PATH: in the first folder of the
+search path that is the package, holds a folder of that name, or holds (up to three
+levels down) a folder whose package.xml names it. The same lookup resolves
+`$(find pkg)` in xacro files and `package://pkg/...` URIs of meshes.
+
+xacro itself resolves `$(find pkg)` through ament_index_python, which needs a sourced
+ROS 2 install; here the PyPI `xacro` package runs with that one function replaced by
+the lookup above (xacro keeps it in a module global, looked up at each call).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import logging
+import re
+import xml.dom.minidom
+import xml.etree.ElementTree as ET
+import xml.parsers.expat
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import xacro as _xacro  # type: ignore[import-untyped]  # the PyPI package ships no type hints
+from xacro import substitution_args as _substitution_args
+
+from ..errors import ConfigError, UsageError
+
+__all__ = ["PackagePath", "XacroResult", "parse_xacro_args", "process_xacro"]
+
+_log = logging.getLogger(__name__)
+
+_CRAWL_DEPTH = 3
+_BANNER_LINES = 4  # the comments xacro.process_file puts before the document
+_IGNORE_MARKERS = ("COLCON_IGNORE", "CATKIN_IGNORE", "AMENT_IGNORE")
+
+
+def _package_name(folder: Path) -> str | None:
+    """Return the name a folder's package.xml gives, or None (no or unreadable package.xml)."""
+    manifest = folder / "package.xml"
+    if not manifest.is_file():
+        return None
+    try:
+        name = ET.parse(manifest).getroot().findtext("name")
+    except (ET.ParseError, OSError):
+        return None
+    return name.strip() if name else None
+
+
+def _crawl(folder: Path, depth: int) -> Iterator[Path]:
+    """Yield package folders (holding a package.xml) below `folder`, in sorted order."""
+    if depth == 0:
+        return
+    try:
+        children = sorted(p for p in folder.iterdir() if p.is_dir() and not p.name.startswith("."))
+    except OSError:
+        return
+    for child in children:
+        if any((child / marker).exists() for marker in _IGNORE_MARKERS):
+            continue
+        if (child / "package.xml").is_file():
+            yield child  # a package: its subfolders are its own, not other packages
+        else:
+            yield from _crawl(child, depth - 1)
+
+
+@dataclass(frozen=True)
+class PackagePath:
+    """An ordered list of folders searched for ROS packages (first match wins).
+
+    Attributes:
+        folders: The search path, in order.
+    """
+
+    folders: tuple[Path, ...]
+    _found: dict[str, Path] = field(default_factory=dict, compare=False, repr=False)
+
+    def describe(self) -> str:
+        """Return the search path as one line, for error messages."""
+        return ", ".join(str(f) for f in self.folders) or "(empty)"
+
+    def find(self, package: str, source: str) -> Path:
+        """Return the folder of `package`; ConfigError names `source`, the package and the search path."""
+        if package in self._found:
+            return self._found[package]
+        for folder in self.folders:
+            hit = self._in(folder, package)
+            if hit is not None:
+                self._found[package] = hit.resolve()  # absolute: xacro joins relative paths to the including file
+                return self._found[package]
+        raise ConfigError(
+            f"{source}: package '{package}' not found; searched in order: {self.describe()} "
+            f"(for a folder named {package} or one whose package.xml names it; "
+            "add its parent folder with --package-path or ROS_PACKAGE_PATH)"
+        )
+
+    @staticmethod
+    def _in(folder: Path, package: str) -> Path | None:
+        if not folder.is_dir():
+            return None
+        if _package_name(folder) == package or folder.name == package:
+            return folder
+        if (folder / package).is_dir():
+            return folder / package
+        for candidate in _crawl(folder, _CRAWL_DEPTH):
+            if _package_name(candidate) == package:
+                return candidate
+        return None
+
+    def resolve_uri(self, uri: str, base: Path, source: str) -> tuple[Path, str]:
+        """Return the file a URDF resource URI names, and the package it came from ('' if none).
+
+        `package://pkg/rest` resolves through the package lookup, `file://path` and absolute
+        paths are taken as they are, and relative paths resolve against `base` (the URDF's
+        folder), then each folder of the search path.
+        """
+        if uri.startswith("package://"):
+            package, _, rest = uri[len("package://"):].partition("/")
+            return self.find(package, source) / rest, package
+        if uri.startswith("file://"):
+            path = Path(uri[len("file://"):])
+            return (path if path.is_absolute() else base / path), ""
+        if "://" in uri:
+            raise ConfigError(f"{source}: unsupported resource URI '{uri}' (use package://, file:// or a path)")
+        path = Path(uri)
+        if path.is_absolute():
+            return path, ""
+        for folder in (base, *self.folders):
+            if (folder / path).exists():
+                return folder / path, ""
+        return base / path, ""
+
+
+@dataclass(frozen=True)
+class XacroResult:
+    """A processed xacro file.
+
+    Attributes:
+        text: The XML document it expands to.
+        includes: Every file it read (includes and YAML loaded with xacro.load_yaml), in order.
+        declared: Names of the xacro args it and its includes declare.
+    """
+
+    text: str
+    includes: tuple[Path, ...]
+    declared: frozenset[str]
+
+
+class _RecordingArgs(dict[str, str]):
+    """xacro's arg table; records which names `<xacro:arg>` asks about, i.e. declares."""
+
+    def __init__(self, values: Mapping[str, str]) -> None:
+        super().__init__(values)
+        self.declared: set[str] = set()
+
+    def __contains__(self, key: object) -> bool:
+        if isinstance(key, str):
+            self.declared.add(key)
+        return super().__contains__(key)
+
+
+def parse_xacro_args(items: Sequence[str]) -> dict[str, str]:
+    """Return `name:=value` strings (the --xacro-arg flag, as ros2 launch writes them) as a mapping."""
+    args: dict[str, str] = {}
+    for item in items:
+        name, sep, value = item.partition(":=")
+        if not sep or not name.strip():
+            raise UsageError(f"--xacro-arg '{item}': expected name:=value")
+        args[name.strip()] = value
+    return args
+
+
+@contextlib.contextmanager
+def _find_through(packages: PackagePath) -> Iterator[None]:
+    """Make xacro resolve `$(find pkg)` (and `find()` in expressions) on `packages`."""
+
+    def find(package: str) -> str:
+        stack = [f for f in (_xacro.filestack or []) if f]
+        return str(packages.find(package, f"{stack[-1] if stack else 'xacro'}: $(find {package})"))
+
+    saved = _substitution_args._eval_find, _substitution_args._eval_dict["find"]
+    _substitution_args._eval_find = find
+    _substitution_args._eval_dict["find"] = find
+    try:
+        yield
+    finally:
+        _substitution_args._eval_find, _substitution_args._eval_dict["find"] = saved
+
+
+def _cause(exc: BaseException) -> BaseException:
+    """Return the innermost exception xacro wrapped (it wraps ours in XacroException.exc)."""
+    while isinstance(getattr(exc, "exc", None), BaseException):
+        exc = exc.exc  # type: ignore[attr-defined]
+    return exc
+
+
+def process_xacro(path: Path, args: Mapping[str, str], packages: PackagePath, shown_as: str) -> XacroResult:
+    """Expand a xacro file with `args`, resolving `$(find pkg)` on `packages`.
+
+    Args:
+        path: The .xacro file.
+        args: xacro args (name -> value), as `xacro file name:=value` takes them.
+        packages: Where `$(find pkg)` looks.
+        shown_as: How the output's banner names the file (relative, so output does not depend
+            on where the config lies).
+
+    Raises:
+        ConfigError: A xacro or XML error (naming the file it happened in and the files that
+            included it), or a package `$(find)` cannot find.
+    """
+    table = _RecordingArgs(args)
+    _xacro.all_includes.clear()
+    captured = io.StringIO()  # xacro prints warnings to stderr; a library logs them instead
+    try:
+        with _find_through(packages), contextlib.redirect_stderr(captured):
+            doc = _xacro.process_file(str(path), mappings=table, verbosity=0)
+    except ConfigError:
+        raise
+    except Exception as exc:  # xacro raises bare Exception subclasses of many kinds
+        cause = _cause(exc)
+        if isinstance(cause, ConfigError):
+            raise cause from None
+        where = _location(path)
+        if isinstance(exc, xml.parsers.expat.ExpatError):
+            raise ConfigError(f"{where}: malformed XML: {exc}") from None
+        message = "; ".join(line.strip() for line in str(exc).splitlines() if line.strip())
+        raise ConfigError(f"{where}: xacro error: {message or type(exc).__name__}") from None
+    finally:
+        for line in captured.getvalue().splitlines():
+            if line.strip():
+                _log.warning("xacro: %s", line.strip())
+    _replace_banner(doc, shown_as)
+    includes = tuple(dict.fromkeys(Path(p) for p in _xacro.all_includes))
+    return XacroResult(doc.toprettyxml(indent="  "), includes, frozenset(table.declared))
+
+
+def _location(path: Path) -> str:
+    """Return where xacro stopped: the file (and its includers), or the macro being expanded."""
+    stack: list[str] = [str(f) for f in (_xacro.filestack or []) if f] or [str(path)]
+    where = stack[-1] + "".join(f" (included from {f})" for f in reversed(stack[:-1]))
+    macros = [str(m.body.getAttribute("name")) for m in reversed(_xacro.macrostack or [])]  # not popped on failure
+    if macros:
+        # xacro records where a macro was grabbed, which for a macro defined inside another
+        # macro is where that one was expanded; the text that defines it says where it is.
+        files = dict.fromkeys([str(path), *(str(f) for f in _xacro.all_includes)])
+        defined_in = next((f for f in files if _defines(f, macros[0])), stack[-1])
+        calls = " <- ".join(repr(name) for name in macros)
+        where = f"{defined_in}: in macro {calls}, expanded from {where}"
+    return where
+
+
+def _defines(file: str, macro: str) -> bool:
+    try:
+        text = Path(file).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return False
+    return re.search(rf"<xacro:macro\s[^>]*name\s*=\s*[\"']{re.escape(macro)}[\"']", text) is not None
+
+
+def _replace_banner(doc: Any, shown_as: str) -> None:
+    """Replace xacro's banner (which names the absolute input path) by one naming `shown_as`."""
+    for _ in range(_BANNER_LINES):
+        if doc.firstChild is None or doc.firstChild.nodeType != xml.dom.minidom.Node.COMMENT_NODE:
+            break
+        doc.removeChild(doc.firstChild)
+    doc.insertBefore(doc.createComment(f" generated by xacro from {shown_as}; do not edit "), doc.firstChild)

@@ -1,0 +1,345 @@
+"""Simulated hardware behind a JointTrajectoryController: what happens to the commands it writes.
+
+A plant receives, once per control cycle, the command the controller samples
+and returns the state the controller will read on the next cycle. `mirror`
+copies commands to states like ros2_control's mock_components/GenericSystem,
+`lag` follows them with a first-order delay, `pid` is a double integrator per
+joint driven through the velocity or effort interface by JTC's PID adapter.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Iterable, Mapping
+
+import numpy as np
+import numpy.typing as npt
+from numpy.typing import NDArray
+
+from ..config.robot_config import ControllerConfig
+from ..errors import UsageError, known
+from .tolerances import position_error
+
+__all__ = ["PLANTS", "FrozenPlant", "LagPlant", "MirrorPlant", "PidPlant", "Plant", "make_plant"]
+
+State = tuple[NDArray[np.float64], NDArray[np.float64]]
+Run = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+
+PLANTS = ("mirror", "lag", "pid")
+"""Plant names `make_plant` knows, the default first."""
+
+
+class Plant(ABC):
+    """Simulated hardware for n joints; positions in [rad] or [m], velocities in [rad]/[s].
+
+    Attributes:
+        interface: The command interface the plant is driven through.
+        last_output: The value written to that interface by the last `step`, shape (n,).
+    """
+
+    interface = "position"
+
+    def __init__(self, joint_count: int) -> None:
+        self._q = np.zeros(joint_count)
+        self._qd = np.zeros(joint_count)
+        self.last_output = np.zeros(joint_count)
+
+    def reset(self, positions: npt.ArrayLike, seed: int = 0) -> State:
+        """Return the measured state after placing the joints at rest at `positions`."""
+        self._q = np.array(positions, dtype=np.float64)
+        self._qd = np.zeros_like(self._q)
+        self.last_output = self._q.copy()
+        return self._measure()
+
+    @abstractmethod
+    def step(
+        self,
+        command_positions: NDArray[np.float64],
+        command_velocities: NDArray[np.float64],
+        command_accelerations: NDArray[np.float64],
+        dt: float,
+    ) -> State:
+        """Return the measured positions and velocities after applying one command for `dt` [s]."""
+
+    def displace(self, delta: NDArray[np.float64]) -> State:
+        """Return the measured state after a bump moved the joints by `delta`."""
+        self._q = self._q + delta
+        return self._measure()
+
+    def run(
+        self,
+        command_positions: NDArray[np.float64],
+        command_velocities: NDArray[np.float64],
+        command_accelerations: NDArray[np.float64],
+        dt: float,
+        bumps: NDArray[np.float64],
+    ) -> Run:
+        """Return measured positions, velocities and outputs, (K, n) each, after each of K commands.
+
+        Row k is the state after command k and then bump k (a displacement, usually zero).
+        """
+        count, n = command_positions.shape
+        positions, velocities, outputs = (np.empty((count, n)) for _ in range(3))
+        bumped = np.any(bumps != 0.0, axis=1)
+        for k in range(count):
+            p, v = self.step(
+                command_positions[k], command_velocities[k], command_accelerations[k], dt
+            )
+            outputs[k] = self.last_output
+            if bumped[k]:
+                p, v = self.displace(bumps[k])
+            positions[k], velocities[k] = p, v
+        return positions, velocities, outputs
+
+    def _measure(self) -> State:
+        # Plants rebind their state arrays and never modify them in place, so no copies.
+        return self._q, self._qd
+
+
+class MirrorPlant(Plant):
+    """State = command, like mock_components/GenericSystem: joints are where they were told to be.
+
+    GenericSystem reports velocity 0 unless velocity is commanded; this reports the commanded
+    velocity, which JTC only compares when it commands velocity or effort.
+    """
+
+    def step(
+        self,
+        command_positions: NDArray[np.float64],
+        command_velocities: NDArray[np.float64],
+        command_accelerations: NDArray[np.float64],
+        dt: float,
+    ) -> State:
+        """Return the command as the new state."""
+        self._q, self._qd = command_positions, command_velocities
+        self.last_output = command_positions
+        return self._measure()
+
+    def run(
+        self,
+        command_positions: NDArray[np.float64],
+        command_velocities: NDArray[np.float64],
+        command_accelerations: NDArray[np.float64],
+        dt: float,
+        bumps: NDArray[np.float64],
+    ) -> Run:
+        """Return the commands as states, plus the bumps: no loop, the state is the command."""
+        self._q, self._qd = command_positions[-1] + bumps[-1], command_velocities[-1].copy()
+        self.last_output = command_positions[-1].copy()
+        return command_positions + bumps, command_velocities.copy(), command_positions.copy()
+
+
+class FrozenPlant(Plant):
+    """Hardware that ignores commands (the upstream tests' separate command and state values)."""
+
+    def step(
+        self,
+        command_positions: NDArray[np.float64],
+        command_velocities: NDArray[np.float64],
+        command_accelerations: NDArray[np.float64],
+        dt: float,
+    ) -> State:
+        """Return the unchanged state."""
+        self.last_output = command_positions
+        return self._measure()
+
+
+class LagPlant(Plant):
+    """First-order response to the position command with time constant `tau_s` per joint [s]."""
+
+    def __init__(self, tau_s: npt.ArrayLike) -> None:
+        self._tau = np.array(tau_s, dtype=np.float64)
+        self._dt, self._decay = math.nan, np.ones_like(self._tau)
+        super().__init__(len(self._tau))
+
+    def step(
+        self,
+        command_positions: NDArray[np.float64],
+        command_velocities: NDArray[np.float64],
+        command_accelerations: NDArray[np.float64],
+        dt: float,
+    ) -> State:
+        """Return the state after moving exponentially towards the command for `dt`."""
+        if dt != self._dt:
+            self._dt, self._decay = dt, np.exp(-dt / self._tau)
+        self._q = command_positions + (self._q - command_positions) * self._decay
+        self._qd = (command_positions - self._q) / self._tau
+        self.last_output = command_positions
+        return self._measure()
+
+
+class PidPlant(Plant):
+    """Double integrator per joint, driven through velocity or effort by JTC's PID adapter.
+
+    The adapter writes u = ff_velocity_scale * v_command + PID(e_pos, e_vel) (control_toolbox
+    Pid; the integral term is clamped to +-i_clamp, so i_clamp 0, JTC's default, turns it off).
+    Errors are desired - measured at the current cycle; with JTC sampling the command one
+    period ahead, the desired state of this cycle is the previous command, which is what the
+    plant keeps. Through `effort`, u is a torque (acceleration = u / inertia, saturated at
+    max_effort); through `velocity`, the drive reaches the velocity u (saturated at
+    max_velocity) as fast as max_effort allows.
+    """
+
+    def __init__(
+        self,
+        gains: Mapping[str, NDArray[np.float64]],
+        interface: str,
+        *,
+        max_velocity: float = math.inf,
+        max_effort: float = math.inf,
+        inertia: float = 1.0,
+        noise: float = 0.0,
+        continuous: npt.ArrayLike | None = None,
+    ) -> None:
+        self._p, self._i, self._d = gains["p"], gains["i"], gains["d"]
+        self._i_clamp, self._ff = gains["i_clamp"], gains["ff_velocity_scale"]
+        super().__init__(len(self._p))
+        self.interface = interface
+        self._max_velocity, self._max_effort, self._inertia = max_velocity, max_effort, inertia
+        self._noise = noise
+        mask = np.asarray(False if continuous is None else continuous, dtype=bool)
+        self._continuous = mask if mask.any() else None
+        self._integrates = bool(np.any((self._i != 0.0) & (self._i_clamp > 0.0)))
+        self._rng = np.random.default_rng(0)
+        self._integral = np.zeros_like(self._p)
+        self._desired: State = (self._q, self._qd)
+        self._measured: State = (self._q, self._qd)
+
+    def reset(self, positions: npt.ArrayLike, seed: int = 0) -> State:
+        """Return the (noisy) measured state after placing the joints at rest; reseeds the noise."""
+        self._rng = np.random.default_rng(seed)
+        state = super().reset(positions)
+        self.last_output = np.zeros_like(self._q)
+        self._integral = np.zeros_like(self._q)
+        # The first cycle's desired state: a MoveIt trajectory starts where the robot is.
+        self._desired = (self._q, np.zeros_like(self._q))
+        return state
+
+    def step(
+        self,
+        command_positions: NDArray[np.float64],
+        command_velocities: NDArray[np.float64],
+        command_accelerations: NDArray[np.float64],
+        dt: float,
+    ) -> State:
+        """Return the measured state after one cycle of PID output applied to the joints."""
+        output = self._pid(command_velocities, dt)
+        self._desired = (command_positions, command_velocities)
+        if self.interface == "effort":
+            acceleration = _saturate(output, self._max_effort) / self._inertia
+        else:
+            target = _saturate(output, self._max_velocity)
+            acceleration = _saturate((target - self._qd) / dt, self._max_effort / self._inertia)
+        # Exact for an acceleration held over the period (zero-order hold of the output).
+        self._q = self._q + (self._qd + 0.5 * dt * acceleration) * dt
+        self._qd = _saturate(self._qd + acceleration * dt, self._max_velocity)
+        return self._measure()
+
+    def _pid(self, command_velocities: NDArray[np.float64], dt: float) -> NDArray[np.float64]:
+        """Return JTC's PID adapter output for this cycle and remember it as `last_output`."""
+        desired_p, desired_v = self._desired
+        measured_p, measured_v = self._measured
+        if self._continuous is None:
+            error = desired_p - measured_p
+        else:
+            error = position_error(desired_p, measured_p, self._continuous)
+        output = self._ff * command_velocities + self._p * error
+        output += self._d * (desired_v - measured_v)
+        if self._integrates:
+            integral = self._integral + self._i * error * dt
+            self._integral = np.clip(integral, -self._i_clamp, self._i_clamp)
+            output += self._integral
+        self.last_output = output
+        return output
+
+    def _measure(self) -> State:
+        positions = self._q
+        if self._noise > 0.0:
+            positions = positions + self._rng.normal(0.0, self._noise, len(positions))
+        self._measured = (positions, self._qd)
+        return self._measured
+
+
+def _saturate(values: NDArray[np.float64], limit: float) -> NDArray[np.float64]:
+    """Return `values` limited to +-limit; cheap for an infinite limit, the common case."""
+    if math.isinf(limit):
+        return values
+    return np.minimum(np.maximum(values, -limit), limit)
+
+
+_PID_PARAMS = ("inertia", "max_effort", "max_velocity", "noise")
+_GAINS = ("p", "i", "d", "i_clamp", "ff_velocity_scale")
+
+
+def make_plant(
+    name: str,
+    params: Mapping[str, float],
+    controller: ControllerConfig,
+    continuous_joints: Iterable[str] = (),
+) -> Plant:
+    """Return the plant `name` for the controller's joints, tuned by `params`.
+
+    mirror takes no parameters; lag takes `tau` [s] for all joints and `tau.<joint>` for one
+    (default 0.05 s); both follow the sampled position command whatever the controller's
+    command interfaces. pid takes max_velocity [rad]/[s], max_effort [N m], inertia
+    [kg m^2], noise (standard deviation of measured positions [rad]) and the gains of
+    `controller`, which must command velocity or effort alone. Raises UsageError for an
+    unknown plant or parameter, naming the valid ones.
+    """
+    joints = controller.joints
+    if name == "mirror":
+        _check_params(name, params, ())
+        return MirrorPlant(len(joints))
+    if name == "lag":
+        _check_params(name, params, ("tau", *(f"tau.{j}" for j in joints)))
+        default = _positive(params, "tau", 0.05)
+        return LagPlant([_positive(params, f"tau.{j}", default) for j in joints])
+    if name == "pid":
+        _check_params(name, params, _PID_PARAMS)
+        noise = float(params.get("noise", 0.0))
+        if not noise >= 0.0:
+            raise UsageError(f"plant parameter 'noise' must be >= 0, got {noise}")
+        return PidPlant(
+            _gains(controller),
+            _pid_interface(controller),
+            max_velocity=_positive(params, "max_velocity", math.inf),
+            max_effort=_positive(params, "max_effort", math.inf),
+            inertia=_positive(params, "inertia", 1.0),
+            noise=noise,
+            continuous=[j in set(continuous_joints) for j in joints],
+        )
+    raise UsageError(f"unknown plant '{name}'; known: {known(PLANTS)}")
+
+
+def _check_params(name: str, params: Mapping[str, float], valid: Iterable[str]) -> None:
+    allowed = set(valid)
+    for key in params:
+        if key not in allowed:
+            raise UsageError(f"plant '{name}' has no parameter '{key}'; known: {known(allowed)}")
+
+
+def _positive(params: Mapping[str, float], key: str, default: float) -> float:
+    value = float(params.get(key, default))
+    if not value > 0.0:
+        raise UsageError(f"plant parameter '{key}' must be positive, got {value}")
+    return value
+
+
+def _pid_interface(controller: ControllerConfig) -> str:
+    """Return the interface JTC's PID adapter drives: velocity or effort, alone."""
+    commands = controller.command_interfaces
+    if commands in (("velocity",), ("effort",)):
+        return commands[0]
+    raise UsageError(
+        f"plant 'pid' needs JTC's PID adapter, which runs only with command_interfaces "
+        f"[velocity] or [effort]; controller '{controller.name}' has [{', '.join(commands)}]"
+    )
+
+
+def _gains(controller: ControllerConfig) -> dict[str, NDArray[np.float64]]:
+    """Return each PID gain as an array over the controller's joints (missing: 0, as in JTC)."""
+    return {
+        gain: np.array([controller.gains.get(j, {}).get(gain, 0.0) for j in controller.joints])
+        for gain in _GAINS
+    }

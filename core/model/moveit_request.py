@@ -1,0 +1,247 @@
+"""MoveIt's moveit_msgs/MotionPlanRequest, written as YAML: start state, goal, group, planner and limits.
+
+Read as move_group reads one, with these choices:
+
+- `goal_constraints` are alternatives; moveplan plans to the first (a warning says so when
+  there are more). A goal is either joint constraints (a joint goal) or one position and
+  one orientation constraint on one link (a pose goal of that link: the constraint region's
+  first pose, moved back by `target_point_offset` along the orientation). Tolerances and
+  weights are ignored: moveplan reaches the goal itself.
+- `planner_id`: "geometric::" is dropped, then a MoveIt planner config name maps to the
+  longest OMPL planner name that begins it (RRTConnectkConfigDefault -> RRTConnect), with
+  BKPIECE, LBKPIECE and KPIECE meaning BKPIECE1, LBKPIECE1 and KPIECE1. Empty: the robot
+  config's default planner. A name of no available planner is an error.
+- `allowed_planning_time` 0 or missing: the default planning time.
+- `max_velocity_scaling_factor`, `max_acceleration_scaling_factor`: as MoveIt's time
+  parameterisation reads them, a value in (0, 1] is used and anything else (0 included,
+  MoveIt's "not set") means 1.0, the full limits; values other than 0 log a warning.
+  A factor left out of the file is not set: the task's or robot config's default applies.
+- Ignored: `num_planning_attempts` (one search per step), `workspace_parameters` (the
+  joint limits bound the search), `pipeline_id`, `reference_trajectories` and Cartesian
+  speed limits (warnings where set). Path and trajectory constraints, visibility
+  constraints and attached objects in the start state are errors.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..config.planners import PLANNERS
+from ..config.robot_config import check_keys, load_yaml, mapping, number
+from ..config.tasks import StepSpec
+from ..errors import ConfigError, known
+from .moveit_messages import header_frame, point, pose, quaternion, robot_state, yaml_list
+from .scene import pose_matrix
+
+__all__ = ["MotionPlanRequest", "load_motion_plan_request", "planner_name"]
+
+logger = logging.getLogger(__name__)
+
+_REQUEST_KEYS = {
+    "workspace_parameters", "start_state", "goal_constraints", "path_constraints", "trajectory_constraints",
+    "reference_trajectories", "pipeline_id", "planner_id", "group_name", "num_planning_attempts",
+    "allowed_planning_time", "max_velocity_scaling_factor", "max_acceleration_scaling_factor",
+    "cartesian_speed_limited_link", "max_cartesian_speed",
+}
+_CONSTRAINTS_KEYS = {
+    "name", "joint_constraints", "position_constraints", "orientation_constraints", "visibility_constraints",
+}
+_JOINT_KEYS = {"joint_name", "position", "tolerance_above", "tolerance_below", "weight"}
+_POSITION_KEYS = {"header", "link_name", "target_point_offset", "constraint_region", "weight"}
+_REGION_KEYS = {"primitives", "primitive_poses", "meshes", "mesh_poses"}
+_ORIENTATION_KEYS = {
+    "header", "orientation", "link_name", "absolute_x_axis_tolerance", "absolute_y_axis_tolerance",
+    "absolute_z_axis_tolerance", "parameterization", "weight",
+}
+# MoveIt's planner configs name these without OMPL's version suffix.
+_ALIASES = {"BKPIECE": "BKPIECE1", "LBKPIECE": "LBKPIECE1", "KPIECE": "KPIECE1"}
+# OMPL geometric planners the Python bindings do not offer: named so that a config like
+# "RRTXstatickConfigDefault" is reported as unavailable, not taken for RRT.
+_UNAVAILABLE = (
+    "RRTXstatic", "RRTsharp", "TRRT", "BiTRRT", "LBTRRT", "LazyLBTRRT", "LazyRRT", "pRRT", "LazyPRM",
+    "LazyPRMstar", "SPARS", "SPARStwo", "EST", "BiEST", "ProjEST", "SBL", "pSBL", "STRIDE", "PDST",
+    "AITstar", "ABITstar", "EITstar", "CForest", "STRRTstar", "SST",
+)
+
+
+@dataclass(frozen=True)
+class MotionPlanRequest:
+    """What moveplan uses of a MotionPlanRequest; None where the request leaves a setting to the defaults.
+
+    Attributes:
+        source: The request file.
+        group_name: Planning group.
+        start: start_state.joint_state as joint -> position in [rad] or [m]; may name joints
+            outside the group (a Panda's fingers), which then hold those values.
+        goal: The first goal alternative as a step, named after the file; None without goals.
+        planner: OMPL planner name.
+        planning_time: In [s].
+        velocity_scaling: Fraction of the velocity limits, in (0, 1].
+        acceleration_scaling: Fraction of the acceleration limits, in (0, 1].
+        raw: The file's bytes, embedded in plan files.
+    """
+
+    source: Path
+    group_name: str | None
+    start: dict[str, float]
+    goal: StepSpec | None
+    planner: str | None
+    planning_time: float | None
+    velocity_scaling: float | None
+    acceleration_scaling: float | None
+    raw: bytes = b""
+
+
+def load_motion_plan_request(path: Path) -> MotionPlanRequest:
+    """Return the MotionPlanRequest in a YAML file."""
+    source = str(path)
+    top = mapping(load_yaml(path), source)
+    check_keys(top, _REQUEST_KEYS, source)
+    _check_unsupported(top, source)
+
+    joints, attached = robot_state(top.get("start_state"), f"{source}: start_state")
+    if attached:
+        raise ConfigError(f"{source}: start_state.attached_collision_objects: not supported in a request; "
+                          "attach objects in the scene (robot_state.attached_collision_objects)")
+    alternatives = yaml_list(top.get("goal_constraints"), f"{source}: goal_constraints")
+    if len(alternatives) > 1:
+        logger.warning("%s: goal_constraints has %d alternatives; moveplan plans to the first",
+                       source, len(alternatives))
+    goal = None
+    if alternatives:
+        goal = StepSpec(path.stem, _goal(alternatives[0], f"{source}: goal_constraints[0]"))
+
+    group = top.get("group_name", "")
+    if not isinstance(group, str):
+        raise ConfigError(f"{source}: group_name: expected a group name, got {group!r}")
+    planner_id = top.get("planner_id", "")
+    if not isinstance(planner_id, str):
+        raise ConfigError(f"{source}: planner_id: expected a planner name, got {planner_id!r}")
+    planning_time = number(top.get("allowed_planning_time", 0.0), f"{source}: allowed_planning_time")
+    if planning_time < 0:
+        raise ConfigError(f"{source}: allowed_planning_time: expected seconds >= 0, got {planning_time!r}")
+    return MotionPlanRequest(
+        source=path,
+        group_name=group or None,
+        start=joints,
+        goal=goal,
+        planner=planner_name(planner_id, f"{source}: planner_id"),
+        planning_time=planning_time or None,
+        velocity_scaling=_scaling(top, "max_velocity_scaling_factor", source),
+        acceleration_scaling=_scaling(top, "max_acceleration_scaling_factor", source),
+        raw=path.read_bytes(),
+    )
+
+
+def planner_name(planner_id: str, where: str) -> str | None:
+    """Return the OMPL planner a MoveIt planner_id names, or None for an empty one (the default)."""
+    name = planner_id.removeprefix("geometric::")
+    if not name:
+        return None
+    candidates = {p: p for p in _UNAVAILABLE} | {p: p for p in PLANNERS}
+    candidates |= {alias: full for alias, full in _ALIASES.items() if full in PLANNERS}
+    matches = [c for c in candidates if name.startswith(c)]
+    planner = candidates[max(matches, key=len)] if matches else ""
+    if planner not in PLANNERS:
+        raise ConfigError(f"{where}: '{planner_id}' names no available OMPL geometric planner; "
+                          f"known: {known(PLANNERS)}")
+    return planner
+
+
+def _check_unsupported(top: dict[str, Any], source: str) -> None:
+    """Raise ConfigError for request fields that would change the motion but that moveplan cannot honour."""
+    path = mapping(top.get("path_constraints"), f"{source}: path_constraints")
+    check_keys(path, _CONSTRAINTS_KEYS, f"{source}: path_constraints")
+    if any(yaml_list(path.get(k), f"{source}: path_constraints.{k}") for k in _CONSTRAINTS_KEYS - {"name"}):
+        raise ConfigError(f"{source}: path_constraints: not supported; moveplan plans without path constraints")
+    trajectory = mapping(top.get("trajectory_constraints"), f"{source}: trajectory_constraints")
+    check_keys(trajectory, {"constraints"}, f"{source}: trajectory_constraints")
+    if yaml_list(trajectory.get("constraints"), f"{source}: trajectory_constraints.constraints"):
+        raise ConfigError(f"{source}: trajectory_constraints: not supported")
+    if yaml_list(top.get("reference_trajectories"), f"{source}: reference_trajectories"):
+        logger.warning("%s: reference_trajectories are ignored", source)
+    pipeline = top.get("pipeline_id", "")
+    if pipeline not in ("", "ompl"):
+        logger.warning("%s: pipeline_id '%s' is ignored; moveplan plans with OMPL", source, pipeline)
+    if number(top.get("max_cartesian_speed", 0.0), f"{source}: max_cartesian_speed") > 0:
+        logger.warning("%s: max_cartesian_speed is ignored; the joint limits bound the motion", source)
+
+
+def _scaling(top: dict[str, Any], key: str, source: str) -> float | None:
+    """Return a scaling factor as MoveIt's time parameterisation reads it: outside (0, 1] is 1.0."""
+    if key not in top:
+        return None
+    factor = number(top[key], f"{source}: {key}")
+    if 0.0 < factor <= 1.0:
+        return factor
+    if factor != 0.0:
+        logger.warning("%s: %s %g is outside (0, 1]; using 1.0, as MoveIt does", source, key, factor)
+    return 1.0
+
+
+def _goal(value: Any, where: str) -> dict[str, Any]:
+    """Return the step goal of one moveit_msgs/Constraints: a joint goal or a pose goal."""
+    entry = mapping(value, where)
+    check_keys(entry, _CONSTRAINTS_KEYS, where)
+    joints = yaml_list(entry.get("joint_constraints"), f"{where}.joint_constraints")
+    positions = yaml_list(entry.get("position_constraints"), f"{where}.position_constraints")
+    orientations = yaml_list(entry.get("orientation_constraints"), f"{where}.orientation_constraints")
+    if yaml_list(entry.get("visibility_constraints"), f"{where}.visibility_constraints"):
+        raise ConfigError(f"{where}.visibility_constraints: not supported")
+    if joints and (positions or orientations):
+        raise ConfigError(f"{where}: give joint constraints or position and orientation constraints, not both")
+    if joints:
+        goal: dict[str, float] = {}
+        for k, item in enumerate(joints):
+            at = f"{where}.joint_constraints[{k}]"
+            constraint = mapping(item, at)
+            check_keys(constraint, _JOINT_KEYS, at)
+            name = constraint.get("joint_name")
+            if not isinstance(name, str) or not name:
+                raise ConfigError(f"{at}.joint_name: expected a joint name, got {name!r}")
+            if name in goal:
+                raise ConfigError(f"{at}.joint_name: joint '{name}' is constrained twice")
+            goal[name] = number(constraint.get("position"), f"{at}.position")
+        return {"joints": goal}
+    if len(positions) != 1 or len(orientations) != 1:
+        raise ConfigError(f"{where}: a goal needs joint constraints, or one position and one orientation "
+                          f"constraint (got {len(positions)} and {len(orientations)})")
+    return {"pose": _pose_goal(positions[0], orientations[0], where)}
+
+
+def _pose_goal(position_value: Any, orientation_value: Any, where: str) -> dict[str, Any]:
+    """Return a pose goal {frame, link, xyz, quat, rpy} from a position and an orientation constraint."""
+    at_p, at_o = f"{where}.position_constraints[0]", f"{where}.orientation_constraints[0]"
+    position = mapping(position_value, at_p)
+    check_keys(position, _POSITION_KEYS, at_p)
+    orientation = mapping(orientation_value, at_o)
+    check_keys(orientation, _ORIENTATION_KEYS, at_o)
+    links = [c.get("link_name") for c in (position, orientation)]
+    if not all(isinstance(link, str) and link for link in links):
+        raise ConfigError(f"{where}: position and orientation constraints need a link_name, got {links}")
+    if links[0] != links[1]:
+        raise ConfigError(f"{at_o}.link_name: '{links[1]}' is not the position constraint's link '{links[0]}'")
+    frames = [header_frame(c, at, "") for c, at in ((position, at_p), (orientation, at_o))]
+    if frames[0] != frames[1]:
+        raise ConfigError(f"{at_o}.header.frame_id: '{frames[1]}' is not the position constraint's frame "
+                          f"'{frames[0]}'; give both in one frame")
+    region = mapping(position.get("constraint_region"), f"{at_p}.constraint_region")
+    check_keys(region, _REGION_KEYS, f"{at_p}.constraint_region")
+    poses = (yaml_list(region.get("primitive_poses"), f"{at_p}.constraint_region.primitive_poses")
+             or yaml_list(region.get("mesh_poses"), f"{at_p}.constraint_region.mesh_poses"))
+    if not poses:
+        raise ConfigError(f"{at_p}.constraint_region.primitive_poses: the region needs a pose, its centre is the goal")
+    centre = pose(poses[0], f"{at_p}.constraint_region.primitive_poses[0]")[:3, 3]
+    quat = quaternion(orientation.get("orientation"), f"{at_o}.orientation") or [0.0, 0.0, 0.0, 1.0]
+    rotation = pose_matrix(None, None, quat, f"{at_o}.orientation")[:3, :3]
+    offset = np.array(point(position.get("target_point_offset", [0.0, 0.0, 0.0]), f"{at_p}.target_point_offset"))
+    # The offset point, fixed in the link, must reach the centre: the link origin sits back from it.
+    origin = centre - rotation @ offset
+    norm = float(np.linalg.norm(quat))
+    return {"frame": frames[0] or None, "link": links[0], "xyz": [float(v) for v in origin],
+            "rpy": None, "quat": [v / norm for v in quat]}

@@ -1,0 +1,133 @@
+"""Robot model: pinocchio kinematics of a robot config, seen through one planning group.
+
+A robot state is a pinocchio configuration vector `q` (all joints); the planner
+works on the group's joint values (`values`, one per active joint, in [rad] or
+[m]). Joints outside the group keep their values from the start state.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from ..config.robot_config import Group, RobotConfig
+from ..errors import ConfigError, UnknownName
+from ..types import Frame, TfSamples
+
+__all__ = ["Robot"]
+
+
+class Robot:
+    """Kinematic model of `config` with one active planning group."""
+
+    def __init__(self, config: RobotConfig, group: str | None = None) -> None:
+        self.config = config
+        self.group: Group = config.group(group)
+        try:
+            self.model = pin.buildModelFromXML(config.urdf)
+        except (RuntimeError, ValueError) as exc:
+            raise ConfigError(f"{config.urdf_path}: pinocchio cannot load the URDF: {exc}") from None
+        self.data = self.model.createData()
+        self.joint_names: tuple[str, ...] = self.group.joints
+        if not self.joint_names:
+            raise ConfigError(f"{config.srdf_path}: group '{self.group.name}' has no movable joints")
+        limits = [config.limits[j] for j in self.joint_names]
+        self.lower = _readonly([lim.lower for lim in limits])
+        self.upper = _readonly([lim.upper for lim in limits])
+        self.max_velocity = _readonly([lim.max_velocity for lim in limits])
+        self.max_acceleration = _readonly([lim.max_acceleration for lim in limits])
+        self.continuous = np.array([lim.continuous for lim in limits])
+        ids = [self.model.getJointId(j) for j in self.joint_names]
+        self.q_index = np.array([self.model.idx_qs[i] for i in ids])
+        self.link_names = tuple(f.name for f in self.model.frames if f.type == pin.FrameType.BODY)
+
+    @property
+    def dof(self) -> int:
+        """Return the number of active joints in the group."""
+        return len(self.joint_names)
+
+    def configuration(self, values: npt.ArrayLike, base: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+        """Return the pinocchio configuration with the group at `values`, other joints from `base`."""
+        return self.configurations(np.asarray(values, dtype=float)[None, :], base)[:, 0]
+
+    def configurations(
+        self, values: NDArray[np.float64], base: NDArray[np.float64] | None = None
+    ) -> NDArray[np.float64]:
+        """Return configurations, shape (nq, k), for group values of shape (k, dof)."""
+        base = self.neutral() if base is None else base
+        q = np.repeat(base[:, None], len(values), axis=1)
+        plain = ~self.continuous
+        q[self.q_index[plain], :] = values[:, plain].T
+        # A continuous joint is stored by pinocchio as (cos, sin).
+        q[self.q_index[self.continuous], :] = np.cos(values[:, self.continuous]).T
+        q[self.q_index[self.continuous] + 1, :] = np.sin(values[:, self.continuous]).T
+        return q
+
+    def values(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Return the group's joint values in configuration `q`."""
+        out = q[self.q_index].astype(float)
+        cont = self.continuous
+        out[cont] = np.arctan2(q[self.q_index[cont] + 1], q[self.q_index[cont]])
+        return out
+
+    def neutral(self) -> NDArray[np.float64]:
+        """Return the configuration where the fake hardware starts (initial_positions, else zero)."""
+        q = np.array(pin.neutral(self.model))
+        for joint, value in self.config.initial_positions.items():
+            q = self.set_joint(q, joint, value)
+        return q
+
+    def set_joint(self, q: NDArray[np.float64], joint: str, value: float) -> NDArray[np.float64]:
+        """Return a copy of `q` with one joint set to `value`."""
+        if not self.model.existJointName(joint):
+            raise UnknownName("joint", joint, str(self.config.urdf_path), self.config.limits)
+        jid = self.model.getJointId(joint)
+        q = q.copy()
+        index = self.model.idx_qs[jid]
+        if self.model.nqs[jid] == 2:
+            q[index : index + 2] = np.cos(value), np.sin(value)
+        else:
+            q[index] = value
+        return q
+
+    def frame_pose(self, q: NDArray[np.float64], frame: str) -> NDArray[np.float64]:
+        """Return `root_T_frame`, the 4x4 pose of a link or frame in the URDF root frame."""
+        if not self.model.existFrame(frame):
+            raise UnknownName("link", frame, str(self.config.urdf_path), self.link_names)
+        fid = self.model.getFrameId(frame)
+        pin.framesForwardKinematics(self.model, self.data, q)
+        return np.array(self.data.oMf[fid].homogeneous)
+
+    def fixed_frames(self) -> tuple[Frame, ...]:
+        """Return `parent_T_child` of every fixed URDF joint, as robot_state_publisher latches them."""
+        pin.framesForwardKinematics(self.model, self.data, self.neutral())
+        joints = [j for j in self.config.urdf_joints.values() if j.type == "fixed"]
+        return tuple(Frame(j.child, j.parent, self._relative(j.parent, j.child)) for j in joints)
+
+    def tf_samples(self, times_s: npt.ArrayLike, values: NDArray[np.float64], base: NDArray[np.float64]) -> TfSamples:
+        """Return `parent_T_child` of every moving URDF joint for group values (M, dof) at `times_s`."""
+        moving = [j for j in self.config.urdf_joints.values() if j.type != "fixed"]
+        rows = np.empty((len(values), len(moving), 4, 4))
+        for k, q in enumerate(self.configurations(np.asarray(values, dtype=float), base).T):
+            pin.framesForwardKinematics(self.model, self.data, q)
+            rows[k] = [self._relative(j.parent, j.child) for j in moving]
+        return TfSamples(times_s, tuple(j.parent for j in moving), tuple(j.child for j in moving), rows)
+
+    def _relative(self, parent: str, child: str) -> NDArray[np.float64]:
+        """Return `parent_T_child` from the last forward kinematics."""
+        frames = self.data.oMf
+        root_T_parent, root_T_child = frames[self.model.getFrameId(parent)], frames[self.model.getFrameId(child)]
+        return np.array((root_T_parent.inverse() * root_T_child).homogeneous)
+
+    @property
+    def root_link(self) -> str:
+        """Return the URDF root link, the planning frame."""
+        return str(self.model.frames[1].name) if len(self.model.frames) > 1 else "world"
+
+
+def _readonly(values: list[float]) -> NDArray[np.float64]:
+    array = np.array(values, dtype=float)
+    array.setflags(write=False)
+    return array

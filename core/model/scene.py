@@ -1,0 +1,208 @@
+"""Scene: named static frames and collision objects around a robot (DESIGN section 3).
+
+Frames may chain and may hang off robot links. Everything is resolved to the
+planning frame (the URDF root) with the robot at its neutral configuration,
+so world objects must sit in frames that do not move with the arm.
+
+A scene file is either moveplan's own format (frames, objects, attached) or a
+moveit_msgs/PlanningScene written as YAML, which core/model/planning_scene.py reads (it places
+objects with the robot in the scene's own robot state, as MoveIt does).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from ..config.robot_config import check_keys, load_yaml, mapping, number
+from ..errors import ConfigError, FrameNotFound
+from ..types import CollisionObject, Frame, Shape
+from .robot import Robot
+
+__all__ = ["PLANNING_SCENE_KEYS", "Scene", "empty_scene", "load_scene", "pose_matrix", "resolve_frames"]
+
+_FRAME_KEYS = {"name", "parent", "xyz", "rpy", "quat"}
+_SHAPE_KEYS = {"box", "cylinder", "sphere", "mesh", "scale"}
+_OBJECT_KEYS = {"name", "frame", "xyz", "rpy", "quat"} | _SHAPE_KEYS
+_ATTACHED_KEYS = {"name", "link", "xyz", "rpy", "quat", "touch_links"} | _SHAPE_KEYS
+# The fields of moveit_msgs/PlanningScene: a scene file with any of them is one.
+PLANNING_SCENE_KEYS = {
+    "name", "robot_state", "robot_model_name", "fixed_frame_transforms", "allowed_collision_matrix",
+    "link_padding", "link_scale", "object_colors", "world", "is_diff",
+}
+
+
+@dataclass(frozen=True)
+class Scene:
+    """Frames and objects of a scene, with every frame resolved to a robot link.
+
+    Attributes:
+        source: The scene file, for messages ("(no scene)" when none was given).
+        frames: Scene frames as written (`parent_T_frame`).
+        objects: World objects placed in the planning frame, then attached objects.
+        anchors: Frame name -> (robot link, `link_T_frame`).
+        allowed: Pairs of link or object names allowed to touch (a PlanningScene's allowed
+            collision matrix; the SRDF's disabled pairs come on top).
+        robot_state: Joint name -> position in [rad] or [m], the robot state a PlanningScene
+            carries (empty for moveplan scenes).
+    """
+
+    source: str
+    frames: tuple[Frame, ...]
+    objects: tuple[CollisionObject, ...]
+    anchors: dict[str, tuple[str, NDArray[np.float64]]]
+    allowed: frozenset[frozenset[str]] = frozenset()
+    robot_state: dict[str, float] = field(default_factory=dict)
+
+    def anchor(self, frame: str, robot: Robot) -> tuple[str, NDArray[np.float64]]:
+        """Return (robot link, `link_T_frame`) for a scene frame or robot link."""
+        if frame in self.anchors:
+            return self.anchors[frame]
+        if frame in robot.link_names:
+            return frame, np.eye(4)
+        raise FrameNotFound(frame, self.source, [*self.anchors, *robot.link_names])
+
+
+def empty_scene() -> Scene:
+    """Return a scene with no frames or objects."""
+    return Scene("(no scene)", (), (), {})
+
+
+def pose_matrix(xyz: Any, rpy: Any, quat: Any, where: str) -> NDArray[np.float64]:
+    """Return the 4x4 transform of a position and an rpy (fixed X-Y-Z) or [x, y, z, w] quaternion."""
+    transform = np.eye(4)
+    transform[:3, 3] = _vector(xyz if xyz is not None else [0, 0, 0], 3, f"{where}.xyz")
+    if rpy is not None and quat is not None:
+        raise ConfigError(f"{where}: give rpy or quat, not both")
+    if quat is not None:
+        x, y, z, w = _vector(quat, 4, f"{where}.quat")
+        norm = math.sqrt(x * x + y * y + z * z + w * w)
+        if norm < 1e-9:
+            raise ConfigError(f"{where}.quat: a quaternion [x, y, z, w] of zero norm is not a rotation")
+        transform[:3, :3] = pin.Quaternion(w / norm, x / norm, y / norm, z / norm).toRotationMatrix()
+    elif rpy is not None:
+        transform[:3, :3] = pin.rpy.rpyToMatrix(*_vector(rpy, 3, f"{where}.rpy"))
+    return transform
+
+
+def _vector(value: Any, size: int, where: str) -> NDArray[np.float64]:
+    if not isinstance(value, list | tuple) or len(value) != size:
+        raise ConfigError(f"{where}: expected a list of {size} numbers, got {value!r}")
+    return np.array([number(v, f"{where}[{i}]") for i, v in enumerate(value)])
+
+
+def _shape(entry: dict[str, Any], where: str, folder: Path) -> Shape:
+    kinds = [k for k in ("box", "cylinder", "sphere", "mesh") if k in entry]
+    if len(kinds) != 1:
+        raise ConfigError(f"{where}: give exactly one shape of box, cylinder, sphere, mesh")
+    kind = kinds[0]
+    value = entry[kind]
+    if kind == "box":
+        dims = tuple(float(v) for v in _vector(value, 3, f"{where}.box"))
+    elif kind == "cylinder":
+        cyl = mapping(value, f"{where}.cylinder")
+        check_keys(cyl, {"radius", "length"}, f"{where}.cylinder")
+        dims = (number(cyl.get("radius"), f"{where}.cylinder.radius", positive=True),
+                number(cyl.get("length"), f"{where}.cylinder.length", positive=True))
+    elif kind == "sphere":
+        dims = (number(value, f"{where}.sphere", positive=True),)
+    else:
+        if not isinstance(value, str):
+            raise ConfigError(f"{where}.mesh: expected a file name, got {value!r}")
+        scale = tuple(float(v) for v in _vector(entry.get("scale", [1, 1, 1]), 3, f"{where}.scale"))
+        return Shape("mesh", (), str(folder / value), (scale[0], scale[1], scale[2]))
+    if any(d <= 0 for d in dims):
+        raise ConfigError(f"{where}.{kind}: sizes must be positive, got {list(dims)}")
+    return Shape(kind, dims)
+
+
+def load_scene(path: Path, robot: Robot) -> Scene:
+    """Return the scene in a moveplan scene file or a PlanningScene YAML, resolved against `robot`'s links."""
+    source = str(path)
+    top = mapping(load_yaml(path), source)
+    if PLANNING_SCENE_KEYS & set(top):
+        # Imported here: moveit_scene builds on this module's helpers.
+        from .planning_scene import planning_scene
+
+        return planning_scene(top, path, robot)
+    check_keys(top, {"frames", "objects", "attached"}, source)
+    frames: list[Frame] = []
+    for k, entry in enumerate(top.get("frames") or []):
+        where = f"{source}: frames[{k}]"
+        entry = mapping(entry, where)
+        check_keys(entry, _FRAME_KEYS, where)
+        for key in ("name", "parent"):
+            if not isinstance(entry.get(key), str):
+                raise ConfigError(f"{where}: '{key}' must be a frame name")
+        transform = pose_matrix(entry.get("xyz"), entry.get("rpy"), entry.get("quat"), where)
+        frames.append(Frame(entry["name"], entry["parent"], transform))
+    anchors = resolve_frames(frames, robot, source)
+
+    root_q = robot.neutral()
+    objects: list[CollisionObject] = []
+    for k, entry in enumerate(top.get("objects") or []):
+        where = f"{source}: objects[{k}]"
+        entry = mapping(entry, where)
+        check_keys(entry, _OBJECT_KEYS, where)
+        name, frame = entry.get("name"), entry.get("frame", robot.root_link)
+        if not isinstance(name, str):
+            raise ConfigError(f"{where}: 'name' must be a string")
+        link, link_T_frame = Scene(source, (), (), anchors).anchor(str(frame), robot)
+        if robot.model.frames[robot.model.getFrameId(link)].parentJoint != 0:
+            raise ConfigError(f"{where}: frame '{frame}' moves with link '{link}'; "
+                              "put objects carried by the robot under 'attached'")
+        root_T_object = robot.frame_pose(root_q, link) @ link_T_frame @ pose_matrix(
+            entry.get("xyz"), entry.get("rpy"), entry.get("quat"), where)
+        objects.append(CollisionObject(name, _shape(entry, where, path.parent), root_T_object))
+    for k, entry in enumerate(top.get("attached") or []):
+        where = f"{source}: attached[{k}]"
+        entry = mapping(entry, where)
+        check_keys(entry, _ATTACHED_KEYS, where)
+        name, link = entry.get("name"), entry.get("link")
+        if not isinstance(name, str) or not isinstance(link, str):
+            raise ConfigError(f"{where}: 'name' and 'link' must be strings")
+        if link not in robot.link_names:
+            raise FrameNotFound(link, where, robot.link_names)
+        touch = tuple(str(t) for t in entry.get("touch_links") or [])
+        transform = pose_matrix(entry.get("xyz"), entry.get("rpy"), entry.get("quat"), where)
+        objects.append(CollisionObject(name, _shape(entry, where, path.parent), transform, link, touch))
+    names = [o.name for o in objects]
+    for name in names:
+        if names.count(name) > 1:
+            raise ConfigError(f"{source}: object name '{name}' is used twice")
+    return Scene(source, tuple(frames), tuple(objects), anchors)
+
+
+def resolve_frames(
+    frames: list[Frame], robot: Robot, source: str
+) -> dict[str, tuple[str, NDArray[np.float64]]]:
+    """Return each frame's robot link and `link_T_frame`, following parent chains."""
+    by_name = {f.name: f for f in frames}
+    for frame in frames:
+        if frame.name in robot.link_names:
+            raise ConfigError(f"{source}: frame '{frame.name}' has the name of a robot link")
+    anchors: dict[str, tuple[str, NDArray[np.float64]]] = {}
+
+    def resolve(name: str, seen: tuple[str, ...]) -> tuple[str, NDArray[np.float64]]:
+        if name in anchors:
+            return anchors[name]
+        if name in robot.link_names:
+            return name, np.eye(4)
+        if name not in by_name:
+            raise FrameNotFound(name, source, [*by_name, *robot.link_names])
+        if name in seen:
+            raise ConfigError(f"{source}: frames form a loop: {' -> '.join((*seen, name))}")
+        frame = by_name[name]
+        link, link_T_parent = resolve(frame.parent, (*seen, name))
+        anchors[name] = (link, link_T_parent @ frame.transform)
+        return anchors[name]
+
+    for frame in frames:
+        resolve(frame.name, ())
+    return anchors

@@ -1,0 +1,286 @@
+"""Planning benchmarks: many problems, planners and seeds; success, times, path quality, exact validity.
+
+A problem is a MoveIt PlanningScene + MotionPlanRequest pair (`sceneNNNN.yaml`,
+`requestNNNN.yaml`, as MotionBenchMaker writes them) or a moveplan task file.
+Each (planner, seed) runs in a process of its own; every run is seeded anew,
+so a problem and seed give the same path here as with `moveplan plan`.
+"""
+
+from __future__ import annotations
+
+import csv
+import logging
+import multiprocessing
+import queue as queue_module
+import re
+import traceback
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ConfigError, InputError, MoveplanError, NoPlan, UsageError
+
+__all__ = ["STAGES", "Problem", "Run", "find_problems", "plot", "run_benchmark", "summarize", "write_csv"]
+
+logger = logging.getLogger(__name__)
+
+_PAIR = re.compile(r"scene(\w*)\.ya?ml$")
+# What a step's time is spent on, and their sum; and the step's whole wall time, IK included.
+STAGES = ("search", "simplify", "certify", "timing", "total", "planning_time")
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One planning problem: a scene + request pair, or a task file (`request` is then None)."""
+
+    name: str
+    scenario: str
+    scene: Path | None
+    request: Path | None
+    task: Path | None = None
+
+
+@dataclass(frozen=True)
+class Run:
+    """The outcome of one problem, planner and seed; times in [s], path length in [rad].
+
+    `total_s` is search + simplification + certification + time parameterisation;
+    `planning_time_s` is the steps' wall time from goal to certified trajectory (IK included).
+    """
+
+    problem: str
+    scenario: str
+    planner: str
+    seed: int
+    ok: bool
+    search_s: float = float("nan")
+    simplify_s: float = float("nan")
+    certify_s: float = float("nan")
+    timing_s: float = float("nan")
+    total_s: float = float("nan")
+    planning_time_s: float = float("nan")
+    checks: int = 0
+    path_length: float = float("nan")
+    duration_s: float = float("nan")
+    exact_valid: bool | None = None
+    error: str | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        """Return the run as a JSON-ready dict (NaN as None)."""
+        return {k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in asdict(self).items()}
+
+
+def find_problems(paths: Sequence[Path], count: int | None = None) -> tuple[Problem, ...]:
+    """Return the problems in `paths`: folders of scene/request pairs (searched recursively) or task files.
+
+    `count` keeps the first problems of each folder.
+    """
+    problems: list[Problem] = []
+    for path in paths:
+        if path.is_file():
+            problems.append(Problem(path.stem, path.parent.name, None, None, task=path))
+            continue
+        if not path.is_dir():
+            raise ConfigError(f"{path}: no such problem folder or task file")
+        folders = sorted({p.parent for p in path.rglob("scene*.y*ml") if _PAIR.search(p.name)})
+        if not folders:
+            raise ConfigError(f"{path}: no sceneNNNN.yaml / requestNNNN.yaml pairs found")
+        for folder in folders:
+            found = []
+            for scene in sorted(folder.glob("scene*.y*ml")):
+                match = _PAIR.search(scene.name)
+                if not match:
+                    continue
+                request = folder / f"request{match.group(1)}{scene.suffix}"
+                if not request.is_file():
+                    raise ConfigError(f"{scene}: no matching {request.name} beside it")
+                found.append(Problem(f"{folder.name}/{match.group(1)}", folder.name, scene, request))
+            problems.extend(found[:count] if count else found)
+    if not problems:
+        raise UsageError("no problems to run")
+    return tuple(problems)
+
+
+RunProblem = Callable[[Problem], Run]
+
+
+def run_benchmark(
+    robot: Path,
+    problems: Sequence[Problem],
+    planners: Sequence[str],
+    seeds: Sequence[int],
+    planning_time: float,
+    jobs: int = 1,
+    on_run: Callable[[Run], None] | None = None,
+) -> list[Run]:
+    """Return every run of every problem with every planner and seed, in a stable order.
+
+    Each (planner, seed) is one child process; `jobs` of them run at a time.
+    `on_run` is called in this process as each run completes (for a progress bar).
+    """
+    context = multiprocessing.get_context("spawn")
+    results: queue_module.Queue[Any] = context.Queue()
+    pending = [(planner, seed) for planner in planners for seed in seeds]
+    running: dict[tuple[str, int], Any] = {}
+    runs: list[Run] = []
+    while pending or running:
+        while pending and len(running) < max(1, jobs):
+            planner, seed = pending.pop(0)
+            process = context.Process(
+                target=_worker, args=(robot, tuple(problems), planner, seed, planning_time, results), daemon=True)
+            process.start()
+            running[(planner, seed)] = process
+        try:
+            kind, key, payload = results.get(timeout=1.0)
+        except queue_module.Empty:
+            dead = [(key, p.exitcode) for key, p in running.items() if not p.is_alive() and p.exitcode != 0]
+            if dead:
+                (planner, seed), code = dead[0]
+                raise MoveplanError(f"benchmark worker for planner {planner}, seed {seed} died "
+                                    f"(exit code {code})") from None
+            continue
+        if kind == "run":
+            run = Run(**payload)
+            runs.append(run)
+            if on_run is not None:
+                on_run(run)
+        elif kind == "done":
+            running.pop(key).join()
+        else:
+            for process in running.values():
+                process.terminate()
+            raise _rebuild(payload)
+    order = {p.name: i for i, p in enumerate(problems)}
+    return sorted(runs, key=lambda r: (list(planners).index(r.planner), r.seed, order[r.problem]))
+
+
+def _rebuild(payload: dict[str, Any]) -> Exception:
+    """Return the error a worker reported, as the moveplan error class of its exit code."""
+    by_code: dict[int, type[MoveplanError]] = {2: UsageError, 3: InputError, 4: NoPlan}
+    if payload["exit_code"] in by_code:
+        return by_code[payload["exit_code"]](payload["message"])
+    return RuntimeError(f"benchmark worker failed: {payload['message']}\n{payload['traceback']}")
+
+
+def _worker(robot: Path, problems: tuple[Problem, ...], planner: str, seed: int, planning_time: float,
+            results: Any) -> None:
+    """Run every problem with one planner and seed, and put each run on `results`."""
+    key = (planner, seed)
+    try:
+        from ..config.robot_config import load_robot_config
+
+        config = load_robot_config(robot)
+        for problem in problems:
+            results.put(("run", key, asdict(_solve(problem, config, planner, seed, planning_time))))
+    except Exception as exc:  # noqa: BLE001 - reported to the parent, which raises it there
+        results.put(("error", key, {"exit_code": getattr(exc, "exit_code", 1), "message": str(exc),
+                                    "traceback": traceback.format_exc()}))
+        return
+    results.put(("done", key, None))
+
+
+def _solve(problem: Problem, config: Any, planner: str, seed: int, planning_time: float) -> Run:
+    """Return the run of one problem; a problem with no plan is a failed run, bad input an error."""
+    from ..config.tasks import load_task
+    from . import plan as pipeline
+
+    flags = {"robot": config.root, "scene": problem.scene, "request": problem.request, "planner": planner,
+             "planning_time": planning_time, "seed": seed}
+    request = pipeline.resolve_request(load_task(problem.task) if problem.task else None, flags)
+    where = {"problem": problem.name, "scenario": problem.scenario, "planner": planner, "seed": seed}
+    try:
+        plan = pipeline.plan(request, config=config, exact_check=True)
+    except NoPlan as exc:
+        return Run(**where, ok=False, error=str(exc))
+    steps = [step.stats for step in plan.steps]
+
+    def total(key: str) -> float:
+        return float(sum(s.get(key, 0.0) for s in steps))
+
+    stages = {"search_s": total("plan_s"), "simplify_s": total("simplify_s"), "certify_s": total("certify_s"),
+              "timing_s": total("timing_s")}
+    return Run(
+        **where, ok=True, **stages, total_s=sum(stages.values()),
+        planning_time_s=sum(s.planning_time_s for s in plan.steps), checks=int(total("checks")),
+        path_length=total("path_length"), duration_s=sum(s.trajectory.duration_s for s in plan.steps),
+        exact_valid=all(s.get("exact_valid") == 1.0 for s in steps),
+    )
+
+
+def summarize(runs: Iterable[Run]) -> list[dict[str, Any]]:
+    """Return one row per (scenario, planner) and one per planner over all scenarios, with the statistics."""
+    runs = list(runs)
+    groups: dict[tuple[str, str], list[Run]] = {}
+    for run in runs:
+        groups.setdefault((run.scenario, run.planner), []).append(run)
+        groups.setdefault(("all", run.planner), []).append(run)
+    rows = []
+    for (scenario, planner), members in groups.items():
+        ok = [r for r in members if r.ok]
+
+        def stat(field: str, q: float, ok: list[Run] = ok) -> float | None:
+            values = [getattr(r, field) for r in ok]
+            return float(np.percentile(values, q)) if values else None
+
+        row: dict[str, Any] = {
+            "scenario": scenario, "planner": planner, "runs": len(members), "succeeded": len(ok),
+            "success_rate": len(ok) / len(members)}
+        for stage in STAGES:
+            row[f"{stage}_median_s"], row[f"{stage}_p95_s"] = stat(f"{stage}_s", 50), stat(f"{stage}_s", 95)
+        rows.append({
+            **row,
+            "path_length_median": stat("path_length", 50), "duration_median_s": stat("duration_s", 50),
+            "exact_valid": sum(1 for r in ok if r.exact_valid),
+        })
+    return rows
+
+
+def write_csv(runs: Iterable[Run], path: Path) -> None:
+    """Write one CSV row per run to `path` (through a temporary file, so a failure leaves none)."""
+    fields = list(Run.__dataclass_fields__)
+    partial = path.with_name(path.name + ".partial")
+    with partial.open("w", newline="") as stream:
+        writer = csv.DictWriter(stream, fieldnames=fields)
+        writer.writeheader()
+        for run in runs:
+            writer.writerow(run.as_dict())
+    partial.replace(path)
+
+
+def plot(runs: Iterable[Run], path: Path) -> None:
+    """Write a PNG of the distributions of search and total times, one panel per scenario."""
+    import matplotlib
+
+    matplotlib.use("Agg")  # files only; never a window
+    from matplotlib import pyplot
+
+    runs = list(runs)
+    scenarios = sorted({r.scenario for r in runs})
+    planners = list(dict.fromkeys(r.planner for r in runs))
+    figure, axes = pyplot.subplots(1, len(scenarios), figsize=(5 * len(scenarios), 4), squeeze=False)
+    for axis, scenario in zip(axes[0], scenarios, strict=True):
+        for index, planner in enumerate(planners):
+            ok = [r for r in runs if r.scenario == scenario and r.planner == planner and r.ok]
+            total = len([r for r in runs if r.scenario == scenario and r.planner == planner])
+            color = f"C{index}"
+            for field, style in (("search_s", "--"), ("total_s", "-")):
+                values = np.sort([getattr(r, field) * 1e3 for r in ok])
+                if len(values):
+                    # A cumulative distribution over all runs: a failed run never reaches the top.
+                    axis.step(values, np.arange(1, len(values) + 1) / total, style, color=color, where="post",
+                              label=f"{planner} {'search' if field == 'search_s' else 'total'}")
+        axis.set_xscale("log")
+        axis.set_ylim(0.0, 1.02)
+        axis.set_xlabel("time [ms]")
+        axis.set_ylabel("fraction of runs solved")
+        axis.set_title(scenario)
+        axis.grid(True, which="both", alpha=0.3)
+        axis.legend(fontsize="small", loc="lower right")
+    figure.tight_layout()
+    partial = path.with_name(path.name + ".partial.png")
+    figure.savefig(partial, dpi=100)
+    pyplot.close(figure)
+    partial.replace(path)

@@ -1,0 +1,122 @@
+"""Goals: turn a step's goal into target joint values for the planning group.
+
+Joint goals may be complete (one value per group joint, in group order) or
+partial (joint: value; the others keep their start values). Named goals are
+SRDF group_states. Every target is checked against the joint limits.
+
+Pose and shift goals become a pose of the tip link in the planning frame,
+evaluated with the robot where the step starts (frames on moving links move).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from ..errors import ConfigError, GoalOutsideLimits, UnknownName, UsageError
+from ..model.robot import Robot
+from ..model.scene import Scene, pose_matrix
+
+__all__ = ["check_limits", "joint_target", "named_state", "pose_error", "tip_target"]
+
+# Goals written at a limit by hand ("3.14" for pi) must not fail on rounding.
+_LIMIT_SLACK = 1e-6
+
+
+def named_state(robot: Robot, name: str, start: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Return group values of an SRDF group_state; joints it leaves out keep their `start` value."""
+    states = robot.config.srdf.group_states.get(robot.group.name, {})
+    if name not in states:
+        raise UnknownName("named state", name, f"group '{robot.group.name}' of {robot.config.srdf_path}", states)
+    return _apply(robot, states[name], start, f"{robot.config.srdf_path} group_state '{name}'")
+
+
+def joint_target(robot: Robot, goal: dict[str, Any], start: NDArray[np.float64], source: str) -> NDArray[np.float64]:
+    """Return the group values a joints or named goal asks for, checked against the limits."""
+    if "named" in goal:
+        target = named_state(robot, goal["named"], start)
+    else:
+        joints = goal["joints"]
+        if isinstance(joints, dict):
+            target = _apply(robot, joints, start, source)
+        else:
+            if len(joints) != robot.dof:
+                # A count that does not fit is a malformed flag (exit 2) or a malformed file (exit 3).
+                error = UsageError if source.startswith("--") else ConfigError
+                raise error(
+                    f"{source}: joint goal has {len(joints)} values; group '{robot.group.name}' has "
+                    f"{robot.dof} joints: {', '.join(robot.joint_names)}"
+                )
+            target = np.array(joints, dtype=float)
+    check_limits(robot, target)
+    return target
+
+
+def check_limits(robot: Robot, values: NDArray[np.float64]) -> None:
+    """Raise GoalOutsideLimits for the first joint outside its position limits."""
+    for i, joint in enumerate(robot.joint_names):
+        if robot.continuous[i]:
+            continue
+        if not robot.lower[i] - _LIMIT_SLACK <= values[i] <= robot.upper[i] + _LIMIT_SLACK:
+            raise GoalOutsideLimits(joint, float(values[i]), float(robot.lower[i]), float(robot.upper[i]))
+
+
+def _apply(robot: Robot, values: dict[str, float], start: NDArray[np.float64], source: str) -> NDArray[np.float64]:
+    target = start.copy()
+    for joint, value in values.items():
+        if joint not in robot.joint_names:
+            raise UnknownName("joint", joint, f"group '{robot.group.name}' ({source})", robot.joint_names)
+        target[robot.joint_names.index(joint)] = value
+    return target
+
+
+def tip_target(
+    robot: Robot, scene: Scene, goal: dict[str, Any], q: NDArray[np.float64], source: str
+) -> tuple[str, NDArray[np.float64]]:
+    """Return (link, `root_T_link`) that a pose or shift goal asks for, from configuration `q`."""
+    if "pose" in goal:
+        pose = goal["pose"]
+        link = pose.get("link") or robot.group.tip
+        frame = pose.get("frame") or robot.root_link
+        anchor, anchor_T_frame = scene.anchor(frame, robot)
+        root_T_frame = robot.frame_pose(q, anchor) @ anchor_T_frame
+        # What the pose leaves out is the frame's own: no offset, no rotation.
+        return link, root_T_frame @ pose_matrix(pose["xyz"], pose.get("rpy"), pose.get("quat"), source)
+    return robot.group.tip, _shifted(robot, scene, goal["shift"], q)
+
+
+def _shifted(robot: Robot, scene: Scene, shift: dict[str, Any], q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Return the tip pose moved by `shift` from where it is in `q`."""
+    now = robot.frame_pose(q, robot.group.tip)
+    t = np.array([shift.get(a, 0.0) for a in ("x", "y", "z")])
+    rpy = np.array([shift.get(a, 0.0) for a in ("roll", "pitch", "yaw")])
+    delta = pose_matrix(list(t), list(rpy), None, "shift")
+    frame = shift.get("frame", "tool")
+    if frame == "tool":
+        return now @ delta
+    goal = now.copy()
+    if frame == "moveit":
+        # MoveGroupCommander.shift_pose_target: add to [x, y, z, roll, pitch, yaw] of the
+        # pose in the planning frame, angles as fixed-axis (sxyz) Euler angles.
+        goal[:3, 3] += t
+        goal[:3, :3] = pin.rpy.rpyToMatrix(*(pin.rpy.matrixToRpy(now[:3, :3]) + rpy))
+        return goal
+    if frame in ("base", "planning"):
+        axes = np.eye(3)
+    else:
+        anchor, anchor_T_frame = scene.anchor(frame, robot)
+        axes = (robot.frame_pose(q, anchor) @ anchor_T_frame)[:3, :3]
+    # Along and about the frame's axes, turning about the tip's own position.
+    goal[:3, 3] += axes @ t
+    goal[:3, :3] = axes @ delta[:3, :3] @ axes.T @ now[:3, :3]
+    return goal
+
+
+def pose_error(reached: NDArray[np.float64], target: NDArray[np.float64]) -> tuple[float, float]:
+    """Return the distance in [m] and rotation angle in [rad] between two poses."""
+    rotation = reached[:3, :3].T @ target[:3, :3]
+    angle = float(np.arccos(np.clip((np.trace(rotation) - 1.0) / 2.0, -1.0, 1.0)))
+    return float(np.linalg.norm(reached[:3, 3] - target[:3, 3])), angle

@@ -1,0 +1,256 @@
+"""Joint-space path planning with OMPL's geometric planners.
+
+The planner sees the group's joint values in a box of joint limits. States and
+whole edges are checked by the caller's `Validity` (one call per edge, so the
+caller can check all its states in one batch). The straight segment from start
+to goal is tried first; a searched path is shortened by OMPL's rope shortcutting
+under the same checks.
+
+A search is bounded by work, not by the clock: it may check a number of motions
+(states and edges) proportional to its planning time, so the same seed gives the same
+path on any machine under any load. The planning time itself is kept as a wall-clock
+safety cap: a search that reaches it before its budget fails and says so.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from operator import itemgetter
+
+import numpy as np
+from numpy.typing import NDArray
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from ..config.planners import PLANNERS
+from ..errors import PlanningFailed, UsageError, known
+from ..types import frozen_array
+
+__all__ = ["PLANNERS", "PathResult", "Validity", "plan_path", "repair_path", "seed_planner"]
+
+logger = logging.getLogger(__name__)
+ou.setLogLevel(ou.LOG_ERROR)
+
+
+_RANGE_RAD = 1.0  # the longest edge a tree-growing planner adds in one step
+# RRTConnect grows each tree by whole edges of up to a range toward uniform samples. From a goal deep
+# in a shelf almost none is free (MotionBenchMaker bookshelf 0093: 0 of 1,000 at 1 rad, 11 % at
+# 0.1 rad), so the goal tree stays at 2-11 states while the start tree grows to thousands, and no
+# range, intermediate states or mesh checks fix that within 1 s. LBKPIECE1 expands from the least
+# explored cells and checks edges only on candidate paths: it solves those goals in tens of ms.
+# RRTConnect searches alone for the first part of the budget, where it solves all but such
+# problems; LBKPIECE1 then searches on.
+_FALLBACK = {"RRTConnect": "LBKPIECE1"}
+_FALLBACK_AFTER = 0.2  # of the search's budget
+# Checked motions a search may spend per second of planning time. A Panda search among
+# MotionBenchMaker obstacles checks 30,000-75,000 a second on one core of a 2-core machine, so
+# its budget is spent in under half the planning time quiet; a robot without a sphere filter
+# checks fewer, and reaches the wall-clock cap first. A path found is the same either way:
+# the clock only decides whether the search is cut short.
+_CHECKS_PER_S = 20_000
+def seed_planner(seed: int) -> None:
+    """Seed OMPL's process-wide generator of seeds: every planner, sampler and simplifier made after draws from it."""
+    # OMPL logs an error when it is reseeded after first use, yet reseeds. Each search makes its
+    # planner, sampler and simplifier anew, so a plan seeded first draws from `seed` alone,
+    # whatever ran in the process before it. OMPL's seeds are 32-bit and never 0.
+    ou.setLogLevel(ou.LOG_NONE)
+    ou.RNG.setSeed(seed % (2**32 - 1) + 1)
+    ou.setLogLevel(ou.LOG_ERROR)
+
+
+@dataclass(frozen=True)
+class Validity:
+    """The search's collision checks on group joint values: one state, and the straight edge between two."""
+
+    state_free: Callable[[NDArray[np.float64]], bool]
+    edge_free: Callable[[NDArray[np.float64], NDArray[np.float64]], bool]
+
+
+@dataclass(frozen=True)
+class PathResult:
+    """A collision-free joint-space path and how it was found.
+
+    Attributes:
+        waypoints: Path vertices, shape (K, dof), first = start, last = goal.
+        planner: The OMPL planner's name.
+        planning_s: Wall time of the search in [s].
+        simplify_s: Wall time of simplification in [s].
+        checks: Motions (states and edges) the search checked.
+    """
+
+    waypoints: NDArray[np.float64]
+    planner: str
+    planning_s: float
+    simplify_s: float
+    checks: int = 0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "waypoints", frozen_array(self.waypoints, (None, None), "waypoints"))
+
+
+class _Work:
+    """The checked motions a search has spent against its budget, and its wall-clock cap."""
+
+    def __init__(self, time_s: float) -> None:
+        self.time_s = time_s
+        self.budget = max(1, math.ceil(time_s * _CHECKS_PER_S))
+        self.deadline = time.perf_counter() + time_s
+        self.used = 0
+
+    def until(self, checks: int) -> ob.PlannerTerminationCondition:
+        """Return OMPL's condition that ends a search after `checks` motions in all, or at the cap."""
+        return ob.PlannerTerminationCondition(lambda: self.used >= checks or self.out_of_time())
+
+    def out_of_time(self) -> bool:
+        """Return True once the wall-clock cap is reached."""
+        return time.perf_counter() > self.deadline
+
+    def failure(self, planner: str, status: object) -> PlanningFailed:
+        """Return the error for a search that found no path, naming what ended it."""
+        if self.used < self.budget and self.out_of_time():
+            return PlanningFailed(
+                f"{planner} reached the planning time cap of {self.time_s:g} s after {self.used} of its "
+                f"{self.budget} checked motions; the machine is slower or busier than the budget assumes: "
+                "raise --planning-time")
+        return PlanningFailed(f"{planner} found no path within {self.budget} checked motions "
+                              f"({self.time_s:g} s of planning time) ({status})")
+
+
+def plan_path(
+    start: NDArray[np.float64],
+    goal: NDArray[np.float64],
+    lower: NDArray[np.float64],
+    upper: NDArray[np.float64],
+    validity: Validity,
+    planner: str = "RRTConnect",
+    time_s: float = 1.0,
+) -> PathResult:
+    """Return a collision-free path from `start` to `goal`, both given as group joint values.
+
+    The search may check `time_s` x 20,000 motions; it fails when those find no path, or
+    when `time_s` seconds of wall time pass first.
+    """
+    if planner not in PLANNERS:
+        raise UsageError(f"unknown planner '{planner}'; OMPL geometric planners: {known(PLANNERS)}")
+    return _plan(start, goal, lower, upper, validity, planner, _Work(time_s))
+
+
+def repair_path(
+    waypoints: NDArray[np.float64],
+    lower: NDArray[np.float64],
+    upper: NDArray[np.float64],
+    validity: Validity,
+    planner: str,
+    time_s: float,
+) -> PathResult:
+    """Return `waypoints` with each segment `validity` rejects replaced by a path searched between its ends.
+
+    Raises PlanningFailed when a waypoint is not free (a shortcut can put one between two
+    checked states of an edge), or a segment's search finds no path within what remains of the
+    budget of `time_s`.
+    """
+    began = time.perf_counter()
+    work = _Work(time_s)
+    pieces, simplify_s, used = [waypoints[:1]], 0.0, planner
+    for a, b in zip(waypoints[:-1], waypoints[1:], strict=True):
+        if validity.edge_free(a, b):
+            pieces.append(b[None, :])
+            continue
+        if not validity.state_free(b):
+            raise PlanningFailed("a waypoint of the path collides")
+        detour = _plan(a, b, lower, upper, validity, planner, work)
+        pieces.append(detour.waypoints[1:])
+        simplify_s += detour.simplify_s
+        if detour.planner != planner:
+            used = detour.planner  # the fallback found this detour
+    return PathResult(np.concatenate(pieces), used, time.perf_counter() - began - simplify_s, simplify_s, work.used)
+
+
+def _planner(name: str, info: ob.SpaceInformation) -> ob.Planner:
+    """Return OMPL planner `name` on `info`, its range (if it has one) set."""
+    search = getattr(og, name)(info)
+    if hasattr(search, "setRange"):
+        # OMPL's default, a fifth of the space's diagonal (2.4 rad for a Panda), fails more often
+        # in clutter: 5 of 60 MotionBenchMaker bookshelf runs in 1 s, against 1 with 1 rad, which
+        # is as fast or faster on the box and table scenes too.
+        search.setRange(_RANGE_RAD)
+    return search
+
+
+def _plan(
+    start: NDArray[np.float64],
+    goal: NDArray[np.float64],
+    lower: NDArray[np.float64],
+    upper: NDArray[np.float64],
+    validity: Validity,
+    planner: str,
+    work: _Work,
+) -> PathResult:
+    dof = len(start)
+    space = ob.RealVectorStateSpace(dof)
+    bounds = ob.RealVectorBounds(dof)
+    for i in range(dof):
+        bounds.setLow(i, float(lower[i]))
+        bounds.setHigh(i, float(upper[i]))
+    space.setBounds(bounds)
+    setup = og.SimpleSetup(space)
+
+    coordinates = itemgetter(*range(dof))  # a tenth of the cost of indexing in a Python loop
+
+    def values(state: ob.State) -> NDArray[np.float64]:
+        return np.array(coordinates(state), ndmin=1)
+
+    def state_free(state: ob.State) -> bool:
+        work.used += 1
+        return validity.state_free(values(state))
+
+    setup.setStateValidityChecker(state_free)
+
+    class EdgeValidator(ob.MotionValidator):  # type: ignore[misc]
+        """Checks a whole edge in one call."""
+
+        def checkMotion(self, s1: ob.State, s2: ob.State, *rest: object) -> bool:  # noqa: N802 - OMPL's name
+            work.used += 1
+            return validity.edge_free(values(s1), values(s2))
+
+    info = setup.getSpaceInformation()
+    info.setMotionValidator(EdgeValidator(info))
+    endpoints = []
+    for point in (start, goal):
+        state = space.allocState()
+        for i, value in enumerate(point):
+            state[i] = float(value)
+        endpoints.append(state)
+    setup.setStartAndGoalStates(endpoints[0], endpoints[1])
+    setup.setPlanner(_planner(planner, info))
+
+    began, spent_before = time.perf_counter(), work.used
+    work.used += 1
+    if validity.edge_free(start, goal):
+        # A free straight segment is what any search plus shortcutting converges to.
+        return PathResult(np.array([start, goal]), planner, time.perf_counter() - began, 0.0, 1)
+    fallback = _FALLBACK.get(planner)
+    first_share = work.used + math.ceil((work.budget - work.used) * _FALLBACK_AFTER) if fallback else work.budget
+    status = setup.solve(work.until(first_share))
+    if fallback and not setup.haveExactSolutionPath() and not work.out_of_time():
+        setup.getProblemDefinition().clearSolutionPaths()  # RRTConnect's approximate one
+        setup.setPlanner(_planner(fallback, info))
+        planner = f"{planner}+{fallback}"
+        status = setup.solve(work.until(work.budget))
+    planning_s = time.perf_counter() - began
+    if not setup.haveExactSolutionPath():
+        raise work.failure(planner, status)
+    began = time.perf_counter()
+    path = setup.getSolutionPath()
+    # Rope shortcutting (OMPL 2.0) reaches the quality of the full simplify() on MotionBenchMaker
+    # problems with about a tenth of its edge checks.
+    og.PathSimplifier(info).ropeShortcutPath(path)
+    waypoints = np.array([values(path.getState(k)) for k in range(path.getStateCount())])
+    simplify_s = time.perf_counter() - began
+    waypoints[0], waypoints[-1] = start, goal
+    return PathResult(waypoints, planner, planning_s, simplify_s, work.used - spent_before)
