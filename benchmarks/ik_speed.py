@@ -27,7 +27,7 @@ from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import GoalUnreachable
 from moveplan.core.model.kinematics import solve_ik
 from moveplan.core.model.robot import Robot
-from moveplan.core.model.scene import load_scene
+from moveplan.core.model.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 HOME = np.array([0.0, -np.pi / 2, -np.pi / 2, 0.0, 0.0, 0.0])

@@ -37,7 +37,7 @@ from moveplan.core.bag.recording import read_plan
 from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.model.robot import Robot
-from moveplan.core.model.scene import load_scene
+from moveplan.core.model.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 PANDA = ROOT / "configs" / "panda"

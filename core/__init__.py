@@ -1,0 +1,1 @@
+"""moveplan's library: the domain in districts, each owning one concern (see the README's Layout)."""

@@ -13,7 +13,7 @@ from rosbags.highlevel import AnyReader
 from moveplan.core.bag.recording import read_plan
 from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.model.robot import Robot
-from moveplan.core.model.scene import load_scene
+from moveplan.core.model.scene_file import load_scene
 from moveplan.core.trajectory import sample
 
 GOAL = [0.5, -1.2, -1.8, 0.0, 1.57, 0.0]

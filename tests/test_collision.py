@@ -10,7 +10,7 @@ from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import StartInCollision
 from moveplan.core.model.robot import Robot
-from moveplan.core.model.scene import load_scene
+from moveplan.core.model.scene_file import load_scene
 from moveplan.core.types import CollisionObject, Shape
 
 

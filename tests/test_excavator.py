@@ -12,7 +12,7 @@ from moveplan.core.bag.recording import PlanFile, read_plan
 from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.model.robot import Robot
-from moveplan.core.model.scene import load_scene
+from moveplan.core.model.scene_file import load_scene
 from moveplan.core.trajectory import sample
 
 EXCAVATOR = ROOT / "configs" / "excavator"

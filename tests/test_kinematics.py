@@ -18,7 +18,7 @@ from moveplan.core.config.robot_config import RobotConfig, load_robot_config
 from moveplan.core.errors import GoalUnreachable, InputError, UnknownName
 from moveplan.core.model.kinematics import IkSolution, solve_ik
 from moveplan.core.model.robot import Robot
-from moveplan.core.model.scene import load_scene
+from moveplan.core.model.scene_file import load_scene
 
 HOME = np.array([0.0, -np.pi / 2, -np.pi / 2, 0.0, 0.0, 0.0])
 # A regular configuration: away from the wrist (wrist_2 = 0), elbow and shoulder singularities.

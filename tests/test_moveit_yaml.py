@@ -19,7 +19,7 @@ from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import ConfigError, FrameNotFound
 from moveplan.core.model.moveit_request import load_motion_plan_request, planner_name
 from moveplan.core.model.robot import Robot
-from moveplan.core.model.scene import load_scene
+from moveplan.core.model.scene_file import load_scene
 
 MBM = ROOT / "tests" / "data" / "mbm"
 SCENE, REQUEST = MBM / "problems" / "box_panda" / "scene0001.yaml", MBM / "problems" / "box_panda" / "request0001.yaml"

@@ -5,14 +5,14 @@ from __future__ import annotations
 import numpy as np
 from conftest import dense_peaks
 
-from moveplan.core.pipeline.plan import _rest_to_rest
+from moveplan.core.timing import rest_to_rest
 from moveplan.core.trajectory import sample
 
 
 def test_rest_to_rest_timing_keeps_every_joint_on_the_checked_segments() -> None:
     waypoints = np.array([[0.0, 0.0, 0.0], [1.0, 0.5, 0.0], [1.0, 1.0, 1.0], [0.2, 1.0, 1.0]])
     limits_v, limits_a = np.array([1.0, 1.0, 1.0]), np.array([2.0, 2.0, 2.0])
-    trajectory = _rest_to_rest(("a", "b", "c"), waypoints, limits_v, limits_a)
+    trajectory = rest_to_rest(("a", "b", "c"), waypoints, limits_v, limits_a)
     positions, _, _ = sample(trajectory, np.linspace(0.0, trajectory.duration_s, 5000))
 
     def distance_to_path(q: np.ndarray) -> float:

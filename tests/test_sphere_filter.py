@@ -16,7 +16,7 @@ from moveplan.core.collision.sphere_filter import CLEAR, COLLIDES, SphereFilter
 from moveplan.core.collision.sphere_fit import fit_geometry, robot_spheres
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.model.robot import Robot
-from moveplan.core.model.scene import load_scene
+from moveplan.core.model.scene_file import load_scene
 
 PANDA = ROOT / "configs" / "panda"
 MBM = ROOT / "tests" / "data" / "mbm"

@@ -14,7 +14,7 @@ from typing import Any
 import numba
 import numpy as np
 
-from .sphere_filter import CLEAR, COLLIDES, MAYBE
+from ._verdicts import CLEAR, COLLIDES, MAYBE
 
 __all__ = ["LAYOUT", "STRIDE", "classify", "edge", "pack", "tabled"]
 

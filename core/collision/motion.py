@@ -15,19 +15,25 @@ close that no point of the robot moves more than `step_m` between two of them
 
 from __future__ import annotations
 
+import logging
 from typing import Protocol
 
+import coal
 import numpy as np
 from numpy.typing import NDArray
 
+from ..errors import ConfigError
 from ..model.robot import Robot
+from ..model.scene import Scene
 from ..trajectory import interpolate
 from ..types import JointTrajectory
 from . import certify
-from .checker import CollisionChecker
-from .sphere_filter import CLEAR, COLLIDES, MAYBE
+from .checker import CollisionChecker, GeometryMode
+from .sphere_filter import CLEAR, COLLIDES, MAYBE, SphereFilter, UnsupportedJoint
 
-__all__ = ["CERTIFY_STEP_M", "MotionChecker"]
+__all__ = ["CERTIFY_STEP_M", "MotionChecker", "exact_checks", "scene_checks"]
+
+logger = logging.getLogger(__name__)
 
 CERTIFY_STEP_M = 0.005  # the most any robot point moves between two certified states [m]
 
@@ -148,3 +154,45 @@ class MotionChecker:
         """Return the names of a colliding pair at a group state, or None."""
         return self.checker.colliding_pair(self.robot.configuration(values, self.base))
 
+
+def scene_checks(robot: Robot, scene: Scene, geometry: GeometryMode, base: NDArray[np.float64]) -> MotionChecker:
+    """Return the checks of `robot` (other joints at `base`) in `scene`: `geometry`, with the stages before it.
+
+    The sphere filter clears most states first; with meshes, their convex hulls judge what
+    it leaves before the meshes do. Either stage is left out where the robot cannot have it.
+    """
+    checker = CollisionChecker(robot, scene.objects, scene.source, geometry=geometry, allowed=scene.allowed)
+    hulls = _hull_checker(robot, checker, scene)
+    return MotionChecker(robot, checker, base, _sphere_filter(robot, checker, hulls, scene, base), hulls)
+
+
+def exact_checks(checks: MotionChecker, scene: Scene) -> MotionChecker:
+    """Return checks of the same robot and scene under the URDF's exact meshes alone, as a referee."""
+    checker = checks.checker
+    if checker.mode != "exact":
+        checker = CollisionChecker(checks.robot, scene.objects, scene.source, geometry="exact", allowed=scene.allowed)
+    return MotionChecker(checks.robot, checker, checks.base)
+
+
+def _sphere_filter(
+    robot: Robot, checker: CollisionChecker, hulls: CollisionChecker | None, scene: Scene, base: NDArray[np.float64]
+) -> SphereFilter | None:
+    """Return the fast conservative pre-check for `robot` (other joints at `base`) in `scene`, or None."""
+    try:
+        return SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed, base,
+                            (hulls or checker).robot_geometry)
+    except UnsupportedJoint as exc:
+        logger.info("no sphere filter (%s): every state is checked by coal", exc)
+        return None
+
+
+def _hull_checker(robot: Robot, checker: CollisionChecker, scene: Scene) -> CollisionChecker | None:
+    """Return a checker of the robot's meshes as convex hulls in `scene` when `checker` has meshes, else None."""
+    meshes = any(isinstance(obj.geometry, coal.BVHModelBase) for obj in checker.robot_geometry.geometryObjects)
+    if checker.mode != "exact" or not meshes:
+        return None  # the hulls would be the checker's own shapes, checked twice
+    try:
+        return CollisionChecker(robot, scene.objects, scene.source, geometry="convex", allowed=scene.allowed)
+    except ConfigError as exc:
+        logger.info("no hull stage (%s): states the spheres cannot clear go to the meshes", exc)
+        return None

@@ -22,14 +22,13 @@ from numpy.typing import NDArray
 
 from ..model.robot import Robot
 from ..types import CollisionObject
+from ._verdicts import CLEAR, COLLIDES, MAYBE
 from .inner_spheres import inner_spheres
 from .pair_tables import PairTable, pair_tables
 from .sphere_fit import SphereSet, fit_shape, robot_spheres
 
 __all__ = ["CLEAR", "COLLIDES", "MAYBE", "SphereFilter", "UnsupportedJoint"]
 
-# A state's verdict: its spheres touch nothing; unsure; a convex hull (or table pair) surely touches something.
-CLEAR, MAYBE, COLLIDES = 1, 0, -1
 
 # Joint kinds the kernel knows; anything else (planar, free-flyer, ...) makes the filter unavailable.
 _REVOLUTE, _PRISMATIC, _UNBOUNDED = 1, 2, 3

@@ -1,0 +1,14 @@
+"""Robot configuration: the files a MoveIt config package holds, parsed into typed values.
+
+Everything read from a file is checked here, with the file and key in every error; the
+districts above never read a configuration file themselves.
+"""
+
+from .planners import PLANNERS
+from .robot_config import ControllerConfig, ExecutionConfig, Group, JointLimit, RobotConfig, load_robot_config
+from .tasks import StepSpec, TaskFile, load_task
+
+__all__ = [
+    "PLANNERS", "ControllerConfig", "ExecutionConfig", "Group", "JointLimit", "RobotConfig", "StepSpec", "TaskFile",
+    "load_robot_config", "load_task",
+]

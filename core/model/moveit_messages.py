@@ -15,8 +15,8 @@ from numpy.typing import NDArray
 
 from ..config.robot_config import check_keys, mapping, number
 from ..errors import ConfigError, UnknownName
+from .poses import pose_matrix
 from .robot import Robot
-from .scene import pose_matrix
 
 __all__ = [
     "header_frame",

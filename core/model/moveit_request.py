@@ -36,7 +36,7 @@ from ..config.robot_config import check_keys, load_yaml, mapping, number
 from ..config.tasks import StepSpec
 from ..errors import ConfigError, known
 from .moveit_messages import header_frame, point, pose, quaternion, robot_state, yaml_list
-from .scene import pose_matrix
+from .poses import pose_matrix
 
 __all__ = ["MotionPlanRequest", "load_motion_plan_request", "planner_name"]
 

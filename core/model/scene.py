@@ -4,28 +4,28 @@ Frames may chain and may hang off robot links. Everything is resolved to the
 planning frame (the URDF root) with the robot at its neutral configuration,
 so world objects must sit in frames that do not move with the arm.
 
-A scene file is either moveplan's own format (frames, objects, attached) or a
-moveit_msgs/PlanningScene written as YAML, which core/model/planning_scene.py reads (it places
-objects with the robot in the scene's own robot state, as MoveIt does).
+This module reads moveplan's own format (frames, objects, attached);
+core/model/planning_scene.py reads a moveit_msgs/PlanningScene written as YAML (it places
+objects with the robot in the scene's own robot state, as MoveIt does), and
+core/model/scene_file.py tells the two apart.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pinocchio as pin
 from numpy.typing import NDArray
 
-from ..config.robot_config import check_keys, load_yaml, mapping, number
+from ..config.robot_config import check_keys, mapping, number
 from ..errors import ConfigError, FrameNotFound
 from ..types import CollisionObject, Frame, Shape
+from .poses import pose_matrix, vector
 from .robot import Robot
 
-__all__ = ["PLANNING_SCENE_KEYS", "Scene", "empty_scene", "load_scene", "pose_matrix", "resolve_frames"]
+__all__ = ["PLANNING_SCENE_KEYS", "Scene", "empty_scene", "moveplan_scene", "resolve_frames"]
 
 _FRAME_KEYS = {"name", "parent", "xyz", "rpy", "quat"}
 _SHAPE_KEYS = {"box", "cylinder", "sphere", "mesh", "scale"}
@@ -74,29 +74,6 @@ def empty_scene() -> Scene:
     return Scene("(no scene)", (), (), {})
 
 
-def pose_matrix(xyz: Any, rpy: Any, quat: Any, where: str) -> NDArray[np.float64]:
-    """Return the 4x4 transform of a position and an rpy (fixed X-Y-Z) or [x, y, z, w] quaternion."""
-    transform = np.eye(4)
-    transform[:3, 3] = _vector(xyz if xyz is not None else [0, 0, 0], 3, f"{where}.xyz")
-    if rpy is not None and quat is not None:
-        raise ConfigError(f"{where}: give rpy or quat, not both")
-    if quat is not None:
-        x, y, z, w = _vector(quat, 4, f"{where}.quat")
-        norm = math.sqrt(x * x + y * y + z * z + w * w)
-        if norm < 1e-9:
-            raise ConfigError(f"{where}.quat: a quaternion [x, y, z, w] of zero norm is not a rotation")
-        transform[:3, :3] = pin.Quaternion(w / norm, x / norm, y / norm, z / norm).toRotationMatrix()
-    elif rpy is not None:
-        transform[:3, :3] = pin.rpy.rpyToMatrix(*_vector(rpy, 3, f"{where}.rpy"))
-    return transform
-
-
-def _vector(value: Any, size: int, where: str) -> NDArray[np.float64]:
-    if not isinstance(value, list | tuple) or len(value) != size:
-        raise ConfigError(f"{where}: expected a list of {size} numbers, got {value!r}")
-    return np.array([number(v, f"{where}[{i}]") for i, v in enumerate(value)])
-
-
 def _shape(entry: dict[str, Any], where: str, folder: Path) -> Shape:
     kinds = [k for k in ("box", "cylinder", "sphere", "mesh") if k in entry]
     if len(kinds) != 1:
@@ -104,7 +81,7 @@ def _shape(entry: dict[str, Any], where: str, folder: Path) -> Shape:
     kind = kinds[0]
     value = entry[kind]
     if kind == "box":
-        dims = tuple(float(v) for v in _vector(value, 3, f"{where}.box"))
+        dims = tuple(float(v) for v in vector(value, 3, f"{where}.box"))
     elif kind == "cylinder":
         cyl = mapping(value, f"{where}.cylinder")
         check_keys(cyl, {"radius", "length"}, f"{where}.cylinder")
@@ -115,22 +92,16 @@ def _shape(entry: dict[str, Any], where: str, folder: Path) -> Shape:
     else:
         if not isinstance(value, str):
             raise ConfigError(f"{where}.mesh: expected a file name, got {value!r}")
-        scale = tuple(float(v) for v in _vector(entry.get("scale", [1, 1, 1]), 3, f"{where}.scale"))
+        scale = tuple(float(v) for v in vector(entry.get("scale", [1, 1, 1]), 3, f"{where}.scale"))
         return Shape("mesh", (), str(folder / value), (scale[0], scale[1], scale[2]))
     if any(d <= 0 for d in dims):
         raise ConfigError(f"{where}.{kind}: sizes must be positive, got {list(dims)}")
     return Shape(kind, dims)
 
 
-def load_scene(path: Path, robot: Robot) -> Scene:
-    """Return the scene in a moveplan scene file or a PlanningScene YAML, resolved against `robot`'s links."""
+def moveplan_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
+    """Return the scene of a moveplan scene file's parsed `top` mapping, resolved against `robot`'s links."""
     source = str(path)
-    top = mapping(load_yaml(path), source)
-    if PLANNING_SCENE_KEYS & set(top):
-        # Imported here: moveit_scene builds on this module's helpers.
-        from .planning_scene import planning_scene
-
-        return planning_scene(top, path, robot)
     check_keys(top, {"frames", "objects", "attached"}, source)
     frames: list[Frame] = []
     for k, entry in enumerate(top.get("frames") or []):

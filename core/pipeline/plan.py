@@ -16,14 +16,11 @@ from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
-import coal
 import numpy as np
 from numpy.typing import NDArray
 
 from ..bag import recording
-from ..collision.checker import CollisionChecker
-from ..collision.motion import MotionChecker
-from ..collision.sphere_filter import SphereFilter, UnsupportedJoint
+from ..collision.motion import MotionChecker, exact_checks, scene_checks
 from ..config.robot_config import RobotConfig, load_robot_config
 from ..config.tasks import StepSpec, TaskFile
 from ..errors import (
@@ -39,11 +36,12 @@ from ..model.kinematics import solve_ik
 from ..model.moveit_messages import known_joints
 from ..model.moveit_request import MotionPlanRequest, load_motion_plan_request
 from ..model.robot import Robot
-from ..model.scene import Scene, empty_scene, load_scene
+from ..model.scene import Scene, empty_scene
+from ..model.scene_file import load_scene
 from ..planning.cartesian import straight_line
 from ..planning.goals import check_limits, joint_target, pose_error, tip_target
 from ..planning.search import PathResult, Validity, plan_path, repair_path, seed_planner
-from ..timing.parameterize import time_parameterize
+from ..timing import rest_to_rest, time_parameterize
 from ..trajectory import sample
 from ..types import JointTrajectory, Plan, StepResult, TfSamples
 
@@ -155,11 +153,8 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
         raise ConfigError(f"{config.root}: no acceleration limit for joints {', '.join(missing)} "
                           "(joint_limits.yaml: has_acceleration_limits, max_acceleration)")
     scene = load_scene(request.scene, robot) if request.scene else empty_scene()
-    checker = CollisionChecker(robot, scene.objects, scene.source, geometry=config.planning["collision"],
-                               allowed=scene.allowed)
     base, current = _start_values(request, robot, scene)
-    hulls = _hull_checker(robot, checker, scene)
-    checks = MotionChecker(robot, checker, base, _sphere_filter(robot, checker, hulls, scene, base), hulls)
+    checks = scene_checks(robot, scene, config.planning["collision"], base)
     pair = checks.colliding_pair(current)
     if pair:
         raise StartInCollision(pair)
@@ -173,9 +168,7 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
         steps.append(step)
         current = step.trajectory.positions[-1].copy()
     if exact_check:
-        exact = checker if checker.mode == "exact" else CollisionChecker(
-            robot, scene.objects, scene.source, geometry="exact", allowed=scene.allowed)
-        referee = MotionChecker(robot, exact, base)
+        referee = exact_checks(checks, scene)
         for step in steps:
             step.stats["exact_valid"] = float(referee.first_collision_on_trajectory(step.trajectory) is None)
     return Plan(
@@ -195,30 +188,6 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
         metadata={"seed": str(request.seed), "moveplan_version": version("moveplan"),
                   "planners": ",".join(s.planner for s in steps)},
     )
-
-
-def _sphere_filter(
-    robot: Robot, checker: CollisionChecker, hulls: CollisionChecker | None, scene: Scene, base: NDArray[np.float64]
-) -> SphereFilter | None:
-    """Return the fast conservative pre-check for `robot` (other joints at `base`) in `scene`, or None."""
-    try:
-        return SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed, base,
-                            (hulls or checker).robot_geometry)
-    except UnsupportedJoint as exc:
-        logger.info("no sphere filter (%s): every state is checked by coal", exc)
-        return None
-
-
-def _hull_checker(robot: Robot, checker: CollisionChecker, scene: Scene) -> CollisionChecker | None:
-    """Return a checker of the robot's meshes as convex hulls in `scene` when `checker` has meshes, else None."""
-    meshes = any(isinstance(obj.geometry, coal.BVHModelBase) for obj in checker.robot_geometry.geometryObjects)
-    if checker.mode != "exact" or not meshes:
-        return None  # the hulls would be the checker's own shapes, checked twice
-    try:
-        return CollisionChecker(robot, scene.objects, scene.source, geometry="convex", allowed=scene.allowed)
-    except ConfigError as exc:
-        logger.info("no hull stage (%s): states the spheres cannot clear go to the meshes", exc)
-        return None
 
 
 def _in_step(exc: Exception, step: str) -> Exception:
@@ -343,7 +312,7 @@ def _plan_step(
         # the straight segments exactly; certify those segments.
         path = search(Validity(checks.state_free, checks.edge_free_certified))
         mark = time.perf_counter()
-        trajectory = _rest_to_rest(robot.joint_names, path.waypoints, max_velocity, max_acceleration)
+        trajectory = rest_to_rest(robot.joint_names, path.waypoints, max_velocity, max_acceleration)
         timed = time.perf_counter()
         hit = checks.first_collision_on_path(path.waypoints)
         _add(stats, path, timed - mark, time.perf_counter() - timed)
@@ -380,27 +349,6 @@ def _add(stats: dict[str, float], path: PathResult, timing_s: float, certify_s: 
     stats["timing_s"] += timing_s
     stats["certify_s"] += certify_s
     stats["checks"] += path.checks
-
-
-def _rest_to_rest(
-    joint_names: tuple[str, ...],
-    waypoints: NDArray[np.float64],
-    max_velocity: NDArray[np.float64],
-    max_acceleration: NDArray[np.float64],
-) -> JointTrajectory:
-    """Return a trajectory that stops at every waypoint, each segment timed on its own straight line."""
-    segments = [time_parameterize(joint_names, waypoints[k : k + 2], max_velocity, max_acceleration)
-                for k in range(len(waypoints) - 1)]
-    segments = [s for s in segments if len(s.times_s) > 1] or segments[:1]
-    times, rows = [segments[0].times_s], [segments[0]]
-    for segment in segments[1:]:
-        # Consecutive segments share their joining point; keep it once, at the end of the first.
-        times.append(times[-1][-1] + segment.times_s[1:])
-        rows.append(segment)
-    first = [rows[0].positions, rows[0].velocities, rows[0].accelerations]
-    rest = [[r.positions[1:], r.velocities[1:], r.accelerations[1:]] for r in rows[1:]]
-    columns = [np.concatenate([first[i], *(r[i] for r in rest)]) for i in range(3)]
-    return JointTrajectory(joint_names, np.round(np.concatenate(times) * 1e9) / 1e9, *columns)
 
 
 def _describe(goal: dict[str, Any]) -> dict[str, Any]:

@@ -17,8 +17,9 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ..errors import ConfigError, GoalOutsideLimits, UnknownName, UsageError
+from ..model.poses import pose_matrix
 from ..model.robot import Robot
-from ..model.scene import Scene, pose_matrix
+from ..model.scene import Scene
 
 __all__ = ["check_limits", "joint_target", "named_state", "pose_error", "tip_target"]
 

@@ -31,7 +31,7 @@ from ..types import JointTrajectory, frozen_array
 from .blends import BlendedPath, blended_path
 from .topp import SpeedProfile, fastest_speeds
 
-__all__ = ["time_parameterize"]
+__all__ = ["rest_to_rest", "time_parameterize"]
 
 logger = logging.getLogger(__name__)
 
@@ -202,3 +202,24 @@ def _sampled(
     positions[0], positions[-1] = ends
     velocities[0] = velocities[-1] = accelerations[0] = accelerations[-1] = 0.0
     return positions, velocities, accelerations
+
+
+def rest_to_rest(
+    joint_names: tuple[str, ...],
+    waypoints: NDArray[np.float64],
+    max_velocity: NDArray[np.float64],
+    max_acceleration: NDArray[np.float64],
+) -> JointTrajectory:
+    """Return a trajectory that stops at every waypoint, each segment timed on its own straight line."""
+    segments = [time_parameterize(joint_names, waypoints[k : k + 2], max_velocity, max_acceleration)
+                for k in range(len(waypoints) - 1)]
+    segments = [s for s in segments if len(s.times_s) > 1] or segments[:1]
+    times, rows = [segments[0].times_s], [segments[0]]
+    for segment in segments[1:]:
+        # Consecutive segments share their joining point; keep it once, at the end of the first.
+        times.append(times[-1][-1] + segment.times_s[1:])
+        rows.append(segment)
+    first = [rows[0].positions, rows[0].velocities, rows[0].accelerations]
+    rest = [[r.positions[1:], r.velocities[1:], r.accelerations[1:]] for r in rows[1:]]
+    columns = [np.concatenate([first[i], *(r[i] for r in rest)]) for i in range(3)]
+    return JointTrajectory(joint_names, np.round(np.concatenate(times) * 1e9) / 1e9, *columns)

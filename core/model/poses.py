@@ -1,0 +1,39 @@
+"""Poses and number lists as scene, request and MoveIt message files give them, checked where they are read."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from ..config.robot_config import number
+from ..errors import ConfigError
+
+__all__ = ["pose_matrix", "vector"]
+
+
+def pose_matrix(xyz: Any, rpy: Any, quat: Any, where: str) -> NDArray[np.float64]:
+    """Return the 4x4 transform of a position and an rpy (fixed X-Y-Z) or [x, y, z, w] quaternion."""
+    transform = np.eye(4)
+    transform[:3, 3] = vector(xyz if xyz is not None else [0, 0, 0], 3, f"{where}.xyz")
+    if rpy is not None and quat is not None:
+        raise ConfigError(f"{where}: give rpy or quat, not both")
+    if quat is not None:
+        x, y, z, w = vector(quat, 4, f"{where}.quat")
+        norm = math.sqrt(x * x + y * y + z * z + w * w)
+        if norm < 1e-9:
+            raise ConfigError(f"{where}.quat: a quaternion [x, y, z, w] of zero norm is not a rotation")
+        transform[:3, :3] = pin.Quaternion(w / norm, x / norm, y / norm, z / norm).toRotationMatrix()
+    elif rpy is not None:
+        transform[:3, :3] = pin.rpy.rpyToMatrix(*vector(rpy, 3, f"{where}.rpy"))
+    return transform
+
+
+def vector(value: Any, size: int, where: str) -> NDArray[np.float64]:
+    """Return a list of `size` numbers from a YAML file as an array; `where` names it in errors."""
+    if not isinstance(value, list | tuple) or len(value) != size:
+        raise ConfigError(f"{where}: expected a list of {size} numbers, got {value!r}")
+    return np.array([number(v, f"{where}[{i}]") for i, v in enumerate(value)])
