@@ -28,8 +28,8 @@ from mcap.writer import CompressionType, Writer
 from numpy.typing import NDArray
 
 from moveplan.core.bag.jointstates import JOINT_STATE_TYPE, encode_joint_states
-from moveplan.core.bag.recording import PlanStepRecord
-from moveplan.core.config.robot_config import ControllerConfig, ExecutionConfig
+from moveplan.core.bag.plan_file import PlanStepRecord
+from moveplan.core.config.controllers import ControllerConfig, ExecutionConfig
 from moveplan.core.trajectory import sample
 from moveplan.core.types import JointTrajectory
 

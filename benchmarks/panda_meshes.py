@@ -33,7 +33,7 @@ import numpy as np
 import yaml
 from numpy.typing import NDArray
 
-from moveplan.core.bag.recording import read_plan
+from moveplan.core.bag.plan_file import read_plan
 from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.model.robot import Robot

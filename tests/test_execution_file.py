@@ -1,4 +1,4 @@
-"""Executed files from report.write_execution, checked by rosbags and the generic encoder."""
+"""Executed files from report.write_execution, checked by rosbags and the reference encoder (mcap_ros2)."""
 
 from __future__ import annotations
 
@@ -14,22 +14,26 @@ import mcap.writer
 import numpy as np
 import pytest
 from mcap.reader import make_reader
-from mcap_ros2._dynamic import serialize_dynamic
+from reference_cdr import reference_cdr
 from rosbags.highlevel import AnyReader
 from rosbags.interfaces import ConnectionExtRosbag2, QosDurability
 
 from moveplan.core.bag import messages as msgs
-from moveplan.core.bag import recording
+from moveplan.core.bag.execution_file import EXECUTION_RESULT_TOPIC
 from moveplan.core.bag.jointstate_cdr import encode_joint_states
-from moveplan.core.config.robot_config import ControllerConfig, ExecutionConfig
+from moveplan.core.bag.message_cdr import controller_states_cdr
+from moveplan.core.bag.plan_file import PlanFile, read_plan
+from moveplan.core.bag.plan_writer import write_plan
+from moveplan.core.bag.summary import summarize
+from moveplan.core.config.controllers import ControllerConfig, ExecutionConfig
 from moveplan.core.control.controller import ExecutionReport, simulate
 from moveplan.core.control.plants import FrozenPlant, MirrorPlant, make_plant
 from moveplan.core.control.published import controller_states
-from moveplan.core.control.tolerances import Violation
+from moveplan.core.control.results import Violation
 from moveplan.core.errors import InputError, UsageError
 from moveplan.core.pipeline.execute import PlanExecution, StepExecution
-from moveplan.core.pipeline.report import write_execution
-from moveplan.core.types import JointTrajectory, Plan, StepResult, TfSamples
+from moveplan.core.pipeline.report import execution_document, write_execution
+from moveplan.core.types import ControllerStates, JointTrajectory, Plan, PointSeries, StepResult, TfSamples
 
 DISTROS = sorted(
     entry.name
@@ -38,7 +42,7 @@ DISTROS = sorted(
 )
 JOINTS = ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint")
 STATE_TOPIC = "/joint_trajectory_controller/controller_state"
-RESULT_TOPIC = recording.EXECUTION_RESULT_TOPIC
+RESULT_TOPIC = EXECUTION_RESULT_TOPIC
 JOINT_STATE = "sensor_msgs/msg/JointState"
 CONTROLLER_STATE = "control_msgs/msg/JointTrajectoryControllerState"
 URDF = "<robot name='threelink'><link name='base_link'/></robot>"
@@ -73,8 +77,8 @@ def minimum_jerk(
     )
 
 
-def plan_file(urdf: str = URDF, attachments: dict[str, bytes] | None = None) -> recording.PlanFile:
-    return recording.PlanFile(
+def plan_file(urdf: str = URDF, attachments: dict[str, bytes] | None = None) -> PlanFile:
+    return PlanFile(
         robot_name="threelink", group="arm", planning_frame="base_link", distro="jazzy", steps=(),
         attachments=attachments or {}, metadata={}, limits={}, urdf=urdf,
     )
@@ -83,7 +87,7 @@ def plan_file(urdf: str = URDF, attachments: dict[str, bytes] | None = None) -> 
 def execution_of(
     reports: list[tuple[str, ExecutionReport]],
     controller: ControllerConfig,
-    plan: recording.PlanFile | None = None,
+    plan: PlanFile | None = None,
 ) -> PlanExecution:
     steps = tuple(StepExecution(name, report) for name, report in reports)
     last = steps[-1].report
@@ -137,12 +141,6 @@ def cycle_stamps(execution: PlanExecution) -> list[int]:
     return stamps
 
 
-def generic(msgtype: str, distro: str, message: dict[str, Any]) -> bytes:
-    """CDR of `message` from mcap_ros2's schema-driven encoder, the reference."""
-    schema = files("moveplan.core.bag.msgs").joinpath(distro, msgtype.replace("/", "__") + ".msg")
-    return bytes(serialize_dynamic(msgtype, schema.read_text())[msgtype](message))
-
-
 def metadata_records(path: Path) -> dict[str, dict[str, str]]:
     with path.open("rb") as stream:
         records = make_reader(stream).iter_metadata()
@@ -181,7 +179,7 @@ def test_executed_file_has_the_topics_types_counts_and_schemas_of_its_distro(
     assert counts == {"/robot_description": 1, "/joint_states": cycles, STATE_TOPIC: cycles,
                       RESULT_TOPIC: 1}
     assert metadata_records(path)["rosbag2"] == {"ROS_DISTRO": distro}
-    summary = recording.summarize(path)
+    summary = summarize(path)
     assert summary.profile == "ros2" and summary.start_ns == 0
     assert summary.end_ns == cycle_stamps(two_steps)[-1]
 
@@ -360,6 +358,17 @@ def test_non_finite_numbers_become_json_null(tmp_path: Path, two_steps: PlanExec
     assert "NaN" not in message.data and "Infinity" not in message.data
 
 
+def test_execution_document_is_strict_json_however_the_plant_diverged(two_steps: PlanExecution) -> None:
+    report = two_steps.steps[0].report
+    nan = float("nan")
+    diverged = replace(report, margins={"elbow_joint": nan},
+                       violations=(Violation("goal", "elbow_joint", nan, 1.0, float("inf"), float("-inf"), 0.2),))
+    document = execution_document(execution_of([("diverged", diverged)], two_steps.controller))
+    json.dumps(document, allow_nan=False)
+    assert document["margins"] == {"elbow_joint": None}
+    assert [document["violations"][0][k] for k in ("time_s", "reference", "actual", "error")] == [None, 1.0, None, None]
+
+
 def test_execution_that_never_started_writes_channels_and_result_but_no_cycles(
     tmp_path: Path,
 ) -> None:
@@ -429,14 +438,14 @@ def test_read_plan_returns_the_plans_robot_description(tmp_path: Path) -> None:
     trajectory = minimum_jerk(np.zeros(3), np.array([0.2, -0.1, 0.3]), 0.4)
     step = StepResult("move", {}, "RRTConnect", 0.01, trajectory)
     plan = Plan("threelink", "arm", "base_link", (step,), URDF)
-    recording.write_plan(tmp_path / "plan.mcap", plan)
-    plan_read = recording.read_plan(tmp_path / "plan.mcap")
+    write_plan(tmp_path / "plan.mcap", plan)
+    plan_read = read_plan(tmp_path / "plan.mcap")
     assert plan_read.urdf == URDF
     assert plan_read.steps[0].name == "move"
 
 
 def test_plan_file_without_urdf_argument_still_builds() -> None:
-    plan = recording.PlanFile("r", "g", "f", "jazzy", (), {}, {}, {})
+    plan = PlanFile("r", "g", "f", "jazzy", (), {}, {}, {})
     assert plan.urdf == ""
 
 
@@ -491,24 +500,24 @@ def test_unknown_distro_raises_usage_error_and_writes_nothing(
     assert list(tmp_path.iterdir()) == []
 
 
-# --- the fast CDR encoders write what the generic encoder writes ---------------------------------
+# --- the fast CDR encoders write what the reference encoder writes -------------------------------
 
 
 def random_states(
     joints: int, count: int, seed: int, empty: tuple[str, ...] = ()
-) -> msgs.ControllerStates:
+) -> ControllerStates:
     """Random series; `empty` names point fields ("feedback.velocities") left empty."""
     rng = np.random.default_rng(seed)
     shape = (count, joints)
 
-    def series(name: str) -> msgs.PointSeries:
+    def series(name: str) -> PointSeries:
         fields = ("positions", "velocities", "accelerations", "effort")
-        return msgs.PointSeries(**{
+        return PointSeries(**{
             field: rng.normal(size=shape) for field in fields if f"{name}.{field}" not in empty
         })
 
     stamps = np.cumsum(rng.integers(1, 1_500_000_000, count))  # some past a second
-    return msgs.ControllerStates(
+    return ControllerStates(
         joint_names=ODD_NAMES[:joints],
         stamps_ns=stamps,
         times_from_start_ns=stamps - stamps[:1] if count else stamps,
@@ -537,11 +546,10 @@ def test_fast_controller_states_match_the_generic_encoder(
     distro: str, joints: int, count: int, empty: tuple[str, ...]
 ) -> None:
     states = random_states(joints, count, seed=joints * 10 + count, empty=empty)
-    encoded = msgs.controller_states_cdr(states, distro)
+    encoded = controller_states_cdr(states, distro)
     assert len(encoded) == count
-    for index, data in enumerate(encoded):
-        message = msgs.controller_state(states, index, distro)
-        assert data == generic(CONTROLLER_STATE, distro, message), index
+    messages = [msgs.controller_state(states, index, distro) for index in range(count)]
+    assert encoded == reference_cdr(CONTROLLER_STATE, distro, messages)
 
 
 @pytest.mark.parametrize("distro", DISTROS)
@@ -557,9 +565,11 @@ def test_fast_joint_states_match_the_generic_encoder(
     positions, velocities = rng.normal(size=(count, joints)), rng.normal(size=(count, joints))
     encoded = encode_joint_states(names, stamps, positions, velocities, frame_id=frame_id)
     assert len(encoded) == count
-    for data, stamp, q, v in zip(encoded, stamps.tolist(), positions, velocities, strict=True):
-        message = msgs.joint_state(names, stamp, q, v, frame_id)
-        assert data == generic(JOINT_STATE, distro, message)
+    messages = [
+        msgs.joint_state(names, stamp, q, v, frame_id)
+        for stamp, q, v in zip(stamps.tolist(), positions, velocities, strict=True)
+    ]
+    assert encoded == reference_cdr(JOINT_STATE, distro, messages)
 
 
 @pytest.mark.parametrize("distro", DISTROS)
@@ -585,19 +595,17 @@ def test_every_written_message_is_what_the_generic_encoder_writes(
     reports = [s.report for s in execution.steps]
     positions = np.concatenate([r.actual_positions for r in reports])
     velocities = np.concatenate([r.actual_velocities for r in reports])
-    assert written["/joint_states"] == [
-        generic(JOINT_STATE, distro, msgs.joint_state(names, stamp, q, v))
-        for stamp, q, v in zip(stamps, positions, velocities, strict=True)
-    ]
+    assert written["/joint_states"] == reference_cdr(JOINT_STATE, distro, [
+        msgs.joint_state(names, stamp, q, v) for stamp, q, v in zip(stamps, positions, velocities, strict=True)
+    ])
     expected_states = []
     start = 0
     for report in reports:
         times = np.rint(report.times_s * 1e9).astype(np.int64)
         states = controller_states(report, controller, start + times, times)
-        expected_states += [
-            generic(CONTROLLER_STATE, distro, msgs.controller_state(states, k, distro))
-            for k in range(len(times))
-        ]
+        expected_states += reference_cdr(
+            CONTROLLER_STATE, distro, [msgs.controller_state(states, k, distro) for k in range(len(times))]
+        )
         start += round(report.duration_s * 1e9)
     assert written[STATE_TOPIC] == expected_states
     assert len(read_all(path)) == sum(len(v) for v in written.values())

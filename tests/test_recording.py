@@ -1,4 +1,4 @@
-"""Plan files written by recording, checked by independent readers: rosbags and a raw walk."""
+"""Plan files written by plan_writer and read by plan_file and summary, checked by independent readers."""
 
 from __future__ import annotations
 
@@ -12,12 +12,15 @@ import mcap.writer
 import numpy as np
 import pytest
 from mcap.reader import make_reader
-from mcap_ros2._dynamic import serialize_dynamic
+from reference_cdr import generic, reference_cdr
 from rosbags.highlevel import AnyReader
 from rosbags.interfaces import ConnectionExtRosbag2, QosDurability
 
+from moveplan.core.bag import message_cdr
 from moveplan.core.bag import messages as msgs
-from moveplan.core.bag import recording
+from moveplan.core.bag.plan_file import PlanFile, read_plan
+from moveplan.core.bag.plan_writer import write_plan
+from moveplan.core.bag.summary import summarize
 from moveplan.core.errors import InputError, UsageError
 from moveplan.core.types import (
     CollisionObject,
@@ -136,7 +139,7 @@ def plan() -> Plan:
 @pytest.fixture
 def plan_path(tmp_path: Path, plan: Plan) -> Path:
     path = tmp_path / "plan.mcap"
-    recording.write_plan(path, plan)
+    write_plan(path, plan)
     return path
 
 
@@ -232,7 +235,7 @@ def test_every_channel_is_cdr_with_the_shipped_schema_text_byte_for_byte(
     tmp_path: Path, plan: Plan, distro: str
 ) -> None:
     path = tmp_path / "plan.mcap"
-    recording.write_plan(path, plan, distro=distro)
+    write_plan(path, plan, distro=distro)
     shipped = files("moveplan.core.bag.msgs").joinpath(distro)
     schemas = {}
     for opcode, fields in top_level_records(path):
@@ -274,7 +277,7 @@ def test_file_has_one_rosbag2_metadata_record_naming_the_distro(
     tmp_path: Path, plan: Plan, distro: str
 ) -> None:
     path = tmp_path / "plan.mcap"
-    recording.write_plan(path, plan, distro=distro)
+    write_plan(path, plan, distro=distro)
     metadata = {}
     for opcode, fields in top_level_records(path):
         if opcode == 0x0C:
@@ -401,7 +404,7 @@ def test_mesh_object_becomes_a_mesh_resource_marker_with_a_file_uri(
         np.eye(4),
     )
     path = tmp_path / "plan.mcap"
-    recording.write_plan(path, Plan(**{**vars(plan), "objects": (mesh,)}))
+    write_plan(path, Plan(**{**vars(plan), "objects": (mesh,)}))
     [(_, array)] = on(read_all(path), "/planning_scene_markers")
     [marker] = array.markers
     assert marker.type == 10
@@ -413,12 +416,12 @@ def test_mesh_object_becomes_a_mesh_resource_marker_with_a_file_uri(
 
 
 def test_same_plan_written_twice_gives_identical_bytes(tmp_path: Path, plan: Plan) -> None:
-    recording.write_plan(tmp_path / "a.mcap", plan)
-    recording.write_plan(tmp_path / "b.mcap", plan)
+    write_plan(tmp_path / "a.mcap", plan)
+    write_plan(tmp_path / "b.mcap", plan)
     assert (tmp_path / "a.mcap").read_bytes() == (tmp_path / "b.mcap").read_bytes()
 
 
-def assert_same_plan(plan_file: recording.PlanFile, plan: Plan) -> None:
+def assert_same_plan(plan_file: PlanFile, plan: Plan) -> None:
     assert (plan_file.robot_name, plan_file.group, plan_file.planning_frame, plan_file.distro) == (
         "twolink",
         "arm",
@@ -440,7 +443,7 @@ def assert_same_plan(plan_file: recording.PlanFile, plan: Plan) -> None:
 
 
 def test_read_plan_returns_what_write_plan_wrote(plan_path: Path, plan: Plan) -> None:
-    assert_same_plan(recording.read_plan(plan_path), plan)
+    assert_same_plan(read_plan(plan_path), plan)
 
 
 def test_attachments_get_media_types_from_their_file_names(plan_path: Path) -> None:
@@ -454,7 +457,7 @@ def test_attachments_get_media_types_from_their_file_names(plan_path: Path) -> N
 
 
 def test_summarize_lists_topics_counts_durability_and_records(plan_path: Path) -> None:
-    summary = recording.summarize(plan_path)
+    summary = summarize(plan_path)
     assert summary.profile == "ros2" and summary.library.startswith("moveplan")
     assert (summary.start_ns, summary.end_ns) == (0, 1_984_567_891)
     assert summary.duration_s == pytest.approx(1.984567891)
@@ -476,8 +479,8 @@ def test_unfinished_file_without_summary_is_read_by_a_linear_scan(
     data_end = summary_start(plan_path) - 13  # the DataEnd record: opcode, length, CRC
     unfinished = tmp_path / "unfinished.mcap"
     unfinished.write_bytes(plan_path.read_bytes()[:data_end])
-    assert_same_plan(recording.read_plan(unfinished), plan)
-    assert recording.summarize(unfinished) == recording.summarize(plan_path)
+    assert_same_plan(read_plan(unfinished), plan)
+    assert summarize(unfinished) == summarize(plan_path)
 
 
 def test_summarize_counts_messages_of_a_bag_without_statistics(tmp_path: Path) -> None:
@@ -490,17 +493,17 @@ def test_summarize_counts_messages_of_a_bag_without_statistics(tmp_path: Path) -
         for i in range(3):
             writer.add_message(channel, 10 + i, b"\x00\x01\x00\x00\x01\x00\x00\x00\x00", 10 + i)
         writer.finish()  # type: ignore[no-untyped-call]
-    summary = recording.summarize(path)
+    summary = summarize(path)
     assert [(t.topic, t.count, t.qos_durability) for t in summary.topics] == [("/chatter", 3, "")]
     assert (summary.start_ns, summary.end_ns) == (10, 12)
     with pytest.raises(InputError, match=re.escape(str(path)) + ".*not a moveplan plan"):
-        recording.read_plan(path)
+        read_plan(path)
 
 
 # --- bad files and failed writes -----------------------------------------------------------------
 
 
-@pytest.mark.parametrize("read", [recording.read_plan, recording.summarize])
+@pytest.mark.parametrize("read", [read_plan, summarize])
 def test_truncated_file_raises_input_error_naming_the_file(
     tmp_path: Path, plan_path: Path, read: Any
 ) -> None:
@@ -518,10 +521,10 @@ def test_corrupt_chunk_raises_input_error_naming_the_file(tmp_path: Path, plan_p
     corrupt = tmp_path / "corrupt.mcap"
     corrupt.write_bytes(bytes(data))
     with pytest.raises(InputError, match=re.escape(str(corrupt)) + ".*corrupt MCAP data"):
-        recording.read_plan(corrupt)
+        read_plan(corrupt)
 
 
-@pytest.mark.parametrize("read", [recording.read_plan, recording.summarize])
+@pytest.mark.parametrize("read", [read_plan, summarize])
 def test_non_mcap_file_raises_input_error_naming_the_file(tmp_path: Path, read: Any) -> None:
     path = tmp_path / "notes.mcap"
     path.write_text("robot: ur10e\n")
@@ -529,7 +532,7 @@ def test_non_mcap_file_raises_input_error_naming_the_file(tmp_path: Path, read: 
         read(path)
 
 
-@pytest.mark.parametrize("read", [recording.read_plan, recording.summarize])
+@pytest.mark.parametrize("read", [read_plan, summarize])
 def test_missing_file_raises_input_error_naming_the_file(tmp_path: Path, read: Any) -> None:
     path = tmp_path / "nothing.mcap"
     with pytest.raises(InputError, match=re.escape(str(path)) + ".*not found"):
@@ -546,7 +549,7 @@ def test_failed_write_leaves_no_file_behind(
     out = tmp_path / "out"
     out.mkdir()
     with pytest.raises(RuntimeError, match="disk on fire"):
-        recording.write_plan(out / "plan.mcap", plan)
+        write_plan(out / "plan.mcap", plan)
     assert list(out.iterdir()) == []
 
 
@@ -557,7 +560,7 @@ def test_failed_write_keeps_the_previous_file(
     path.write_bytes(b"previous plan")
     monkeypatch.setattr(mcap.writer.Writer, "finish", lambda self: 1 / 0)
     with pytest.raises(ZeroDivisionError):
-        recording.write_plan(path, plan)
+        write_plan(path, plan)
     assert [p.name for p in tmp_path.iterdir()] == ["plan.mcap"]
     assert path.read_bytes() == b"previous plan"
 
@@ -567,25 +570,19 @@ def test_write_into_a_missing_folder_raises_input_error_naming_it(
 ) -> None:
     path = tmp_path / "no" / "plan.mcap"
     with pytest.raises(InputError, match=re.escape(str(path)) + ".*cannot write"):
-        recording.write_plan(path, plan)
+        write_plan(path, plan)
 
 
 def test_unknown_distro_raises_usage_error_listing_known_ones(tmp_path: Path, plan: Plan) -> None:
     with pytest.raises(UsageError, match="rolling.*humble, jazzy"):
-        recording.write_plan(tmp_path / "plan.mcap", plan, distro="rolling")
+        write_plan(tmp_path / "plan.mcap", plan, distro="rolling")
     assert list(tmp_path.iterdir()) == []
 
 
-# --- the fast CDR encoders write what the generic encoder writes ---------------------------------
+# --- the fast CDR encoders write what the reference encoder writes -------------------------------
 
 # Names of every length mod 8, so strings leave every possible padding before what follows.
 ODD_NAMES = ("j", "jo", "joi", "join", "joint", "joint_", "joint_1", "joint_12", "joint_123")
-
-
-def generic(msgtype: str, distro: str, message: dict[str, Any]) -> bytes:
-    """CDR of `message` from mcap_ros2's schema-driven encoder, the reference."""
-    schema = files("moveplan.core.bag.msgs").joinpath(distro, msgtype.replace("/", "__") + ".msg")
-    return bytes(serialize_dynamic(msgtype, schema.read_text())[msgtype](message))
 
 
 def random_trajectory(names: tuple[str, ...], count: int, seed: int) -> JointTrajectory:
@@ -621,7 +618,7 @@ def test_fast_joint_trajectory_matches_the_generic_encoder(
     trajectory = random_trajectory(ODD_NAMES[:joints], count, seed=joints * count)
     message = msgs.joint_trajectory(trajectory, frame_id)
     expected = generic("trajectory_msgs/msg/JointTrajectory", distro, message)
-    assert msgs.joint_trajectory_cdr(trajectory, frame_id) == expected
+    assert message_cdr.joint_trajectory_cdr(trajectory, frame_id) == expected
 
 
 @pytest.mark.parametrize("distro", DISTROS)
@@ -634,7 +631,7 @@ def test_fast_display_trajectory_matches_the_generic_encoder(
     trajectories = [random_trajectory(names, count, seed) for seed, count in enumerate(counts)]
     message = msgs.display_trajectory(robot_name, trajectories, "world")
     expected = generic("moveit_msgs/msg/DisplayTrajectory", distro, message)
-    assert msgs.display_trajectory_cdr(robot_name, trajectories, "world") == expected
+    assert message_cdr.display_trajectory_cdr(robot_name, trajectories, "world") == expected
 
 
 @pytest.mark.parametrize("distro", DISTROS)
@@ -644,11 +641,13 @@ def test_fast_tf_messages_match_the_generic_encoder(distro: str, samples: int, c
     children = tuple(ODD_NAMES[i % len(ODD_NAMES)] for i in range(count))
     transforms = random_transforms(samples, count, seed=samples + count)
     stamps_ns = [i * 987_654_321 for i in range(samples)]  # seconds and nanoseconds
-    encoded = msgs.tf_messages_cdr(parents, children, transforms, stamps_ns)
+    encoded = message_cdr.tf_messages_cdr(parents, children, transforms, stamps_ns)
     assert len(encoded) == samples
-    for data, sample, stamp_ns in zip(encoded, transforms, stamps_ns, strict=True):
-        message = msgs.tf_message(parents, children, list(sample), stamp_ns)
-        assert data == generic("tf2_msgs/msg/TFMessage", distro, message)
+    messages = [
+        msgs.tf_message(parents, children, list(sample), stamp_ns)
+        for sample, stamp_ns in zip(transforms, stamps_ns, strict=True)
+    ]
+    assert encoded == reference_cdr("tf2_msgs/msg/TFMessage", distro, messages)
 
 
 @pytest.fixture
@@ -671,7 +670,7 @@ def test_every_written_message_is_what_the_generic_encoder_writes(
 ) -> None:
     plan = request.getfixturevalue(which)
     path = tmp_path / "plan.mcap"
-    recording.write_plan(path, plan, distro=distro)
+    write_plan(path, plan, distro=distro)
     frame, trajectories = plan.planning_frame, [step.trajectory for step in plan.steps]
     statics = plan.static_frames
     expected = {
@@ -699,7 +698,7 @@ def test_every_written_message_is_what_the_generic_encoder_writes(
         for _, channel, message in make_reader(stream).iter_messages(log_time_order=False):
             written[channel.topic].append(message.data)
     for topic, messages in expected.items():
-        want = [generic(TYPES[topic], distro, message) for message in messages]
+        want = reference_cdr(TYPES[topic], distro, messages)
         assert written[topic] == want, topic
     decoded = read_all(path)  # and an independent reader decodes every one of them
     assert len(decoded) == sum(len(messages) for messages in expected.values())
@@ -711,6 +710,6 @@ def test_every_written_message_is_what_the_generic_encoder_writes(
 def test_same_edge_plan_written_twice_gives_identical_bytes(
     tmp_path: Path, edge_plan: Plan
 ) -> None:
-    recording.write_plan(tmp_path / "a.mcap", edge_plan)
-    recording.write_plan(tmp_path / "b.mcap", edge_plan)
+    write_plan(tmp_path / "a.mcap", edge_plan)
+    write_plan(tmp_path / "b.mcap", edge_plan)
     assert (tmp_path / "a.mcap").read_bytes() == (tmp_path / "b.mcap").read_bytes()

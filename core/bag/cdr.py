@@ -1,19 +1,20 @@
-"""A minimal little-endian CDR (XCDR1) writer for hand-written ROS 2 message encoders.
+"""A minimal little-endian CDR (XCDR1) writer: what every moveplan message encoder writes through.
 
 ROS 2 (rmw_fastrtps, rosbag2) serializes messages as plain CDR: a 4-byte encapsulation
 header 00 01 00 00 (CDR, little endian), then the fields in definition order, each
 primitive aligned to its own size relative to the start of the payload after the header.
 Sequences and strings carry a uint32 length; strings are UTF-8 with a trailing NUL that
-the length counts. The writer reproduces mcap_ros2's generic encoder byte for byte
-(tests/test_recording.py checks that) but packs float arrays in bulk from numpy, and
-`patched_copies` repeats a written template with new values, which is what makes the
-encoders built on it fast: a generic encoder spends a Python call per field.
+the length counts. The schema-driven encoder (core.bag.generic_cdr) writes field by field;
+the hand-written twins (core.bag.message_cdr) pack float arrays in bulk from numpy, and
+`patched_copies` repeats a written template with new values, which is what makes them
+fast: a generic encoder spends a Python call per field.
 """
 
 from __future__ import annotations
 
 import struct
 from collections.abc import Iterable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -69,7 +70,8 @@ class CdrWriter:
         """Write a builtin_interfaces Time or Duration of `stamp_ns` [ns] >= 0; return its index."""
         self._align(4)
         start = len(self._buffer)
-        # mcap_ros2 writes sec as uint32 too, so a negative time fails in both encoders alike.
+        # sec packed as uint32: a negative time raises here (and in time_array), where the
+        # schema-driven encoder, following the schemas' int32 sec, would write it.
         self._buffer += _TIME.pack(*divmod(stamp_ns, 1_000_000_000))
         return start
 
@@ -84,6 +86,17 @@ class CdrWriter:
         self.uint32(len(texts))
         for text in texts:
             self.string(text)
+
+    def scalars(self, code: str, size: int, values: Sequence[Any]) -> None:
+        """Write `values` as the struct type `code` ("d", "I", "b" ...) of `size` bytes; return None.
+
+        Each element is aligned to its size: aligning the first aligns the rest, and no
+        values write nothing, not even padding.
+        """
+        if values:
+            if size > 1:
+                self._align(size)
+            self._buffer += struct.pack(f"<{len(values)}{code}", *values)
 
     def float64_array(self, values: NDArray[np.float64]) -> int:
         """Write the elements of `values` (C order) as float64, no length; return their index."""

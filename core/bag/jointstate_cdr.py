@@ -1,7 +1,7 @@
 """The CDR layout of sensor_msgs/msg/JointState, both ways: payloads built, and parsed.
 
 `encode_joint_states` builds payloads for writers and tests; `parse_layout` finds where
-the fields of one payload lie, which core.jointstates uses as a template for the rows
+the fields of one payload lie, which core.bag.jointstates uses as a template for the rows
 laid out alike; `check_definition` checks that a ros2msg schema named JointState has
 its fields.
 """

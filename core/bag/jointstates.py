@@ -1,10 +1,10 @@
 """Joint states from any MCAP file: sensor_msgs/msg/JointState messages as numpy columns.
 
-Fast enough for hour-long 1 kHz recordings: core.mcapreader hands over a topic's
+Fast enough for hour-long 1 kHz recordings: core.bag.topic_reader hands over a topic's
 payloads chunk by chunk, and the rows whose bytes up to the position array equal a
 template row's (same frame_id, same names, same array sizes) are decoded together with
 numpy. Rows laid out differently get their own template, or are decoded one by one.
-The CDR layout itself is core.jointstate_cdr's, which also encodes payloads
+The CDR layout itself is core.bag.jointstate_cdr's, which also encodes payloads
 (`encode_joint_states`, re-exported here with JOINT_STATE_TYPE and JointStateSeries).
 """
 
@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError, known
+from ..errors import CorruptData, InputError, known
 from ..types import JointStateSeries, TimeSource
 from .jointstate_cdr import (
     JOINT_STATE_TYPE,
@@ -28,7 +28,7 @@ from .jointstate_cdr import (
     encode_joint_states,
     parse_layout,
 )
-from .reader import Channel, CorruptData, byte_rows, read_topic
+from .topic_reader import Channel, byte_rows, read_topic
 
 __all__ = ["JOINT_STATE_TYPE", "JointStateSeries", "encode_joint_states", "read_joint_states"]
 

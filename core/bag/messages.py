@@ -1,24 +1,15 @@
-"""The ROS 2 side of plan files: shipped message definitions, QoS profiles, messages.
+"""ROS 2 messages as plain dicts, for the schema-driven CDR encoder, and their time stamps.
 
-Messages are plain dicts for a schema-driven CDR encoder. Field names follow the .msg
-definitions in core/bag/msgs; a field left out is written with its default (zero, empty or
-the definition's constant) by the encoder.
-
-The big, numerous messages (trajectories, /tf, joint states, controller states) also have
-`*_cdr` twins that write CDR bytes directly with bulk float packing: a generic encoder
-spends a Python call per float. Each twin writes exactly the bytes the generic encoder
-makes of its dict builder's message (tests/test_recording.py and tests/test_execution_file.py
-check every shipped distro). The field layout is the same in every distro except
-control_msgs/JointTrajectoryControllerState, whose builders read it from the distro's schema.
+Field names follow the .msg definitions in core/bag/msgs; a field left out is written with
+its default (zero, empty or the definition's constant) by the encoder (core.bag.generic_cdr).
+The big, numerous messages also have `*_cdr` twins in core.bag.message_cdr that write the
+same bytes directly.
 """
 
 from __future__ import annotations
 
-import re
 from collections.abc import Sequence
 from dataclasses import fields
-from functools import cache
-from importlib.resources import files
 from pathlib import Path
 from typing import Any
 
@@ -26,29 +17,21 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from ..errors import UsageError, known
 from ..types import CollisionObject, ControllerStates, JointTrajectory, PointSeries
-from .cdr import CdrWriter, patched_copies, time_array
+from .definitions import POINT_SOURCES, controller_state_fields
 
 __all__ = [
-    "ControllerStates",
-    "PointSeries",
+    "Message",
     "controller_state",
-    "controller_states_cdr",
     "display_trajectory",
-    "display_trajectory_cdr",
-    "durability",
     "joint_state",
     "joint_trajectory",
-    "joint_trajectory_cdr",
     "marker_array",
-    "offered_qos_profiles",
-    "schema_text",
+    "quaternions_xyzw",
     "seconds_to_ns",
     "stamps_ns",
     "string",
     "tf_message",
-    "tf_messages_cdr",
     "time_msg",
     "trajectory_from_message",
 ]
@@ -60,62 +43,6 @@ _TRIANGLE_LIST = 11
 # MoveIt's RViz defaults: scene objects green, attached objects purple.
 _SCENE_COLOR = {"r": 0.2, "g": 0.9, "b": 0.2, "a": 0.9}
 _ATTACHED_COLOR = {"r": 0.6, "g": 0.2, "b": 0.6, "a": 0.9}
-_CONTROLLER_STATE = "control_msgs/msg/JointTrajectoryControllerState"
-# Humble's deprecated points repeat the new ones: ros2_controllers#1985 fills `desired`
-# from the reference and `actual` from the feedback.
-_POINT_SOURCES = {
-    "reference": "reference",
-    "feedback": "feedback",
-    "error": "error",
-    "output": "output",
-    "desired": "reference",
-    "actual": "feedback",
-}
-
-
-@cache
-def schema_text(msgtype: str, distro: str) -> bytes:
-    """Return the shipped ros2msg definition of `msgtype` ("pkg/msg/Type") for `distro`.
-
-    The text is exactly what rosbag2 stores as an MCAP schema (see core/bag/msgs/README.md).
-    """
-    folder = files("moveplan.core.bag.msgs")
-    distros = [entry.name for entry in folder.iterdir() if entry.is_dir() and entry.name.isalpha()]
-    if distro not in distros:
-        raise UsageError(f"unknown ROS distro '{distro}'; known: {known(distros)}")
-    return folder.joinpath(distro, msgtype.replace("/", "__") + ".msg").read_bytes()
-
-
-def offered_qos_profiles(latched: bool) -> str:
-    """Return the offered_qos_profiles YAML rosbag2 stores per topic, with integer enums.
-
-    Humble's player reads the enums as integers only; Jazzy's reads both. history 1 =
-    keep_last, reliability 1 = reliable, durability 1 = transient_local (latched) or
-    2 = volatile, liveliness 1 = automatic; durations are rmw's "infinite".
-    """
-    infinite = "    sec: 9223372036\n    nsec: 854775807\n"
-    return (
-        "- history: 1\n"
-        f"  depth: {1 if latched else 10}\n"
-        "  reliability: 1\n"
-        f"  durability: {1 if latched else 2}\n"
-        f"  deadline:\n{infinite}"
-        f"  lifespan:\n{infinite}"
-        "  liveliness: 1\n"
-        f"  liveliness_lease_duration:\n{infinite}"
-        "  avoid_ros_namespace_conventions: false"
-    )
-
-
-def durability(offered_qos_profiles: str) -> str:
-    """Return "transient_local" if all offered profiles are, else "volatile"; "" if none given."""
-    # Humble writes integer enums, Jazzy writes names. No yaml here: it enters through config only.
-    values = re.findall(r"^[\s-]*durability:\s*['\"]?(\w+)", offered_qos_profiles, re.MULTILINE)
-    enums = {"1": "transient_local", "2": "volatile"}
-    names = [enums.get(value, value.lower()) for value in values]
-    if not names:
-        return ""
-    return "transient_local" if all(name == "transient_local" for name in names) else "volatile"
 
 
 def seconds_to_ns(seconds: float) -> int:
@@ -228,13 +155,13 @@ def controller_state(states: ControllerStates, index: int, distro: str) -> Messa
     """
     tfs = time_msg(int(states.times_from_start_ns[index]))
     message: Message = {}
-    for kind, name in _controller_state_fields(distro):
+    for kind, name in controller_state_fields(distro):
         if kind == "header":
             message[name] = {"stamp": time_msg(int(states.stamps_ns[index])), "frame_id": ""}
         elif kind == "names":
             message[name] = list(states.joint_names) if name == "joint_names" else []
         elif kind == "point":
-            series: PointSeries = getattr(states, _POINT_SOURCES[name])
+            series: PointSeries = getattr(states, POINT_SOURCES[name])
             point = {
                 field.name: [] if value is None else value[index].tolist()
                 for field, value in zip(fields(series), series.filled(), strict=True)
@@ -246,106 +173,6 @@ def controller_state(states: ControllerStates, index: int, distro: str) -> Messa
         else:
             message[name] = 1.0  # speed_scaling_factor: JTC without scaling runs at 1
     return message
-
-
-def joint_trajectory_cdr(trajectory: JointTrajectory, frame_id: str) -> bytes:
-    """Return `joint_trajectory(trajectory, frame_id)` encoded as CDR."""
-    writer = CdrWriter()
-    _write_joint_trajectory(writer, trajectory, frame_id)
-    return writer.data()
-
-
-def display_trajectory_cdr(
-    robot_name: str, trajectories: Sequence[JointTrajectory], frame_id: str
-) -> bytes:
-    """Return `display_trajectory(robot_name, trajectories, frame_id)` encoded as CDR."""
-    writer = CdrWriter()
-    writer.string(robot_name)  # model_id
-    writer.uint32(len(trajectories))
-    for trajectory in trajectories:  # moveit_msgs/RobotTrajectory
-        _write_joint_trajectory(writer, trajectory, frame_id)
-        # An empty trajectory_msgs/MultiDOFJointTrajectory: header, joint_names[], points[].
-        writer.time(0)
-        writer.string("")
-        writer.uint32(0)
-        writer.uint32(0)
-    first = trajectories[0]
-    # trajectory_start, a moveit_msgs/RobotState; first its sensor_msgs/JointState.
-    writer.time(0)
-    writer.string(frame_id)
-    writer.strings(first.joint_names)
-    writer.float64_sequence(first.positions[0])
-    writer.float64_sequence(first.velocities[0])
-    writer.uint32(0)  # effort[]
-    # An empty sensor_msgs/MultiDOFJointState: header, then joint_names[], transforms[],
-    # twist[], wrench[].
-    writer.time(0)
-    writer.string("")
-    for _ in range(4):
-        writer.uint32(0)
-    writer.uint32(0)  # attached_collision_objects[]
-    writer.boolean(False)  # is_diff
-    return writer.data()
-
-
-def tf_messages_cdr(
-    parents: Sequence[str],
-    children: Sequence[str],
-    transforms: NDArray[np.float64],
-    stamps_ns: Sequence[int],
-) -> list[bytes]:
-    """Return one CDR `tf_message` per stamp; `transforms` has shape (stamps, children, 4, 4)."""
-    # The messages differ only in stamps and poses: one template written field by field,
-    # then copies of it patched in bulk (a plan has ~180 messages of ~7 transforms).
-    template = CdrWriter()
-    template.uint32(len(children))
-    stamp_at, pose_at = [], []
-    for parent, child in zip(parents, children, strict=True):
-        # geometry_msgs/TransformStamped: header, child_frame_id, then a Transform of
-        # translation xyz and rotation xyzw, seven float64 in a row.
-        stamp_at.append(template.time(0))
-        template.string(parent)
-        template.string(child)
-        pose_at.append(template.float64_array(np.zeros(7)))
-    poses = np.concatenate([transforms[..., :3, 3], _quaternions(transforms)], axis=-1)
-    poses = poses.astype("<f8", copy=False)
-    stamps = time_array(stamps_ns)
-    patches: list[tuple[int, NDArray[np.generic]]] = [(start, stamps) for start in stamp_at]
-    patches += [(start, poses[:, child]) for child, start in enumerate(pose_at)]
-    messages = patched_copies(template.data(), len(stamps), patches)
-    return [message.tobytes() for message in messages]
-
-
-def controller_states_cdr(states: ControllerStates, distro: str) -> list[bytes]:
-    """Return every cycle of `states` as CDR `controller_state`, laid out for `distro`."""
-    # Every message of a series has the same names and array lengths, so the same layout
-    # and padding: one template, patched per cycle.
-    template = CdrWriter()
-    count = len(states.stamps_ns)
-    times = time_array(states.times_from_start_ns)
-    zeros = np.zeros(len(states.joint_names))
-    patches: list[tuple[int, NDArray[np.generic]]] = []
-    for kind, name in _controller_state_fields(distro):
-        if kind == "header":
-            patches.append((template.time(0), time_array(states.stamps_ns)))
-            template.string("")
-        elif kind == "names":
-            template.strings(states.joint_names if name == "joint_names" else ())
-        elif kind == "point":
-            series: PointSeries = getattr(states, _POINT_SOURCES[name])
-            for values in series.filled():
-                if values is None:
-                    template.uint32(0)
-                else:
-                    patches.append((template.float64_sequence(zeros), _column(values)))
-            patches.append((template.time(0), times))
-        elif kind == "multi_dof_point":
-            for _ in range(3):  # transforms[], velocities[], accelerations[]
-                template.uint32(0)
-            template.time(0)
-        else:
-            template.float64_array(np.ones(1))  # speed_scaling_factor
-    return _copies(template.data(), count, patches)
 
 
 def marker_array(objects: Sequence[CollisionObject], planning_frame: str) -> Message:
@@ -390,87 +217,6 @@ def _marker(obj: CollisionObject, marker_id: int, planning_frame: str) -> Messag
     }
 
 
-def _write_joint_trajectory(writer: CdrWriter, trajectory: JointTrajectory, frame_id: str) -> None:
-    """Write the fields of `joint_trajectory(trajectory, frame_id)` to `writer`; return None."""
-    writer.time(0)
-    writer.string(frame_id)
-    writer.strings(trajectory.joint_names)
-    times_ns = [seconds_to_ns(t) for t in trajectory.times_s.tolist()]
-    motion = (trajectory.positions, trajectory.velocities, trajectory.accelerations)
-    arrays = [values.astype("<f8", copy=False) for values in motion]
-
-    def write_point(i: int) -> list[int]:
-        """Write point `i`; return where its positions, velocities, accelerations, time start."""
-        indexes = [writer.float64_sequence(values[i]) for values in arrays]
-        writer.uint32(0)  # effort[]
-        return [*indexes, writer.time(times_ns[i])]
-
-    writer.uint32(len(times_ns))
-    write_point(0)
-    if len(times_ns) == 1:
-        return
-    # A point's padding depends on where it starts, mod 8, and the first may start
-    # anywhere. Every point ends at the same offset mod 8, though, so from the second on
-    # all points share one layout: the second is written field by field and the rest are
-    # copies of it with their own values (its size, a multiple of 8, keeps them aligned).
-    start = len(writer)
-    indexes = write_point(1)
-    template = writer.data()[start:]
-    assert len(template) % 8 == 0, len(template)
-    columns: list[NDArray[np.generic]] = [*arrays, time_array(times_ns)]
-    patches = [(index - start, column[2:]) for index, column in zip(indexes, columns, strict=True)]
-    writer.raw(patched_copies(template, len(times_ns) - 2, patches).tobytes())
-
-
-@cache
-def _controller_state_fields(distro: str) -> tuple[tuple[str, str], ...]:
-    """Return (kind, name) of each JointTrajectoryControllerState field of `distro`, in order.
-
-    Read from the shipped schema, as the layouts differ (Humble keeps the deprecated
-    desired/actual points, Jazzy adds speed_scaling_factor). Kinds: header, names, point,
-    multi_dof_point, scale.
-
-    Raises:
-        UsageError: `distro` has no shipped message definitions.
-        ValueError: The schema has a field these encoders do not know.
-
-    """
-    kinds = {
-        "std_msgs/Header": "header",
-        "string[]": "names",
-        "trajectory_msgs/JointTrajectoryPoint": "point",
-        "trajectory_msgs/MultiDOFJointTrajectoryPoint": "multi_dof_point",
-        "float64": "scale",
-    }
-    root = schema_text(_CONTROLLER_STATE, distro).decode().split("\n" + "=" * 80)[0]
-    result = []
-    for line in root.splitlines():
-        words = line.split("#", 1)[0].split()
-        if not words or "=" in line.split("#", 1)[0]:
-            continue  # blank, comment or constant
-        msgtype, name = words[0], words[1]
-        kind = kinds.get(msgtype)
-        known_point = kind != "point" or name in _POINT_SOURCES
-        if kind is None or not known_point or (kind == "scale" and name != "speed_scaling_factor"):
-            raise ValueError(f"{_CONTROLLER_STATE} ({distro}): unexpected field '{msgtype} {name}'")
-        result.append((kind, name))
-    return tuple(result)
-
-
-def _column(values: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Return (rows, n) values as little-endian float64 rows, for `patched_copies`."""
-    return np.asarray(values).astype("<f8", copy=False)
-
-
-def _copies(
-    template: bytes, count: int, patches: list[tuple[int, NDArray[np.generic]]]
-) -> list[bytes]:
-    """Return `count` copies of `template` patched row by row, as separate messages."""
-    if count == 0:
-        return []
-    return [row.tobytes() for row in patched_copies(template, count, patches)]
-
-
 def _xyz(transform: NDArray[np.float64]) -> Message:
     x, y, z = transform[:3, 3].tolist()
     return {"x": x, "y": y, "z": z}
@@ -478,11 +224,11 @@ def _xyz(transform: NDArray[np.float64]) -> Message:
 
 def _quaternion(transform: NDArray[np.float64]) -> Message:
     """Return the rotation of a 4x4 transform as a unit quaternion with w >= 0."""
-    x, y, z, w = _quaternions(transform).tolist()
+    x, y, z, w = quaternions_xyzw(transform).tolist()
     return {"x": x, "y": y, "z": z, "w": w}
 
 
-def _quaternions(transforms: NDArray[np.float64]) -> NDArray[np.float64]:
+def quaternions_xyzw(transforms: NDArray[np.float64]) -> NDArray[np.float64]:
     """Return the rotations of 4x4 transforms (..., 4, 4) as unit quaternions xyzw with w >= 0."""
     (m00, m01, m02), (m10, m11, m12), (m20, m21, m22) = np.moveaxis(
         transforms[..., :3, :3], (-2, -1), (0, 1)

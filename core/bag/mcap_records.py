@@ -1,0 +1,241 @@
+"""MCAP records read without the mcap package: the summary section, record walks, chunks decompressed.
+
+The few record kinds bulk topic reading needs (MCAP specification, records Header to
+Statistics), parsed from bytes with struct and numpy; only zstandard (and lz4, imported
+when a file uses it) besides. A structural error raises CorruptData, which the topic
+reader turns into an InputError naming the file.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import IO, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import CorruptData, InputError
+
+__all__ = [
+    "CHANNEL",
+    "CHUNK",
+    "DATA_AT",
+    "FOOTER",
+    "MAGIC",
+    "MESSAGE",
+    "MESSAGE_FIXED",
+    "RECORD_HEAD",
+    "SCHEMA",
+    "ChunkIndex",
+    "Codecs",
+    "Summary",
+    "channel_record",
+    "chunk_records",
+    "message_index",
+    "read_summary",
+    "schema_record",
+    "walk",
+    "walk_positions",
+]
+
+MAGIC = b"\x89MCAP0\r\n"
+FOOTER, SCHEMA, CHANNEL, MESSAGE, CHUNK, MESSAGE_INDEX, CHUNK_INDEX = 2, 3, 4, 5, 6, 7, 8
+STATISTICS = 11
+RECORD_HEAD = 9  # opcode u8 + length u64
+FOOTER_SIZE = RECORD_HEAD + 20 + len(MAGIC)
+# A Message record: head, channel_id u16, sequence u32, log_time u64, publish_time u64, data.
+MESSAGE_FIXED = 22
+DATA_AT = RECORD_HEAD + MESSAGE_FIXED
+
+
+@dataclass(frozen=True)
+class ChunkIndex:
+    """A ChunkIndex record: where a chunk lies, its message indexes per channel, its size decompressed."""
+
+    start: int
+    length: int
+    message_index_offsets: dict[int, int]
+    message_index_length: int
+    uncompressed_size: int
+
+
+@dataclass
+class Summary:
+    """What a file's summary section holds: schemas and channels by id, chunk indexes, counts per channel."""
+
+    schemas: dict[int, tuple[str, str, bytes]] = field(default_factory=dict)
+    channels: dict[int, tuple[int, str, str]] = field(default_factory=dict)
+    chunks: list[ChunkIndex] = field(default_factory=list)
+    channel_counts: dict[int, int] = field(default_factory=dict)
+
+
+def read_summary(stream: IO[bytes], size: int) -> Summary | None:
+    """Return the schemas, channels and chunk indexes of the summary section, or None."""
+    if size < len(MAGIC) + FOOTER_SIZE:
+        return None
+    stream.seek(size - FOOTER_SIZE)
+    tail = stream.read(FOOTER_SIZE)
+    if tail[-len(MAGIC) :] != MAGIC or tail[0] != FOOTER:
+        return None
+    summary_start = struct.unpack_from("<Q", tail, RECORD_HEAD)[0]
+    if not len(MAGIC) <= summary_start <= size - FOOTER_SIZE:
+        return None
+    stream.seek(summary_start)
+    data = stream.read(size - FOOTER_SIZE - summary_start)
+    summary = Summary()
+    try:
+        for opcode, content in walk(data):
+            if opcode == SCHEMA:
+                schema_id, name, encoding, text = schema_record(content)
+                summary.schemas[schema_id] = (name, encoding, text)
+            elif opcode == CHANNEL:
+                channel_id, schema_id, channel_topic, encoding = channel_record(content)
+                summary.channels[channel_id] = (schema_id, channel_topic, encoding)
+            elif opcode == CHUNK_INDEX:
+                summary.chunks.append(_chunk_index(content))
+            elif opcode == STATISTICS:
+                # message_count .. message_end_time take 42 bytes; then a map<u16, u64>.
+                (map_size,) = struct.unpack_from("<I", content, 42)
+                counts = struct.iter_unpack("<HQ", content[46 : 46 + map_size])
+                summary.channel_counts = dict(counts)
+    except (CorruptData, struct.error, UnicodeDecodeError):
+        return None  # an unreadable summary: the linear scan still reads the data
+    return summary
+
+
+def walk(data: bytes | memoryview) -> Iterator[tuple[int, memoryview]]:
+    """Yield (opcode, content) of the records in `data`, which must hold whole records."""
+    view = memoryview(data)
+    position, end = 0, len(view)
+    while position < end:
+        if position + RECORD_HEAD > end:
+            raise CorruptData(f"a record header at byte {position} is cut")
+        opcode, length = struct.unpack_from("<BQ", view, position)
+        start = position + RECORD_HEAD
+        if start + length > end:
+            raise CorruptData(f"a record at byte {position} runs past its container")
+        yield opcode, view[start : start + length]
+        position = start + length
+
+
+def _string(content: memoryview, offset: int) -> tuple[str, int]:
+    (length,) = struct.unpack_from("<I", content, offset)
+    end = offset + 4 + length
+    if end > len(content):
+        raise CorruptData("a string runs past its record")
+    return bytes(content[offset + 4 : end]).decode(), end
+
+
+def schema_record(content: memoryview) -> tuple[int, str, str, bytes]:
+    """Return id, name, encoding and data of the Schema record `content`."""
+    (schema_id,) = struct.unpack_from("<H", content)
+    name, offset = _string(content, 2)
+    encoding, offset = _string(content, offset)
+    (length,) = struct.unpack_from("<I", content, offset)
+    return schema_id, name, encoding, bytes(content[offset + 4 : offset + 4 + length])
+
+
+def channel_record(content: memoryview) -> tuple[int, int, str, str]:
+    """Return id, schema id, topic and message encoding of the Channel record `content`."""
+    channel_id, schema_id = struct.unpack_from("<HH", content)
+    topic, offset = _string(content, 4)
+    encoding, _ = _string(content, offset)
+    return channel_id, schema_id, topic, encoding
+
+
+def _chunk_index(content: memoryview) -> ChunkIndex:
+    start, length, map_size = struct.unpack_from("<QQI", content, 16)
+    entries = struct.iter_unpack("<HQ", content[36 : 36 + map_size])
+    (index_length,) = struct.unpack_from("<Q", content, 36 + map_size)
+    _, offset = _string(content, 44 + map_size)
+    (uncompressed_size,) = struct.unpack_from("<Q", content, offset + 8)
+    return ChunkIndex(start, length, dict(entries), index_length, uncompressed_size)
+
+
+def chunk_records(
+    raw: memoryview, chunk_at: int, codecs: Codecs, out: bytearray | None = None
+) -> NDArray[np.uint8]:
+    """Return the decompressed records of the Chunk record in `raw`, in `out` if it fits."""
+    opcode, _ = struct.unpack_from("<BQ", raw)
+    if opcode != CHUNK:
+        raise CorruptData(f"no chunk at byte {chunk_at}, where the chunk index points")
+    (uncompressed_size,) = struct.unpack_from("<Q", raw, RECORD_HEAD + 16)
+    compression, offset = _string(raw, RECORD_HEAD + 28)
+    (length,) = struct.unpack_from("<Q", raw, offset)
+    records = raw[offset + 8 : offset + 8 + length]
+    if len(records) != length:
+        raise CorruptData(f"the chunk at byte {chunk_at} is cut")
+    try:
+        data = codecs.decompress(compression, records, uncompressed_size, out)
+    except (InputError, CorruptData):
+        raise
+    except Exception as exc:  # each codec raises its own kinds
+        raise CorruptData(f"the chunk at byte {chunk_at} does not decompress ({exc})") from None
+    if len(data) != uncompressed_size:
+        raise CorruptData(f"the chunk at byte {chunk_at} decompresses to the wrong size")
+    return np.frombuffer(data, dtype=np.uint8)
+
+
+class Codecs:
+    """Decompressors, made once per read: a zstd context costs more to make than to use."""
+
+    def __init__(self) -> None:
+        self._zstd: Any = None
+
+    def decompress(
+        self, compression: str, records: memoryview, size: int, out: bytearray | None
+    ) -> bytes | memoryview:
+        """Return one chunk's records decompressed, into `out` where the codec allows it.
+
+        Decompressing into a reused buffer spares a fresh megabyte of memory, and its
+        page faults, per chunk.
+        """
+        if compression == "":
+            return records
+        if compression == "zstd":
+            if self._zstd is None:
+                import zstandard
+
+                self._zstd = zstandard.ZstdDecompressor()
+            if out is None or len(out) < size:
+                return self._zstd.decompress(records, max_output_size=size)  # type: ignore[no-any-return]
+            view = memoryview(out)[:size]
+            filled = 0
+            with self._zstd.stream_reader(records) as reader:
+                while filled < size:
+                    count = reader.readinto(view[filled:])
+                    if not count:
+                        break
+                    filled += count
+                if filled < size or reader.read(1):
+                    raise CorruptData(f"a chunk does not decompress to its {size} bytes")
+            return view
+        if compression == "lz4":
+            try:
+                import lz4.frame
+            except ImportError:
+                raise InputError("the file has lz4-compressed chunks; install lz4") from None
+            return bytes(lz4.frame.decompress(records))
+        raise CorruptData(f"unknown chunk compression '{compression}'")
+
+
+def message_index(raw: memoryview, at: int) -> NDArray[np.uint64]:
+    """Return the (log_time, offset) rows of the MessageIndex record at byte `at` of `raw`."""
+    opcode, length = struct.unpack_from("<BQ", raw, at)
+    if opcode != MESSAGE_INDEX:
+        raise CorruptData("a chunk index points at a message index that is not there")
+    (size,) = struct.unpack_from("<I", raw, at + RECORD_HEAD + 2)
+    start = at + RECORD_HEAD + 6
+    if size % 16 or start + size > len(raw):
+        raise CorruptData("a message index is malformed")
+    return np.frombuffer(raw, dtype="<u8", count=size // 8, offset=start).reshape(-1, 2)
+
+
+def walk_positions(buf: NDArray[np.uint8]) -> Iterator[tuple[int, memoryview, int]]:
+    """Yield (opcode, content, offset of the record) of the whole records in `buf`."""
+    position = 0
+    for opcode, content in walk(memoryview(buf.data)):
+        yield opcode, content, position
+        position += RECORD_HEAD + len(content)

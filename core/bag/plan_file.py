@@ -1,0 +1,172 @@
+"""Plan files: their layout (topics, types, metadata keys; DESIGN section 6), and plans read back.
+
+A plan file is a ROS 2 bag: /robot_description, /tf_static, /planning_scene_markers and
+/display_planned_path once and latched, one /planned_trajectory message per step at the
+step's start, /tf along the plan; a "moveplan" metadata record (robot, group, frame, step
+names, limits, distro) and the robot's config files as attachments.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+from mcap_ros2.decoder import DecoderFactory
+
+from ..errors import InputError
+from ..types import JointTrajectory
+from .mcap_scan import DAMAGE, Contents, Kept, open_mcap, scan
+from .messages import trajectory_from_message
+
+__all__ = [
+    "PLAN_TOPICS",
+    "ROBOT_DESCRIPTION",
+    "STRING",
+    "TRAJECTORY",
+    "PlanFile",
+    "PlanStepRecord",
+    "plan_urdf",
+    "read_plan",
+]
+
+STRING = "std_msgs/msg/String"
+TRAJECTORY = "/planned_trajectory"
+ROBOT_DESCRIPTION = "/robot_description"
+# topic -> (message type, latched). Latched topics are offered transient_local, so a late
+# subscriber (RViz, robot_state_publisher) still gets them from `ros2 bag play`. The
+# trajectory stays volatile: a controller that joins late must not receive a stale step.
+PLAN_TOPICS: dict[str, tuple[str, bool]] = {
+    ROBOT_DESCRIPTION: (STRING, True),
+    "/tf_static": ("tf2_msgs/msg/TFMessage", True),
+    "/planning_scene_markers": ("visualization_msgs/msg/MarkerArray", True),
+    "/display_planned_path": ("moveit_msgs/msg/DisplayTrajectory", True),
+    TRAJECTORY: ("trajectory_msgs/msg/JointTrajectory", False),
+    "/tf": ("tf2_msgs/msg/TFMessage", False),
+}
+"""Every topic a plan file may hold, in channel order: topic -> (message type, latched)."""
+
+PLAN_KEYS = ("robot_name", "group", "planning_frame", "step_names", "limits", "distro")
+"""The keys moveplan itself writes into a plan's "moveplan" metadata record."""
+
+_UNREADABLE = (*DAMAGE, TypeError, IndexError, AttributeError)
+
+
+@dataclass(frozen=True)
+class PlanStepRecord:
+    """One step read back from a plan file: name, start on the plan's timeline in [s], motion."""
+
+    name: str
+    start_s: float
+    trajectory: JointTrajectory
+
+
+@dataclass(frozen=True)
+class PlanFile:
+    """A plan read back from an MCAP file: its steps plus what execute and checks need.
+
+    `urdf` is the text of the file's /robot_description, "" if it has none.
+    """
+
+    robot_name: str
+    group: str
+    planning_frame: str
+    distro: str
+    steps: tuple[PlanStepRecord, ...]
+    attachments: dict[str, bytes]
+    metadata: dict[str, str]
+    limits: dict[str, dict[str, float]]
+    urdf: str = ""
+
+
+def read_plan(path: Path) -> PlanFile:
+    """Return the plan stored in the moveplan MCAP file at `path`.
+
+    Raises:
+        InputError: The file is missing, not MCAP, truncated, corrupt or not a moveplan plan.
+
+    """
+    with open_mcap(path) as stream:
+        contents = scan(path, stream, keep_topics=(TRAJECTORY, ROBOT_DESCRIPTION))
+    info = next((m.metadata for m in contents.metadata if m.name == "moveplan"), {})
+    if any(key not in info for key in PLAN_KEYS):
+        raise InputError(f"{path}: not a moveplan plan file (no complete 'moveplan' metadata)")
+    try:
+        step_names = [str(name) for name in json.loads(info["step_names"])]
+        limits = {
+            joint: {key: float(value) for key, value in joint_limits.items()}
+            for joint, joint_limits in json.loads(info["limits"]).items()
+        }
+    except (ValueError, TypeError, AttributeError) as exc:
+        raise InputError(f"{path}: 'moveplan' metadata is malformed: {exc}") from exc
+    factory = DecoderFactory()
+    descriptions = [item for item in contents.kept if item[0].topic == ROBOT_DESCRIPTION]
+    return PlanFile(
+        robot_name=info["robot_name"],
+        group=info["group"],
+        planning_frame=info["planning_frame"],
+        distro=info["distro"],
+        steps=_steps(path, factory, contents, step_names),
+        attachments={attachment.name: attachment.data for attachment in contents.attachments},
+        metadata={key: value for key, value in info.items() if key not in PLAN_KEYS},
+        limits=limits,
+        urdf=_robot_description(path, factory, descriptions),
+    )
+
+
+def plan_urdf(plan: PlanFile) -> str:
+    """Return the plan's URDF: its /robot_description, else its one .urdf attachment, else ""."""
+    if plan.urdf:
+        return plan.urdf
+    urdfs = [data for name, data in plan.attachments.items() if name.lower().endswith(".urdf")]
+    return urdfs[0].decode() if len(urdfs) == 1 else ""
+
+
+def _steps(
+    path: Path, factory: DecoderFactory, contents: Contents, step_names: list[str]
+) -> tuple[PlanStepRecord, ...]:
+    """Return the steps: one /planned_trajectory message per name, in log-time order.
+
+    Raises:
+        InputError: The counts differ, or a message is not a readable JointTrajectory.
+
+    """
+    kept = [item for item in contents.kept if item[0].topic == TRAJECTORY]
+    if len(kept) != len(step_names):
+        raise InputError(
+            f"{path}: {len(kept)} messages on {TRAJECTORY} "
+            f"but {len(step_names)} step names in its metadata"
+        )
+    steps = []
+    for name, (channel, schema, message) in zip(step_names, kept, strict=True):
+        decode = factory.decoder_for(channel.message_encoding, schema)
+        if decode is None or schema is None or schema.name != PLAN_TOPICS[TRAJECTORY][0]:
+            raise InputError(
+                f"{path}: {TRAJECTORY} must hold CDR trajectory_msgs/msg/JointTrajectory "
+                "messages with a ros2msg schema"
+            )
+        try:
+            trajectory = trajectory_from_message(decode(message.data))
+        except _UNREADABLE as exc:
+            raise InputError(f"{path}: step '{name}' on {TRAJECTORY} is unreadable: {exc}") from exc
+        steps.append(PlanStepRecord(name, message.log_time / 1e9, trajectory))
+    return tuple(steps)
+
+
+def _robot_description(path: Path, factory: DecoderFactory, kept: list[Kept]) -> str:
+    """Return the URDF text of the first /robot_description message, "" if there is none.
+
+    Raises:
+        InputError: The message is not a readable std_msgs/msg/String.
+
+    """
+    if not kept:
+        return ""
+    channel, schema, message = kept[0]
+    decode = factory.decoder_for(channel.message_encoding, schema)
+    if decode is None or schema is None or schema.name != STRING:
+        raise InputError(f"{path}: {ROBOT_DESCRIPTION} must hold a CDR {STRING} with a ros2msg schema")
+    try:
+        return str(decode(message.data).data)
+    except _UNREADABLE as exc:
+        raise InputError(f"{path}: {ROBOT_DESCRIPTION} is unreadable: {exc}") from exc

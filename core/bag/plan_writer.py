@@ -1,0 +1,88 @@
+"""Plans written as plan files: every message of a plan encoded, then written as one ROS 2 bag."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..types import Plan
+from . import messages as msgs
+from .bag_writer import write_bag
+from .definitions import schema_text
+from .generic_cdr import encoder
+from .message_cdr import display_trajectory_cdr, joint_trajectory_cdr, tf_messages_cdr
+from .plan_file import PLAN_TOPICS, ROBOT_DESCRIPTION, TRAJECTORY
+
+__all__ = ["write_plan"]
+
+
+def write_plan(path: Path, plan: Plan, distro: str = "jazzy") -> None:
+    """Write `plan` to `path` as a ROS 2 bag for `distro`, atomically; return None.
+
+    Raises:
+        UsageError: `distro` has no shipped message definitions.
+        InputError: `path` cannot be written.
+
+    """
+    schemas = {msgtype: schema_text(msgtype, distro) for msgtype, _ in PLAN_TOPICS.values()}
+    messages = _plan_messages(plan, schemas)
+    metadata = {
+        **plan.metadata,
+        "robot_name": plan.robot_name,
+        "group": plan.group,
+        "planning_frame": plan.planning_frame,
+        "step_names": json.dumps([step.name for step in plan.steps]),
+        "limits": json.dumps(plan.limits, sort_keys=True),
+        "distro": distro,
+    }
+    topics = {topic: PLAN_TOPICS[topic] for topic in dict.fromkeys(t for t, _, _ in messages)}
+    write_bag(
+        path,
+        topics,
+        schemas,
+        messages,
+        {"rosbag2": {"ROS_DISTRO": distro}, "moveplan": metadata},
+        plan.attachments,
+    )
+
+
+def _plan_messages(plan: Plan, schemas: dict[str, bytes]) -> list[tuple[str, int, bytes]]:
+    """Return (topic, log time [ns], CDR message) for every message of `plan`, in log-time order.
+
+    Trajectories and transforms take the fast `*_cdr` encoders; the two small messages
+    take the generic encoder built from `schemas` (message type -> schema text).
+    """
+    if not plan.steps:
+        raise ValueError("a plan needs at least one step")
+
+    def generic(topic: str, message: msgs.Message) -> bytes:
+        msgtype = PLAN_TOPICS[topic][0]
+        return encoder(msgtype, schemas[msgtype])(message)
+
+    frame = plan.planning_frame
+    trajectories = [step.trajectory for step in plan.steps]
+    statics = plan.static_frames
+    # reshape, not np.array alone: no static frames must still give shape (1, 0, 4, 4).
+    static_transforms = np.reshape([f.transform for f in statics], (1, len(statics), 4, 4))
+    [tf_static] = tf_messages_cdr([f.parent for f in statics], [f.name for f in statics], static_transforms, [0])
+    messages = [
+        (ROBOT_DESCRIPTION, 0, generic(ROBOT_DESCRIPTION, msgs.string(plan.urdf))),
+        ("/tf_static", 0, tf_static),
+        ("/planning_scene_markers", 0, generic("/planning_scene_markers", msgs.marker_array(plan.objects, frame))),
+        ("/display_planned_path", 0, display_trajectory_cdr(plan.robot_name, trajectories, frame)),
+    ]
+    # Starts add up integer durations, so a step starts exactly where the previous one's
+    # last time_from_start ends.
+    start_ns = 0
+    for trajectory in trajectories:
+        messages.append((TRAJECTORY, start_ns, joint_trajectory_cdr(trajectory, frame)))
+        start_ns += msgs.seconds_to_ns(trajectory.duration_s)
+    if plan.tf is not None:
+        tf = plan.tf
+        stamps_ns = [msgs.seconds_to_ns(float(time_s)) for time_s in tf.times_s]
+        encoded = tf_messages_cdr(tf.parents, tf.children, tf.transforms, stamps_ns)
+        messages += [("/tf", stamp, data) for stamp, data in zip(stamps_ns, encoded, strict=True)]
+    # A stable sort: messages logged at the same time keep the order above.
+    return sorted(messages, key=lambda item: item[1])
