@@ -9,9 +9,10 @@ import pytest
 import yaml
 from conftest import ROOT, UR10E, Cli
 
-from moveplan.core.bag import recording
+from moveplan.core import bag as recording
 from moveplan.core.collision.checker import CollisionChecker
-from moveplan.core.config.robot_config import RobotConfig, load_robot_config, resolve_config_path, search_path
+from moveplan.core.config.robot_config import RobotConfig, load_robot_config
+from moveplan.core.config.sources import resolve_config_path, search_path
 from moveplan.core.config.xacro import PackagePath, parse_xacro_args
 from moveplan.core.errors import ConfigError, UnknownName, UsageError
 from moveplan.core.model.robot import Robot

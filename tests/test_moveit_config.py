@@ -12,7 +12,7 @@ import pytest
 import yaml
 from conftest import ROOT, Cli
 
-from moveplan.core.bag import recording
+from moveplan.core import bag as recording
 from moveplan.core.config.robot_config import RobotConfig, load_robot_config
 from moveplan.core.errors import ConfigError, UsageError
 from moveplan.core.model.robot import Robot

@@ -1,0 +1,178 @@
+"""Controller settings: ros2_controllers.yaml's JointTrajectoryControllers, moveit_controllers.yaml's execution.
+
+Only the controllers moveplan interprets are read, and their keys checked: a
+JointTrajectoryController's parameters, `constraints` and `gains` accept what some
+ROS 2 release of it declares, so a typo (`trajectroy`, read by ROS as an undeclared
+parameter and ignored) is an error rather than a tolerance of 0, "not checked". The
+other controllers of the file (broadcasters, grippers, ...) are not looked at.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import ConfigError
+from .fields import boolean, check_keys, load_yaml, mapping, number
+
+__all__ = ["ControllerConfig", "ExecutionConfig", "parse_controllers", "parse_execution"]
+
+# What a JointTrajectoryController declares, in any release from Humble to master: ros2_controllers'
+# joint_trajectory_controller/src/joint_trajectory_controller_parameters.yaml (@9c53e68, Humble-era
+# versions, @02aa372 master) and its release notes (start_with_holding, removed in Jazzy).
+_JTC_KEYS = frozenset({
+    "joints", "command_joints", "command_interfaces", "state_interfaces", "allow_partial_joints_goal",
+    "open_loop_control", "interpolate_from_desired_state", "allow_integration_in_goal_trajectories",
+    "set_last_command_interface_value_as_state_on_activation", "state_publish_rate", "action_monitor_rate",
+    "interpolation_method", "allow_nonzero_velocity_at_trajectory_end", "cmd_timeout", "start_with_holding",
+    "speed_scaling", "gains", "constraints",
+})
+# Every controller's node also takes these: controller_interface's update_rate, is_async and
+# async_parameters (ControllerInterfaceBase), the spawner's `type`, rclcpp's use_sim_time.
+_NODE_KEYS = frozenset({"update_rate", "is_async", "async_parameters", "type", "use_sim_time"})
+# ur_controllers' ScaledJointTrajectoryController adds scaled_joint_trajectory_controller_parameters.yaml.
+_SCALED_JTC_KEYS = frozenset({
+    "speed_scaling_interface_name", "use_speed_scaling_topic_instead", "speed_scaling_topic_name",
+    "speed_scaling_sim_mode",
+})
+_SPEED_SCALING_KEYS = frozenset({"initial_scaling_factor", "state_interface", "command_interface"})
+_CONSTRAINT_KEYS = frozenset({"stopped_velocity_tolerance", "goal_time", "decelerate_on_cancel"})
+_JOINT_CONSTRAINT_KEYS = frozenset({"trajectory", "goal", "max_deceleration_on_cancel"})
+# gains.<joint>: numbers (kept in ControllerConfig.gains), flags, and the anti-windup strategy's name.
+_GAIN_NUMBERS = frozenset({
+    "p", "i", "d", "i_clamp", "i_clamp_max", "i_clamp_min", "u_clamp_max", "u_clamp_min", "ff_velocity_scale",
+    "tracking_time_constant", "error_deadband",
+})
+_GAIN_FLAGS = frozenset({"angle_wraparound", "normalize_error", "antiwindup"})
+_GAIN_STRINGS = frozenset({"antiwindup_strategy"})
+
+
+@dataclass(frozen=True)
+class ControllerConfig:
+    """A JointTrajectoryController's parameters from ros2_controllers.yaml."""
+
+    name: str
+    joints: tuple[str, ...]
+    update_rate_hz: float
+    command_interfaces: tuple[str, ...]
+    state_interfaces: tuple[str, ...]
+    goal_time_s: float
+    stopped_velocity_tolerance: float
+    trajectory_tolerance: dict[str, float]
+    goal_tolerance: dict[str, float]
+    gains: dict[str, dict[str, float]]
+
+
+@dataclass(frozen=True)
+class ExecutionConfig:
+    """MoveIt's trajectory_execution parameters from moveit_controllers.yaml (MoveIt defaults)."""
+
+    allowed_start_tolerance: float = 0.01
+    allowed_execution_duration_scaling: float = 1.1
+    allowed_goal_duration_margin: float = 0.5
+    execution_duration_monitoring: bool = True
+
+
+def parse_controllers(path: Path) -> dict[str, ControllerConfig]:
+    """Return the JointTrajectoryControllers configured in a ros2_controllers.yaml, by name.
+
+    Raises:
+        ConfigError: A malformed value, or an unknown key in a JointTrajectoryController's
+            parameters, `constraints` or `gains`; names the file and the key path.
+    """
+    top = mapping(load_yaml(path), str(path))
+    manager = _ros_parameters(top, "controller_manager", path)
+    rate = number(manager.get("update_rate", 100), f"{path}: controller_manager.ros__parameters.update_rate",
+                  positive=True)
+    controllers: dict[str, ControllerConfig] = {}
+    for name, entry in manager.items():
+        kind = str(entry.get("type", "")) if isinstance(entry, dict) else ""
+        if "JointTrajectoryController" in kind:
+            controllers[name] = _joint_trajectory_controller(name, kind, _ros_parameters(top, name, path), rate,
+                                                             f"{path}: {name}.ros__parameters")
+    return controllers
+
+
+def parse_execution(path: Path) -> ExecutionConfig:
+    """Return moveit_controllers.yaml's trajectory_execution settings, MoveIt's defaults where absent."""
+    top = mapping(load_yaml(path), str(path))
+    section = mapping(top.get("trajectory_execution"), f"{path}: trajectory_execution")
+    defaults = ExecutionConfig()
+    where = f"{path}: trajectory_execution"
+    return ExecutionConfig(
+        allowed_start_tolerance=number(
+            section.get("allowed_start_tolerance", defaults.allowed_start_tolerance),
+            f"{where}.allowed_start_tolerance",
+        ),
+        allowed_execution_duration_scaling=number(
+            section.get("allowed_execution_duration_scaling", defaults.allowed_execution_duration_scaling),
+            f"{where}.allowed_execution_duration_scaling",
+        ),
+        allowed_goal_duration_margin=number(
+            section.get("allowed_goal_duration_margin", defaults.allowed_goal_duration_margin),
+            f"{where}.allowed_goal_duration_margin",
+        ),
+        execution_duration_monitoring=boolean(
+            section.get("execution_duration_monitoring", defaults.execution_duration_monitoring),
+            f"{where}.execution_duration_monitoring",
+        ),
+    )
+
+
+def _ros_parameters(top: dict[str, Any], node: str, path: Path) -> dict[str, Any]:
+    section = mapping(top.get(node), f"{path}: {node}")
+    return mapping(section.get("ros__parameters"), f"{path}: {node}.ros__parameters")
+
+
+def _joint_trajectory_controller(
+    name: str, kind: str, params: dict[str, Any], rate: float, where: str
+) -> ControllerConfig:
+    """Return one JointTrajectoryController's settings from its checked `ros__parameters` (at `where`)."""
+    scaled = _SCALED_JTC_KEYS if "ScaledJointTrajectoryController" in kind else frozenset()
+    check_keys(params, _JTC_KEYS | _NODE_KEYS | scaled, where)
+    check_keys(mapping(params.get("speed_scaling"), f"{where}.speed_scaling"), _SPEED_SCALING_KEYS,
+               f"{where}.speed_scaling")
+    joints = tuple(params.get("joints") or ())
+    if not joints:
+        raise ConfigError(f"{where}.joints: a JointTrajectoryController needs joints")
+    constraints = mapping(params.get("constraints"), f"{where}.constraints")
+    check_keys(constraints, _CONSTRAINT_KEYS | set(joints), f"{where}.constraints")
+    trajectory, goal = {}, {}
+    for joint in joints:
+        entry = mapping(constraints.get(joint), f"{where}.constraints.{joint}")
+        check_keys(entry, _JOINT_CONSTRAINT_KEYS, f"{where}.constraints.{joint}")
+        trajectory[joint] = number(entry.get("trajectory", 0.0), f"{where}.constraints.{joint}.trajectory")
+        goal[joint] = number(entry.get("goal", 0.0), f"{where}.constraints.{joint}.goal")
+    return ControllerConfig(
+        name=name,
+        joints=joints,
+        update_rate_hz=rate,
+        command_interfaces=tuple(params.get("command_interfaces") or ("position",)),
+        state_interfaces=tuple(params.get("state_interfaces") or ("position",)),
+        goal_time_s=number(constraints.get("goal_time", 0.0), f"{where}.constraints.goal_time"),
+        stopped_velocity_tolerance=number(
+            constraints.get("stopped_velocity_tolerance", 0.01), f"{where}.constraints.stopped_velocity_tolerance"
+        ),
+        trajectory_tolerance=trajectory,
+        goal_tolerance=goal,
+        gains=_gains(params.get("gains"), joints, f"{where}.gains"),
+    )
+
+
+def _gains(value: Any, joints: tuple[str, ...], where: str) -> dict[str, dict[str, float]]:
+    """Return the numeric gains by joint; flags and the anti-windup strategy are checked, not kept."""
+    section = mapping(value, where)
+    check_keys(section, set(joints), where)
+    gains: dict[str, dict[str, float]] = {}
+    for joint, entry in section.items():
+        at = f"{where}.{joint}"
+        entry = mapping(entry, at)
+        check_keys(entry, _GAIN_NUMBERS | _GAIN_FLAGS | _GAIN_STRINGS, at)
+        for key in _GAIN_FLAGS & entry.keys():
+            boolean(entry[key], f"{at}.{key}")
+        for key in _GAIN_STRINGS & entry.keys():
+            if not isinstance(entry[key], str):
+                raise ConfigError(f"{at}.{key}: expected a string, got {entry[key]!r}")
+        gains[joint] = {k: number(v, f"{at}.{k}") for k, v in entry.items() if k in _GAIN_NUMBERS}
+    return gains
