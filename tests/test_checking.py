@@ -15,12 +15,13 @@ from moveplan.core.bag.jointstates import (
     encode_joint_states,
     read_joint_states,
 )
-from moveplan.core.bag.recording import PlanStepRecord
-from moveplan.core.config.robot_config import ControllerConfig, ExecutionConfig
-from moveplan.core.control.checking import CheckReport, check_recording, uses_velocities
+from moveplan.core.bag.plan_file import PlanStepRecord
+from moveplan.core.config.controllers import ControllerConfig, ExecutionConfig
+from moveplan.core.control.check_report import CheckReport
+from moveplan.core.control.checking import check_recording, uses_velocities
 from moveplan.core.control.controller import WAIT_LIMIT_S, Disturbance, simulate
 from moveplan.core.control.plants import MirrorPlant
-from moveplan.core.control.tolerances import INCOMPLETE
+from moveplan.core.control.results import INCOMPLETE
 from moveplan.core.errors import InputError, UsageError
 from moveplan.core.trajectory import sample
 from moveplan.core.types import JointTrajectory

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -192,3 +193,24 @@ def test_single_check_cut_after_a_violation_fails(
     code, document = cli.json("check-tolerances", plan, recording)
     assert code == 5
     assert document["result"]["name"] == "PATH_TOLERANCE_VIOLATED" and document["error"] is None
+
+
+def test_recording_with_an_infinite_position_prints_strict_json_with_null(cli: Cli, tmp_path: Path) -> None:
+    recorded = read_joint_states(RECORDINGS / "tool_up_ok.mcap")
+    positions = recorded.positions.copy()
+    positions[len(positions) // 2, 3] = np.inf  # a sensor glitch on wrist_1_joint
+    stamps = recorded.start_ns + np.round(recorded.times_s * 1e9).astype(np.int64)
+    payloads = encode_joint_states(recorded.names, stamps, positions)
+    glitch = write_bag(tmp_path / "glitch.mcap", [("/joint_states", "sensor_msgs/msg/JointState", int(s), p)
+                                                  for s, p in zip(stamps, payloads, strict=True)])
+
+    def reject(constant: str) -> None:
+        raise ValueError(f"not JSON: {constant}")
+
+    result = cli("check-tolerances", PLAN, glitch, "--json")
+    assert result.exit_code == 5, result.stderr
+    document = json.loads(result.stdout, parse_constant=reject)
+    [violation] = document["violations"]
+    assert violation["joint"] == "wrist_1_joint" and violation["actual"] is None and violation["error"] is None
+    text = cli("check-tolerances", PLAN, glitch)
+    assert text.exit_code == 5 and "inf/nan" in text.stdout and "Traceback" not in text.stderr

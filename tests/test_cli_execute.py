@@ -2,10 +2,19 @@
 
 from __future__ import annotations
 
+import json
+from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import pytest
 from conftest import SAMPLES, UR10E, Cli
+
+from moveplan.core.control.results import Violation
+from moveplan.core.pipeline import execute as pipeline
+from moveplan.core.pipeline.execute import ExecuteRequest, PlanExecution
+
+SHIPPED_PLAN = SAMPLES / "recordings" / "tool_up_plan.mcap"  # shipped: these tests need no planner
 
 
 @pytest.fixture(scope="module")
@@ -111,3 +120,64 @@ def test_pid_plant_passes_with_tuned_gains_and_fails_with_mistuned_ones(cli: Cli
     assert mistuned == 5
     assert mistuned_doc["result"]["name"] == "PATH_TOLERANCE_VIOLATED"
     assert mistuned_doc["violations"][0]["check"] == "path"
+
+
+# --- numbers that are not finite ---------------------------------------------------------------
+
+
+def strict_json(text: str) -> Any:
+    """Parse `text` as JSON proper: NaN, Infinity and -Infinity are not JSON."""
+    def reject(constant: str) -> None:
+        raise ValueError(f"not JSON: {constant}")
+
+    return json.loads(text, parse_constant=reject)
+
+
+@pytest.fixture()
+def exploding_controllers(tmp_path: Path) -> Path:
+    """An effort-driven PID so stiff that, on a near-weightless joint, the first correction overflows."""
+    text = (SAMPLES / "ur10e_velocity_controllers.yaml").read_text()
+    text = text.replace("      - velocity\n    state_interfaces", "      - effort\n    state_interfaces")
+    text = text.replace("p: 20.0, i: 0.0, d: 0.5, i_clamp: 0.0, ff_velocity_scale: 1.0",
+                        "p: 1.0e+300, i: 0.0, d: 0.0, i_clamp: 0.0, ff_velocity_scale: 0.0")
+    path = tmp_path / "exploding_controllers.yaml"
+    path.write_text(text)
+    return path
+
+
+def test_diverging_plant_prints_strict_json_with_null_for_infinite_errors(
+        cli: Cli, exploding_controllers: Path) -> None:
+    args = ("execute", SHIPPED_PLAN, "--fake", "--plant", "pid", "--plant-param", "inertia=1e-300",
+            "--controllers", exploding_controllers)
+    result = cli(*args, "--json")
+    assert result.exit_code == 5, result.stderr
+    document = strict_json(result.stdout)
+    assert document["result"]["name"] == "PATH_TOLERANCE_VIOLATED" and "inf" in document["result"]["message"]
+    assert document["violations"] and all(v["actual"] is None and v["error"] is None for v in document["violations"])
+    assert all(v["tolerance"] == 0.2 for v in document["violations"])
+    text = cli(*args)
+    assert text.exit_code == 5 and "Traceback" not in text.stderr
+    assert "inf/nan" in text.stdout
+
+
+def test_execution_with_nan_prints_strict_json_with_null(cli: Cli, monkeypatch: pytest.MonkeyPatch) -> None:
+    real = pipeline.execute
+
+    def diverged(request: ExecuteRequest) -> PlanExecution:
+        outcome = real(request)
+        step = outcome.steps[0]
+        nan = float("nan")
+        report = replace(step.report, ok=False, margins={"elbow_joint": nan, "wrist_1_joint": float("-inf")},
+                         violations=(Violation("path", "elbow_joint", 0.1, 1.0, nan, nan, 0.2),))
+        return replace(outcome, ok=False, steps=(replace(step, report=report),))
+
+    monkeypatch.setattr(pipeline, "execute", diverged)
+    result = cli("execute", SHIPPED_PLAN, "--fake", "--json")
+    assert result.exit_code == 5, result.stderr
+    document = strict_json(result.stdout)
+    assert document["margins"] == {"elbow_joint": None, "wrist_1_joint": None}
+    assert document["violations"][0]["actual"] is None and document["violations"][0]["error"] is None
+    assert document["violations"][0]["reference"] == 1.0
+    text = cli("execute", SHIPPED_PLAN, "--fake")
+    assert text.exit_code == 5 and "Traceback" not in text.stderr
+    assert "inf/nan" in text.stdout

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from moveplan.core.config.robot_config import ControllerConfig, ExecutionConfig
+from moveplan.core.config.controllers import ControllerConfig, ExecutionConfig
 from moveplan.core.control.controller import WAIT_LIMIT_S, Disturbance, simulate
 from moveplan.core.control.plants import FrozenPlant, LagPlant, MirrorPlant, PidPlant, make_plant
 from moveplan.core.errors import InputError, UnknownName, UsageError

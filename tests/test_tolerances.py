@@ -3,21 +3,20 @@
 import numpy as np
 import pytest
 
-from moveplan.core.config.robot_config import ControllerConfig, ExecutionConfig
-from moveplan.core.control.tolerances import (
+from moveplan.core.config.controllers import ControllerConfig, ExecutionConfig
+from moveplan.core.control.judging import judge, judge_spans
+from moveplan.core.control.moveit_checks import Timeout, check_start_state, expected_duration_s
+from moveplan.core.control.results import (
     GOAL_TOLERANCE_VIOLATED,
     PATH_TOLERANCE_VIOLATED,
     START_STATE_INVALID,
     SUCCESSFUL,
     TIMED_OUT,
+)
+from moveplan.core.control.tolerances import (
     SegmentTolerances,
     StateTolerance,
-    Timeout,
-    check_start_state,
     check_state_tolerance_per_joint,
-    expected_duration_s,
-    judge,
-    judge_spans,
     position_error,
     segment_tolerances,
     velocity_error_computable,

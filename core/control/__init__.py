@@ -1,11 +1,12 @@
 """ros2_control as MoveIt drives it: the JointTrajectoryController, simulated hardware, and its tolerances."""
 
-from .checking import CheckReport, check_recording
+from .check_report import CheckReport, CycleCheck, StepCheck
+from .checking import check_recording, uses_velocities
 from .controller import Disturbance, ExecutionReport, simulate
 from .plants import PLANTS, make_plant
-from .tolerances import ExecutionResult, Violation
+from .results import ExecutionResult, Violation
 
 __all__ = [
-    "PLANTS", "CheckReport", "Disturbance", "ExecutionReport", "ExecutionResult", "Violation", "check_recording",
-    "make_plant", "simulate",
+    "PLANTS", "CheckReport", "CycleCheck", "Disturbance", "ExecutionReport", "ExecutionResult", "StepCheck",
+    "Violation", "check_recording", "make_plant", "simulate", "uses_velocities",
 ]

@@ -20,31 +20,29 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from ..config.robot_config import ControllerConfig, ExecutionConfig
+from ..config.controllers import ControllerConfig, ExecutionConfig
 from ..errors import UsageError, known
 from ..trajectory import PointBefore, sample
 from ..types import JointTrajectory, frozen_array
+from .judging import judge
+from .moveit_checks import Timeout, check_start_state, expected_duration_s
 from .plants import Plant
-from .tolerances import (
+from .results import (
     GOAL_TOLERANCE_VIOLATED,
     PATH_TOLERANCE_VIOLATED,
     TIMED_OUT,
     ExecutionResult,
-    Timeout,
     ToleranceReport,
     Violation,
-    check_start_state,
-    expected_duration_s,
-    in_controller_order,
-    judge,
-    position_error,
-    segment_tolerances,
-    velocity_error_computable,
 )
+from .tolerances import in_controller_order, position_error, segment_tolerances, velocity_error_computable
 
 __all__ = ["WAIT_LIMIT_S", "Disturbance", "ExecutionReport", "simulate"]
 
 _FIRST_CHUNK = 256
+
+# Three (K, n) arrays per cycle and joint: positions, velocities, and accelerations or outputs.
+_PerCycle = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
 
 WAIT_LIMIT_S = 10.0
 """How long after the last point the simulation waits at least when nothing else ends it, in [s].
@@ -157,27 +155,27 @@ def simulate(
     if np.any(bumps[0]):
         p0, v0 = plant.displace(bumps[0])
     initial_output = plant.last_output.copy()
-    ref_p, ref_v, ref_a = sample(trajectory, grid, point_before=_point_before(controller, p0, v0),
-                                 continuous=continuous)
-    tolerances = segment_tolerances(controller)
-    velocities = velocity_error_computable(controller)
+    reference = sample(trajectory, grid, point_before=_point_before(controller, p0, v0),
+                       continuous=continuous)
+    verdict_of = _judge_cycles(trajectory, controller, grid, reference, timeout, continuous)
+    actual_p, actual_v, output, verdict = _run(plant, reference, bumps, (p0, v0), dt, verdict_of)
+    return _executed(verdict, joints, grid, reference, (actual_p, actual_v, output), initial_output, continuous,
+                     plant.interface)
 
-    def verdict_of(actual_p: NDArray[np.float64], actual_v: NDArray[np.float64]) -> ToleranceReport:
-        k = len(actual_p)
-        return judge(
-            tolerances, grid[:k], ref_p[:k], actual_p,
-            # Jazzy's update() takes the segment from its second sample: the command's, at t + dt.
-            before_last_point=grid[1 : k + 1] < trajectory.duration_s,
-            last_point_s=trajectory.duration_s,
-            timeout=timeout,
-            reference_velocities=ref_v[:k] if velocities else None,
-            actual_velocities=actual_v if velocities else None,
-            continuous=continuous,
-        )
 
-    actual_p, actual_v, output, verdict = _run(
-        plant, (ref_p, ref_v, ref_a), bumps, (p0, v0), dt, verdict_of
-    )
+def _executed(
+    verdict: ToleranceReport,
+    joints: tuple[str, ...],
+    grid: NDArray[np.float64],
+    reference: _PerCycle,
+    measured: _PerCycle,
+    initial_output: NDArray[np.float64],
+    continuous: NDArray[np.bool_],
+    interface: str,
+) -> ExecutionReport:
+    """Return the report of an execution that ran: its cycles up to the one that decided."""
+    actual_p, actual_v, output = measured
+    ref_p, ref_v, ref_a = reference
     end = verdict.end_index + 1
     return ExecutionReport(
         ok=verdict.ok,
@@ -194,13 +192,42 @@ def simulate(
         actual_velocities=actual_v[:end],
         output=_hold_on_abort(output[:end], initial_output, verdict.result.code),
         error=position_error(ref_p[:end], actual_p[:end], continuous),
-        output_interface=plant.interface,
+        output_interface=interface,
     )
+
+
+def _judge_cycles(
+    trajectory: JointTrajectory,
+    controller: ControllerConfig,
+    grid: NDArray[np.float64],
+    reference: _PerCycle,
+    timeout: Timeout,
+    continuous: NDArray[np.bool_],
+) -> Callable[[NDArray[np.float64], NDArray[np.float64]], ToleranceReport]:
+    """Return the verdict on the first K cycles of `grid`, given the K states read so far."""
+    ref_p, ref_v, _ = reference
+    tolerances = segment_tolerances(controller)
+    velocities = velocity_error_computable(controller)
+
+    def verdict_of(actual_p: NDArray[np.float64], actual_v: NDArray[np.float64]) -> ToleranceReport:
+        k = len(actual_p)
+        return judge(
+            tolerances, grid[:k], ref_p[:k], actual_p,
+            # Jazzy's update() takes the segment from its second sample: the command's, at t + dt.
+            before_last_point=grid[1 : k + 1] < trajectory.duration_s,
+            last_point_s=trajectory.duration_s,
+            timeout=timeout,
+            reference_velocities=ref_v[:k] if velocities else None,
+            actual_velocities=actual_v if velocities else None,
+            continuous=continuous,
+        )
+
+    return verdict_of
 
 
 def _run(
     plant: Plant,
-    reference: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]],
+    reference: _PerCycle,
     bumps: NDArray[np.float64],
     initial: tuple[NDArray[np.float64], NDArray[np.float64]],
     dt: float,

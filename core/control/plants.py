@@ -17,7 +17,7 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from ..config.robot_config import ControllerConfig
+from ..config.controllers import ControllerConfig
 from ..errors import UsageError, known
 from .tolerances import position_error
 

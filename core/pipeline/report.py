@@ -1,21 +1,30 @@
-"""An execution's result: its document (in the executed file and `--json`), and the executed file."""
+"""Results of execute and check-tolerances: their documents (in the executed file and `--json`), and the executed file.
+
+One document per command, built here and nowhere else, so that the executed file and
+`--json` say the same; numbers that are not finite (a diverged plant) are null, so every
+document is strict JSON.
+"""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
+from .. import bag as recording
 from ..bag import messages as msgs
-from ..bag import recording
 from ..control.published import controller_states
+from ..errors import InputError
 from ..types import TfSamples
 
 if TYPE_CHECKING:
     from pathlib import Path
 
+    from ..control.check_report import CheckReport
+    from ..control.results import ExecutionResult, Violation
     from .execute import PlanExecution
 
-__all__ = ["execution_document", "finite", "write_execution"]
+__all__ = ["check_document", "execution_document", "finite", "write_execution"]
 
 
 def write_execution(path: Path, execution: PlanExecution, distro: str = "jazzy", tf: TfSamples | None = None) -> None:
@@ -45,11 +54,12 @@ def write_execution(path: Path, execution: PlanExecution, distro: str = "jazzy",
 
 
 def execution_document(execution: PlanExecution) -> dict[str, Any]:
-    """Return the result JSON document of an execution; non-finite numbers become null.
+    """Return the result document of an execution: the executed file's, and `execute --json`'s.
 
-    Keys: ok, result {code, name, message}, violations (each with its step; times from the
-    step's start), margins, then controller, duration_s and steps (name, ok, result,
-    start_s and duration_s on the execution's timeline).
+    Keys: ok, result {code, name, message}, violations (each with its step: step, check,
+    joint, time_s, reference, actual, error, tolerance; times from the step's start),
+    margins {joint: margin}, then controller, duration_s and steps (name, ok, result,
+    start_s and duration_s on the execution's timeline). Non-finite numbers are null.
     """
     steps, start_ns = [], 0
     for step in execution.steps:
@@ -60,35 +70,94 @@ def execution_document(execution: PlanExecution) -> dict[str, Any]:
                 "ok": report.ok,
                 "result": report.result.name,
                 "start_s": start_ns / 1e9,
-                "duration_s": finite(report.duration_s),
+                "duration_s": report.duration_s,
             }
         )
         start_ns += msgs.seconds_to_ns(report.duration_s)
-    result = execution.result
-    return {
-        "ok": execution.ok,
-        "result": {"code": result.code, "name": result.name, "message": result.message},
-        "violations": [
-            {
-                "step": name,
-                "check": v.check,
-                "joint": v.joint,
-                "time_s": finite(v.time_s),
-                "reference": finite(v.reference),
-                "actual": finite(v.actual),
-                "error": finite(v.error),
-                "tolerance": finite(v.tolerance),
-            }
-            for name, v in execution.violations
-        ],
-        "margins": {joint: finite(margin) for joint, margin in execution.margins.items()},
+    return _finite_numbers({
+        **_verdict(execution.ok, execution.result, execution.violations, execution.margins),
         "controller": execution.controller.name,
         "duration_s": start_ns / 1e9,
         "steps": steps,
+    })
+
+
+def check_document(report: CheckReport, recording: Path) -> dict[str, Any]:
+    """Return the result document of a check of `recording`: `check-tolerances --json`'s.
+
+    Keys: ok, result, violations and margins as in `execution_document`; duration_s and
+    start_s (the first execution's start, from the recording's first sample); steps (name,
+    ok, result, start_s, duration_s, aligned_by); gaps [{start_s, length_s}]; warnings;
+    error, null unless no execution is complete: then {exit_code, kind, message}, the check
+    could not be done on this recording (bad input). With `start="all"` also cycles
+    [{index, start_s, ok, result, worst_margin}], failing_cycles and incomplete_cycles.
+    "ok" of a step or cycle is null when the recording cuts it off before a verdict
+    (INCOMPLETE). Non-finite numbers are null.
+    """
+    error = None
+    if not report.complete:
+        cut = InputError(f"{recording}: {report.result.message}")
+        error = {"exit_code": cut.exit_code, "kind": cut.kind, "message": str(cut)}
+    document: dict[str, Any] = {
+        **_verdict(report.ok, report.result, report.violations, report.margins),
+        "duration_s": report.duration_s,
+        "start_s": report.start_s,
+        "steps": [{"name": s.name, "ok": s.ok if s.complete else None, "result": s.report.result.name,
+                   "start_s": s.start_s, "duration_s": s.duration_s, "aligned_by": s.aligned_by}
+                  for s in report.steps],
+        "gaps": [{"start_s": start, "length_s": length} for start, length in report.gaps],
+        "warnings": list(report.warnings),
+        "error": error,
     }
+    if report.cycles:
+        document["cycles"] = [{"index": c.index, "start_s": c.start_s, "ok": c.ok if c.complete else None,
+                               "result": _result(c.result), "worst_margin": c.worst_margin}
+                              for c in report.cycles]
+        document["failing_cycles"] = list(report.failing_cycles)
+        document["incomplete_cycles"] = list(report.incomplete_cycles)
+    return _finite_numbers(document)
 
 
 def finite(value: float) -> float | None:
     """Return `value` as a float, or None (JSON null) if NaN or infinite (a diverged plant)."""
     number = float(value)
     return number if math.isfinite(number) else None
+
+
+def _verdict(
+    ok: bool, result: ExecutionResult, violations: Iterable[tuple[str, Violation]], margins: Mapping[str, float]
+) -> dict[str, Any]:
+    """Return the head both documents share: ok, result, violations (with their step), margins."""
+    return {
+        "ok": ok,
+        "result": _result(result),
+        "violations": [
+            {
+                "step": step,
+                "check": v.check,
+                "joint": v.joint,
+                "time_s": v.time_s,
+                "reference": v.reference,
+                "actual": v.actual,
+                "error": v.error,
+                "tolerance": v.tolerance,
+            }
+            for step, v in violations
+        ],
+        "margins": dict(margins),
+    }
+
+
+def _result(result: ExecutionResult) -> dict[str, Any]:
+    return {"code": result.code, "name": result.name, "message": result.message}
+
+
+def _finite_numbers(value: Any) -> Any:
+    """Return `value` with every float in it, at any depth, made `finite`: strict JSON."""
+    if isinstance(value, float):
+        return finite(value)
+    if isinstance(value, dict):
+        return {key: _finite_numbers(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite_numbers(item) for item in value]
+    return value

@@ -1,0 +1,102 @@
+"""What every part of a recording check shares, computed once: samples, step profiles, tolerances."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..config.controllers import ControllerConfig, ExecutionConfig
+from ..types import JointStateSeries, JointTrajectory
+from .alignment import ZONE_RAD, Samples, StepProfile
+from .tolerances import SegmentTolerances, in_controller_order, segment_tolerances, velocity_error_computable
+
+__all__ = ["CheckContext", "CheckedPlan", "CheckedStep"]
+
+
+class CheckedStep(Protocol):
+    """A step of the plan checked: its name, start on the plan's timeline and trajectory."""
+
+    @property
+    def name(self) -> str:
+        """The step's name."""
+
+    @property
+    def start_s(self) -> float:
+        """Where the step starts on the plan's timeline, in [s]."""
+
+    @property
+    def trajectory(self) -> JointTrajectory:
+        """The step's trajectory, its times from the step's start."""
+
+
+class CheckedPlan(Protocol):
+    """The plan checked: its steps (a PlanFile is one)."""
+
+    @property
+    def steps(self) -> Sequence[CheckedStep]:
+        """The plan's steps, in order."""
+
+
+@dataclass(frozen=True)
+class CheckContext:
+    """Everything the checks share, computed once.
+
+    Attributes:
+        samples: The recorded positions in controller order, with their times.
+        profiles: Per step of the plan, its trajectory in controller order and how it departs.
+        velocities: The recorded velocities in the recording's column order, or None.
+        check_velocities: True if JTC computes velocity errors and the recording has velocities.
+        controller: The JointTrajectoryController whose tolerances apply.
+        execution: MoveIt's trajectory_execution settings.
+        tolerances: The controller's tolerances.
+        warnings: What the recording lacks: samples too sparse, no velocities.
+    """
+
+    samples: Samples
+    profiles: tuple[StepProfile, ...]
+    velocities: NDArray[np.float64] | None
+    check_velocities: bool
+    controller: ControllerConfig
+    execution: ExecutionConfig
+    tolerances: SegmentTolerances
+    warnings: tuple[str, ...]
+
+    @staticmethod
+    def build(
+        plan: CheckedPlan, series: JointStateSeries, controller: ControllerConfig,
+        execution: ExecutionConfig, continuous_joints: Iterable[str],
+    ) -> CheckContext:
+        """Return the context of checking `series` against `plan` with these settings."""
+        samples = Samples.build(series, controller.joints, continuous_joints)
+        zone = max(ZONE_RAD, 2.0 * execution.allowed_start_tolerance)
+        profiles = tuple(
+            StepProfile.build(step.name, in_controller_order(step.trajectory, controller),
+                              samples.continuous, zone)
+            for step in plan.steps
+        )
+        computable = velocity_error_computable(controller)
+        warnings = []
+        period = samples.period_s
+        if period > 1.5 / controller.update_rate_hz:
+            warnings.append(
+                f"the recording has a sample every {period * 1e3:.3g} ms, the controller checks "
+                f"every {1e3 / controller.update_rate_hz:.3g} ms: short excursions between "
+                "samples are not seen")
+        if series.velocities is None and computable:
+            warnings.append("the recording carries no velocities: the stopped velocity "
+                            "tolerance is not checked")
+        return CheckContext(samples, profiles, series.velocities,
+                            computable and series.velocities is not None, controller, execution,
+                            segment_tolerances(controller), tuple(warnings))
+
+    def before_recording(self, start: float) -> bool:
+        """Return True if a goal started at `start` [s] was sent before the recording's first sample.
+
+        A sample period of slack: an execution recorded from its send time (an executed file)
+        is aligned to within a period of its first sample, on either side.
+        """
+        return start < float(self.samples.times[0]) - self.samples.period_s
