@@ -159,7 +159,8 @@ def judge(values: Any, stop: bool, base: Any, group: Any, continuous: Any, model
 
     Returns how many states were judged: all, or with `stop` up to the first COLLIDES.
     One loop over all states: a function called per state would be passed every array of
-    the model each time, which costs more than the judging.
+    the model each time, which costs more than the judging. Measured: moving its stages into
+    @njit helpers, inlined by numba or not, makes classify and edge 9-29 % slower.
     """
     tables, joints, spheres, owners, inner, pairs, obstacles, check = model
     centres, radii, sjoint, start = spheres

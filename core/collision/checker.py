@@ -151,6 +151,29 @@ def _geometry_error(config: RobotConfig, exc: Exception) -> ConfigError:
     return ConfigError(f"{config.urdf_path}: cannot load collision geometry: {' '.join(text.split())}")
 
 
+def _pairs_to_check(
+    owner: list[str],
+    touch: list[frozenset[str]],
+    joint_of: list[int],
+    robot_count: int,
+    disabled: frozenset[frozenset[str]],
+) -> tuple[list[tuple[int, int]], list[tuple[int, int]]]:
+    """Return the geometry pairs (i < j) that may touch: on two joints (checked per state), and on one."""
+    moving: list[tuple[int, int]] = []
+    fixed: list[tuple[int, int]] = []
+    for i in range(len(owner)):
+        for j in range(i + 1, len(owner)):
+            a, b = owner[i], owner[j]
+            if a == b or frozenset((a, b)) in disabled:
+                continue
+            if a in touch[j] or b in touch[i]:
+                continue  # an attached object may touch its link and touch_links
+            if i >= robot_count and j >= robot_count and (joint_of[i] == 0 and joint_of[j] == 0):
+                continue  # world objects never move relative to each other
+            (fixed if joint_of[i] == joint_of[j] else moving).append((i, j))
+    return moving, fixed
+
+
 class CollisionChecker:
     """Answers whether robot configurations collide, and which pair collides."""
 
@@ -194,22 +217,10 @@ class CollisionChecker:
             geom.addGeometryObject(self._placed(obj, source))
         self.owner = tuple(owner)
         robot_count = len(owner) - len(objects)
-        joint_of = [g.parentJoint for g in geom.geometryObjects]
-        disabled = config.srdf.disabled_pairs | allowed
-        fixed_pairs: list[tuple[int, int]] = []
-        for i in range(len(owner)):
-            for j in range(i + 1, len(owner)):
-                a, b = owner[i], owner[j]
-                if a == b or frozenset((a, b)) in disabled:
-                    continue
-                if a in touch[j] or b in touch[i]:
-                    continue  # an attached object may touch its link and touch_links
-                if i >= robot_count and j >= robot_count and (joint_of[i] == 0 and joint_of[j] == 0):
-                    continue  # world objects never move relative to each other
-                if joint_of[i] == joint_of[j]:
-                    fixed_pairs.append((i, j))
-                else:
-                    geom.addCollisionPair(pin.CollisionPair(i, j))
+        moving_pairs, fixed_pairs = _pairs_to_check(owner, touch, [g.parentJoint for g in geom.geometryObjects],
+                                                    robot_count, config.srdf.disabled_pairs | allowed)
+        for i, j in moving_pairs:
+            geom.addCollisionPair(pin.CollisionPair(i, j))
         self.geometry = geom
         self.data = geom.createData()
         # A broadphase (AABB tree) culls most pairs: 3-4x faster per state than testing each pair.

@@ -14,12 +14,13 @@ overlaps, surely collides under the hulls. Anything else is "maybe": the caller 
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from ..errors import UnsupportedJoint
 from ..model.robot import Robot
 from ..types import CollisionObject
 from ._verdicts import CLEAR, COLLIDES, MAYBE
@@ -34,10 +35,6 @@ __all__ = ["CLEAR", "COLLIDES", "MAYBE", "SphereFilter", "UnsupportedJoint"]
 _REVOLUTE, _PRISMATIC, _UNBOUNDED = 1, 2, 3
 _AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
 _BOX, _SPHERE, _CYLINDER = 0, 1, 2
-
-
-class UnsupportedJoint(ValueError):
-    """The robot has a joint the filter's kinematics do not handle."""
 
 
 def _joint_kind(model: pin.Model, jid: int) -> tuple[int, tuple[float, float, float]]:
@@ -75,55 +72,18 @@ class SphereFilter:
             UnsupportedJoint: The robot has a joint kind the kernel does not handle.
         """
         model = robot.model
-        kinds = [(0, (0.0, 0.0, 1.0))] + [_joint_kind(model, j) for j in range(1, model.njoints)]
-        robot_set = robot_spheres(model, geometry, robot.config.urdf)
-        centres, radii = [robot_set.centres], [robot_set.radii]
-        joints, owners = [robot_set.joints], list(robot_set.owners)
-        touch: dict[str, frozenset[str]] = {}
-        world = [obj for obj in objects if not obj.link]
-        for obj in objects:
-            if obj.link:
-                frame = model.frames[model.getFrameId(obj.link)]
-                c, r = fit_shape(obj.shape, np.asarray(frame.placement.homogeneous) @ obj.transform)
-                centres.append(c)
-                radii.append(r)
-                joints.append(np.full(len(r), frame.parentJoint))
-                owners.extend([obj.name] * len(r))
-                touch[obj.name] = frozenset((obj.link, *obj.touch_links))
-        names = list(dict.fromkeys(owners))
-        owner_index = np.array([names.index(o) for o in owners], dtype=np.int64)
-        order = np.argsort(owner_index, kind="stable")
-        centre, radius = np.concatenate(centres)[order], np.concatenate(radii)[order]
-        joint = np.concatenate(joints)[order]
-        start = np.searchsorted(owner_index[order], np.arange(len(names) + 1))
-        # Each owner's bounding ball, in its joint's frame.
-        owner_joint = joint[start[:-1]]
-        owner_centre, owner_radius = np.zeros((len(names), 3)), np.zeros(len(names))
-        for k in range(len(names)):
-            c, r = centre[start[k]:start[k + 1]], radius[start[k]:start[k + 1]]
-            owner_centre[k] = (c.min(axis=0) + c.max(axis=0)) / 2
-            owner_radius[k] = np.max(np.linalg.norm(c - owner_centre[k], axis=1) + r)
-
+        joints = _joint_arrays(model)  # first: an unsupported joint fails before the spheres are fitted
+        spheres, touch = _owned_spheres(robot, geometry, objects)
+        names = spheres.names
+        owner_joint, owner_centre, owner_radius = _owner_balls(spheres)
         disabled = robot.config.srdf.disabled_pairs | allowed
-        pairs = []
-        for a in range(len(names)):
-            for b in range(a + 1, len(names)):
-                na, nb = names[a], names[b]
-                if owner_joint[a] == owner_joint[b] or frozenset((na, nb)) in disabled:
-                    continue
-                if na in touch.get(nb, ()) or nb in touch.get(na, ()):
-                    continue
-                pairs.append((a, b))
         # Pairs whose distance depends on one or two joints (a wrist's links) are looked up in tables.
         tables = [t for t in pair_tables(model, hulls or geometry, robot.config.srdf.disabled_pairs, robot.config.urdf)
                   if frozenset((t.upper, t.lower)) not in disabled]
-        tabulated = {frozenset((t.upper, t.lower)) for t in tables}
-        pairs = [(a, b) for a, b in pairs if frozenset((names[a], names[b])) not in tabulated]
+        pairs = _owner_pairs(names, owner_joint, disabled, touch, tables)
         self.tabulated = tuple((t.upper, t.lower) for t in tables)
-        # A link fixed to the world (a base) never moves relative to world obstacles: the collision
-        # checker tests those pairs once, when the scene loads, so no state needs to.
-        check = np.array([[frozenset((name, obj.name)) not in allowed and owner_joint[k] != 0 for obj in world]
-                          for k, name in enumerate(names)]).reshape(len(names), len(world))
+        world = [obj for obj in objects if not obj.link]
+        check = _world_checks(names, owner_joint, world, allowed)
         from . import _kernels as sphere_kernels  # numba: compiled once, then loaded from its disk cache
 
         self._kernels = sphere_kernels
@@ -131,11 +91,8 @@ class SphereFilter:
         inner = inner_spheres(model, hulls or geometry, robot.config.urdf)
         # Packed once: the kernels run thousands of times per search, and a call costs per argument.
         self._packed = sphere_kernels.pack({
-            "base": base, "group": robot.q_index, "continuous": robot.continuous, **_table_arrays(tables),
-            "parents": model.parents, "kinds": [k for k, _ in kinds], "axes": [a for _, a in kinds],
-            "iq": model.idx_qs, "prot": [np.asarray(p.rotation) for p in model.jointPlacements],
-            "ptrans": [np.asarray(p.translation) for p in model.jointPlacements],
-            "centres": centre, "radii": radius, "sjoint": joint, "start": start,
+            "base": base, "group": robot.q_index, "continuous": robot.continuous, **_table_arrays(tables), **joints,
+            "centres": spheres.centre, "radii": spheres.radius, "sjoint": spheres.joint, "start": spheres.start,
             "ojoint": owner_joint, "ocentre": owner_centre, "oradius": owner_radius,
             **_inner_arrays(inner, names), "pairs": np.reshape(pairs, (-1, 2)), **_obstacles(world), "check": check})
         self._nq = model.nq
@@ -170,6 +127,95 @@ class SphereFilter:
             self._verdicts, self._unclear = np.empty(-kept, dtype=np.int8), np.empty((-kept, self._nq))
             return self.edge(a, b, resolution, stop)
         return worst, self._verdicts[:kept], self._unclear[:kept]
+
+
+def _joint_arrays(model: pin.Model) -> dict[str, Any]:
+    """Return the joint tree as the kernel's arrays (raises UnsupportedJoint for a kind the kernel lacks)."""
+    kinds = [(0, (0.0, 0.0, 1.0))] + [_joint_kind(model, j) for j in range(1, model.njoints)]
+    return {"parents": model.parents, "kinds": [k for k, _ in kinds], "axes": [a for _, a in kinds],
+            "iq": model.idx_qs, "prot": [np.asarray(p.rotation) for p in model.jointPlacements],
+            "ptrans": [np.asarray(p.translation) for p in model.jointPlacements]}
+
+
+class _Spheres(NamedTuple):
+    """Every owner's enclosing spheres, grouped by owner: owner `k`'s are rows `start[k]:start[k + 1]`."""
+
+    names: list[str]  # owners: links, then attached objects
+    centre: NDArray[np.float64]  # (n, 3), in the frame of the sphere's joint [m]
+    radius: NDArray[np.float64]  # (n,) [m]
+    joint: NDArray[np.int64]  # (n,) pinocchio joint index
+    start: NDArray[np.int64]  # (owners + 1,)
+
+
+def _owned_spheres(
+    robot: Robot, geometry: pin.GeometryModel, objects: tuple[CollisionObject, ...]
+) -> tuple[_Spheres, dict[str, frozenset[str]]]:
+    """Return the spheres of the robot and its attached objects by owner, and per attached object what it may touch."""
+    model = robot.model
+    robot_set = robot_spheres(model, geometry, robot.config.urdf)
+    centres, radii = [robot_set.centres], [robot_set.radii]
+    joints, owners = [robot_set.joints], list(robot_set.owners)
+    touch: dict[str, frozenset[str]] = {}
+    for obj in objects:
+        if obj.link:
+            frame = model.frames[model.getFrameId(obj.link)]
+            c, r = fit_shape(obj.shape, np.asarray(frame.placement.homogeneous) @ obj.transform)
+            centres.append(c)
+            radii.append(r)
+            joints.append(np.full(len(r), frame.parentJoint))
+            owners.extend([obj.name] * len(r))
+            touch[obj.name] = frozenset((obj.link, *obj.touch_links))
+    names = list(dict.fromkeys(owners))
+    owner_index = np.array([names.index(o) for o in owners], dtype=np.int64)
+    order = np.argsort(owner_index, kind="stable")
+    start = np.searchsorted(owner_index[order], np.arange(len(names) + 1))
+    return _Spheres(names, np.concatenate(centres)[order], np.concatenate(radii)[order],
+                    np.concatenate(joints)[order], start), touch
+
+
+def _owner_balls(
+    spheres: _Spheres,
+) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]]:
+    """Return each owner's joint, and the centre (in that joint's frame) and radius of its bounding ball."""
+    start, count = spheres.start, len(spheres.names)
+    owner_centre, owner_radius = np.zeros((count, 3)), np.zeros(count)
+    for k in range(count):
+        c, r = spheres.centre[start[k]:start[k + 1]], spheres.radius[start[k]:start[k + 1]]
+        owner_centre[k] = (c.min(axis=0) + c.max(axis=0)) / 2
+        owner_radius[k] = np.max(np.linalg.norm(c - owner_centre[k], axis=1) + r)
+    return spheres.joint[start[:-1]], owner_centre, owner_radius
+
+
+def _owner_pairs(
+    names: list[str],
+    owner_joint: NDArray[np.int64],
+    disabled: frozenset[frozenset[str]],
+    touch: dict[str, frozenset[str]],
+    tables: list[PairTable],
+) -> list[tuple[int, int]]:
+    """Return the owner pairs (a < b) whose spheres are checked: on two joints, never allowed to touch, untabulated."""
+    tabulated = {frozenset((t.upper, t.lower)) for t in tables}
+    pairs = []
+    for a in range(len(names)):
+        for b in range(a + 1, len(names)):
+            na, nb = names[a], names[b]
+            if owner_joint[a] == owner_joint[b] or frozenset((na, nb)) in disabled:
+                continue
+            if na in touch.get(nb, ()) or nb in touch.get(na, ()):
+                continue
+            if frozenset((na, nb)) not in tabulated:
+                pairs.append((a, b))
+    return pairs
+
+
+def _world_checks(
+    names: list[str], owner_joint: NDArray[np.int64], world: list[CollisionObject], allowed: frozenset[frozenset[str]]
+) -> NDArray[np.bool_]:
+    """Return per owner and world obstacle whether a state must check them, shape (owners, obstacles)."""
+    # A link fixed to the world (a base) never moves relative to world obstacles: the collision
+    # checker tests those pairs once, when the scene loads, so no state needs to.
+    return np.array([[frozenset((name, obj.name)) not in allowed and owner_joint[k] != 0 for obj in world]
+                     for k, name in enumerate(names)]).reshape(len(names), len(world))
 
 
 def _inner_arrays(inner: SphereSet, names: list[str]) -> dict[str, NDArray[Any]]:

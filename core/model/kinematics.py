@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import weakref
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import eigenpy
 import numpy as np
@@ -100,6 +100,23 @@ def solve_ik(
             error reached, or says that every solution found collides.
     """
     solver = _solver(robot)
+    frame, root_T_target, reference, base = _checked_inputs(robot, solver, target, link, start, base)
+    # Converging to half the tolerance leaves margin for callers that re-measure the pose
+    # with other arithmetic (arccos of the trace loses digits near zero).
+    tolerances = (0.5 * position_tolerance, 0.5 * orientation_tolerance)
+    outcome = _search(solver, reference, base, frame, root_T_target, tolerances, is_free, seed, max_attempts,
+                     exhaustive)
+    if outcome.best is not None:
+        best = outcome.best
+        return IkSolution(best.values, best.position_m, best.angle_rad, outcome.attempts)
+    raise _unreachable(robot, solver, outcome, link, root_T_target, reference, base, colliding_pair)
+
+
+def _checked_inputs(
+    robot: Robot, solver: _Solver, target: npt.ArrayLike, link: str, start: npt.ArrayLike,
+    base: NDArray[np.float64] | None,
+) -> tuple[int, pin.SE3, NDArray[np.float64], NDArray[np.float64]]:
+    """Return the frame id of `link`, `root_T_target`, the start values and the base configuration, checked."""
     if not robot.model.existFrame(link):
         raise UnknownName("link", link, str(robot.config.urdf_path), robot.link_names)
     frame = robot.model.getFrameId(link)
@@ -111,14 +128,27 @@ def solve_ik(
     if base.shape != solver.neutral.shape:
         raise InputError(f"IK base configuration: expected shape {solver.neutral.shape}, "
                          f"got {base.shape}")
-    # Converging to half the tolerance leaves margin for callers that re-measure the pose
-    # with other arithmetic (arccos of the trace loses digits near zero).
-    tolerances = (0.5 * position_tolerance, 0.5 * orientation_tolerance)
+    return frame, root_T_target, reference, base
 
-    rng: np.random.Generator | None = None
-    best: _Attempt | None = None
+
+@dataclass
+class _Outcome:
+    """What the local solve and the restarts found."""
+
+    best: _Attempt | None = None  # the valid solution nearest the start
     closest: _Attempt | None = None  # of the attempts that did not converge
-    colliding: list[NDArray[np.float64]] = []
+    colliding: list[NDArray[np.float64]] = field(default_factory=list)  # converged, but not free
+    attempts: int = 0
+
+
+def _search(
+    solver: _Solver, reference: NDArray[np.float64], base: NDArray[np.float64], frame: int, root_T_target: pin.SE3,
+    tolerances: tuple[float, float], is_free: Callable[[NDArray[np.float64]], bool] | None, seed: int,
+    max_attempts: int, exhaustive: bool,
+) -> _Outcome:
+    """Return what the local solve from `reference`, then seeded restarts if needed, found."""
+    found = _Outcome()
+    rng: np.random.Generator | None = None
     valid = attempts = 0
     while attempts < max(1, max_attempts):
         if attempts == 0:
@@ -129,24 +159,33 @@ def solve_ik(
         attempts += 1
         attempt = solver.descend(guess, base, frame, root_T_target, tolerances)
         if not attempt.converged:
-            if closest is None or attempt.residual < closest.residual:
-                closest = attempt
+            if found.closest is None or attempt.residual < found.closest.residual:
+                found.closest = attempt
             continue
         values = solver.nearest_turn(attempt.values, reference)
         if is_free is not None and not is_free(values):
-            colliding.append(values)
+            found.colliding.append(values)
             continue
         valid += 1
         distance = solver.distance(values, reference)
-        if best is None or distance < best.distance:
-            best = _Attempt(values, attempt.position_m, attempt.angle_rad, attempt.residual, True,
-                            distance)
+        if found.best is None or distance < found.best.distance:
+            found.best = _Attempt(values, attempt.position_m, attempt.angle_rad, attempt.residual, True,
+                                  distance)
         if not exhaustive and (attempts == 1 or valid >= _VALID_SOLUTIONS):
             break  # the local solution from the start moves least; restarts gather a few to compare
-    if best is not None:
-        return IkSolution(best.values, best.position_m, best.angle_rad, attempts)
+    found.attempts = attempts
+    return found
+
+
+def _unreachable(
+    robot: Robot, solver: _Solver, outcome: _Outcome, link: str, root_T_target: pin.SE3,
+    reference: NDArray[np.float64], base: NDArray[np.float64],
+    colliding_pair: Callable[[NDArray[np.float64]], tuple[str, str] | None] | None,
+) -> GoalUnreachable:
+    """Return the error for a search with no valid solution: the closest pose error, or what the solutions hit."""
     x, y, z = root_T_target.translation
     where = f"no IK solution for link '{link}' at [{x:.3f} {y:.3f} {z:.3f}]"
+    attempts, colliding, closest = outcome.attempts, outcome.colliding, outcome.closest
     tries = f"after {attempts} attempt{'s' if attempts != 1 else ''}"
     if colliding:
         count = len(colliding)
@@ -156,10 +195,10 @@ def solve_ik(
             nearest = min(colliding, key=lambda values: solver.distance(values, reference))
             pair = colliding_pair(robot.configuration(nearest, base))
             text += f" (nearest the start: {pair[0]} touches {pair[1]})" if pair else ""
-        raise GoalUnreachable(f"{text} {tries}")
+        return GoalUnreachable(f"{text} {tries}")
     assert closest is not None  # no attempt converged, so every one was a candidate
-    raise GoalUnreachable(f"{where}: closest reached {closest.position_m * 1e3:.1f} mm, "
-                          f"{closest.angle_rad:.3g} rad away {tries}")
+    return GoalUnreachable(f"{where}: closest reached {closest.position_m * 1e3:.1f} mm, "
+                           f"{closest.angle_rad:.3g} rad away {tries}")
 
 
 @dataclass(frozen=True)

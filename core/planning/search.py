@@ -191,19 +191,56 @@ def _plan(
     planner: str,
     work: _Work,
 ) -> PathResult:
-    dof = len(start)
+    """Return the straight segment if free, else the path OMPL planner `planner` finds within `work`, shortened."""
+    space = _bounded_space(len(start), lower, upper)
+    setup = og.SimpleSetup(space)
+    values = _state_reader(len(start))
+    info = _checked_by(setup, validity, work, values)
+    endpoints = [_state(space, point) for point in (start, goal)]
+    setup.setStartAndGoalStates(endpoints[0], endpoints[1])
+    setup.setPlanner(_planner(planner, info))
+
+    began, spent_before = time.perf_counter(), work.used
+    work.used += 1
+    if validity.edge_free(start, goal):
+        # A free straight segment is what any search plus shortcutting converges to.
+        return PathResult(np.array([start, goal]), planner, time.perf_counter() - began, 0.0, 1)
+    planner, status = _search(setup, info, planner, work)
+    planning_s = time.perf_counter() - began
+    if not setup.haveExactSolutionPath():
+        raise work.failure(planner, status)
+    began = time.perf_counter()
+    waypoints = _shortened(setup, info, values)
+    simplify_s = time.perf_counter() - began
+    waypoints[0], waypoints[-1] = start, goal
+    return PathResult(waypoints, planner, planning_s, simplify_s, work.used - spent_before)
+
+
+def _bounded_space(dof: int, lower: NDArray[np.float64], upper: NDArray[np.float64]) -> ob.RealVectorStateSpace:
+    """Return OMPL's space of `dof` group joint values, bounded by the joint limits."""
     space = ob.RealVectorStateSpace(dof)
     bounds = ob.RealVectorBounds(dof)
     for i in range(dof):
         bounds.setLow(i, float(lower[i]))
         bounds.setHigh(i, float(upper[i]))
     space.setBounds(bounds)
-    setup = og.SimpleSetup(space)
+    return space
 
+
+def _state_reader(dof: int) -> Callable[[ob.State], NDArray[np.float64]]:
+    """Return the function that reads an OMPL state's `dof` coordinates as an array."""
     coordinates = itemgetter(*range(dof))  # a tenth of the cost of indexing in a Python loop
 
     def values(state: ob.State) -> NDArray[np.float64]:
         return np.array(coordinates(state), ndmin=1)
+
+    return values
+
+
+def _checked_by(
+    setup: og.SimpleSetup, validity: Validity, work: _Work, values: Callable[[ob.State], NDArray[np.float64]]
+) -> ob.SpaceInformation:
+    """Return `setup`'s space information, its states and edges now checked by `validity`, each check counted."""
 
     def state_free(state: ob.State) -> bool:
         work.used += 1
@@ -220,20 +257,21 @@ def _plan(
 
     info = setup.getSpaceInformation()
     info.setMotionValidator(EdgeValidator(info))
-    endpoints = []
-    for point in (start, goal):
-        state = space.allocState()
-        for i, value in enumerate(point):
-            state[i] = float(value)
-        endpoints.append(state)
-    setup.setStartAndGoalStates(endpoints[0], endpoints[1])
-    setup.setPlanner(_planner(planner, info))
+    return info
 
-    began, spent_before = time.perf_counter(), work.used
-    work.used += 1
-    if validity.edge_free(start, goal):
-        # A free straight segment is what any search plus shortcutting converges to.
-        return PathResult(np.array([start, goal]), planner, time.perf_counter() - began, 0.0, 1)
+
+def _state(space: ob.RealVectorStateSpace, point: NDArray[np.float64]) -> ob.State:
+    """Return a new OMPL state of `space` at `point`."""
+    state = space.allocState()
+    for i, value in enumerate(point):
+        state[i] = float(value)
+    return state
+
+
+def _search(
+    setup: og.SimpleSetup, info: ob.SpaceInformation, planner: str, work: _Work
+) -> tuple[str, ob.PlannerStatus]:
+    """Return the planner name, "+fallback" if its first share of the budget found no path, and OMPL's status."""
     fallback = _FALLBACK.get(planner)
     first_share = work.used + math.ceil((work.budget - work.used) * _FALLBACK_AFTER) if fallback else work.budget
     status = setup.solve(work.until(first_share))
@@ -242,15 +280,15 @@ def _plan(
         setup.setPlanner(_planner(fallback, info))
         planner = f"{planner}+{fallback}"
         status = setup.solve(work.until(work.budget))
-    planning_s = time.perf_counter() - began
-    if not setup.haveExactSolutionPath():
-        raise work.failure(planner, status)
-    began = time.perf_counter()
+    return planner, status
+
+
+def _shortened(
+    setup: og.SimpleSetup, info: ob.SpaceInformation, values: Callable[[ob.State], NDArray[np.float64]]
+) -> NDArray[np.float64]:
+    """Return the waypoints of `setup`'s solution path after rope shortcutting, shape (K, dof)."""
     path = setup.getSolutionPath()
     # Rope shortcutting (OMPL 2.0) reaches the quality of the full simplify() on MotionBenchMaker
     # problems with about a tenth of its edge checks.
     og.PathSimplifier(info).ropeShortcutPath(path)
-    waypoints = np.array([values(path.getState(k)) for k in range(path.getStateCount())])
-    simplify_s = time.perf_counter() - began
-    waypoints[0], waypoints[-1] = start, goal
-    return PathResult(waypoints, planner, planning_s, simplify_s, work.used - spent_before)
+    return np.array([values(path.getState(k)) for k in range(path.getStateCount())])
