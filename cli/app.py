@@ -8,21 +8,25 @@ from __future__ import annotations
 
 import logging
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from moveplan.cli.errors import exit_codes
 from moveplan.cli.parsing import (
     parse_disturbance,
+    parse_joint_values,
     parse_joints,
     parse_number,
+    parse_optional,
     parse_params,
     parse_pose,
-    parse_scaling,
     parse_seeds,
     parse_shift,
 )
+
+if TYPE_CHECKING:  # each command imports the core it runs, so that `moveplan --help` stays fast
+    from moveplan.core.pipeline.request import PlanFlags
 
 __all__ = ["app", "main"]
 
@@ -86,69 +90,32 @@ def plan(
     with exit_codes(as_json):
         flags = _plan_flags(locals())
         from moveplan.cli import render
-        from moveplan.core.bag import recording
-        from moveplan.core.config.tasks import load_task
-        from moveplan.core.pipeline import plan as pipeline
+        from moveplan.core.pipeline.plan import plan_to_file
 
-        request = pipeline.resolve_request(load_task(task) if task else None, flags)
-        result = pipeline.plan(request)
-        recording.write_plan(output, result, ros_distro)
+        result = plan_to_file(task, flags, output, ros_distro)
     render.plan_summary(result, output, as_json, quiet)
 
 
-def _plan_flags(args: dict[str, Any]) -> dict[str, Any]:
-    """Return the plan flags as typed values, None where not given."""
-    from moveplan.core.config.tasks import StepSpec
+def _plan_flags(args: dict[str, Any]) -> PlanFlags:
+    """Return the plan command's flags as core's typed values; core checks the rules between them."""
     from moveplan.core.config.xacro import parse_xacro_args
-    from moveplan.core.errors import UsageError
+    from moveplan.core.pipeline.request import PlanFlags
 
-    starts = [k for k in ("start_joints", "start_named", "start_from") if args[k] is not None]
-    goals = [k for k in ("joints", "named", "pose", "shift") if args[k] is not None]
-    if len(starts) > 1 or len(goals) > 1:
-        given = ", ".join("--" + k.replace("_", "-") for k in starts + goals)
-        raise UsageError(f"give one start flag and one goal flag, got {given}")
-    start: dict[str, Any] = {}
-    if args["start_joints"] is not None:
-        start = parse_joints(args["start_joints"], "--start-joints")
-    elif args["start_named"] is not None:
-        start = {"named": args["start_named"]}
-    elif args["start_from"] is not None:
-        start = {"from": args["start_from"]}
-    for flag, needs in (("frame", "pose"), ("link", "pose"), ("shift_frame", "shift")):
-        if args[flag] is not None and args[needs] is None:
-            raise UsageError(f"--{flag.replace('_', '-')} goes with --{needs}")
-    if args["linear"] and not ({"pose", "shift"} & set(goals)):
-        raise UsageError("--linear goes with --pose or --shift")
-    steps = []
-    if args["joints"] is not None:
-        steps.append(StepSpec("goal", parse_joints(args["joints"], "--joints")))
-    elif args["named"] is not None:
-        steps.append(StepSpec(args["named"], {"named": args["named"]}))
-    elif args["pose"] is not None:
-        goal = {"pose": {**parse_pose(args["pose"], "--pose"), "frame": args["frame"], "link": args["link"]}}
-        steps.append(StepSpec("pose", goal, linear=args["linear"]))
-    elif args["shift"] is not None:
-        goal = {"shift": {**parse_shift(args["shift"], "--shift"), "frame": args["shift_frame"] or "tool"}}
-        steps.append(StepSpec("shift", goal, linear=args["linear"]))
-    min_fraction = None
-    if args["min_fraction"] is not None:
-        min_fraction = parse_number(args["min_fraction"], "--min-fraction")
-        if not 0.0 <= min_fraction <= 1.0:
-            raise UsageError(f"--min-fraction: expected a number in [0, 1], got '{args['min_fraction']}'")
-    planning_time = None
-    if args["planning_time"] is not None:
-        planning_time = parse_number(args["planning_time"], "--planning-time")
-        if planning_time <= 0:
-            raise UsageError(f"--planning-time: expected a positive number of seconds, got '{args['planning_time']}'")
-    return {
-        "robot": args["robot"], "scene": args["scene"], "request": args["motion_request"], "group": args["group"],
-        "start": start, "steps": steps,
-        "planner": args["planner"], "planning_time": planning_time, "seed": args["seed"],
-        "velocity_scaling": parse_scaling(args["velocity_scaling"], "--velocity-scaling"),
-        "acceleration_scaling": parse_scaling(args["acceleration_scaling"], "--acceleration-scaling"),
-        "package_paths": tuple(args["package_path"] or ()), "min_fraction": min_fraction,
-        "xacro_args": parse_xacro_args(args["xacro_arg"] or ()),
-    }
+    def number(key: str) -> float | None:
+        return parse_optional(parse_number, args[key], "--" + key.replace("_", "-"))
+
+    return PlanFlags(
+        robot=args["robot"], scene=args["scene"], request=args["motion_request"], group=args["group"],
+        start_joints=parse_optional(parse_joints, args["start_joints"], "--start-joints"),
+        start_named=args["start_named"], start_from=args["start_from"],
+        joints=parse_optional(parse_joints, args["joints"], "--joints"), named=args["named"],
+        pose=parse_optional(parse_pose, args["pose"], "--pose"), frame=args["frame"], link=args["link"],
+        shift=parse_optional(parse_shift, args["shift"], "--shift"), shift_frame=args["shift_frame"],
+        linear=args["linear"], min_fraction=number("min_fraction"), planner=args["planner"],
+        planning_time=number("planning_time"), seed=args["seed"], velocity_scaling=number("velocity_scaling"),
+        acceleration_scaling=number("acceleration_scaling"), package_paths=tuple(args["package_path"] or ()),
+        xacro_args=parse_xacro_args(args["xacro_arg"] or ()),
+    )
 
 
 @app.command()
@@ -181,11 +148,9 @@ def execute(
         request = ExecuteRequest(
             plan=plan_file, plant=plant, plant_params=parse_params(plant_param or [], "--plant-param"),
             disturbances=tuple(parse_disturbance(d) for d in disturb or []),
-            start_joints=parse_joints(start_joints, "--start-joints")["joints"] if start_joints else None,
+            start_joints=parse_joint_values(start_joints, "--start-joints") if start_joints else None,
             controllers=controllers, seed=seed,
         )
-        if request.start_joints is not None and not isinstance(request.start_joints, dict):
-            raise UsageError("--start-joints: give joint=value pairs")
         outcome = run(request)
         if output is not None:
             from moveplan.core.pipeline import report
@@ -240,7 +205,7 @@ def robot_info(
     _logging(False, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render
-        from moveplan.core.config.robot_config import load_robot_config
+        from moveplan.core.config import load_robot_config
         from moveplan.core.config.xacro import parse_xacro_args
 
         loaded = load_robot_config(config, tuple(package_path or ()), parse_xacro_args(xacro_arg or ()))
@@ -258,11 +223,10 @@ def inspect(
     _logging(False, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render
-        from moveplan.core.bag import recording
+        from moveplan.core.pipeline.inspection import inspect_file
 
-        summary = recording.summarize(file)
-        plan_file = recording.read_plan(file) if "moveplan" in summary.metadata else None
-    render.inspect_summary(file, summary, plan_file, as_json, quiet)
+        inspection = inspect_file(file)
+    render.inspect_summary(inspection, as_json, quiet)
 
 
 @app.command()
@@ -285,14 +249,12 @@ def benchmark(
     _logging(False, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render
-        from moveplan.core.config.robot_config import load_robot_config
-        from moveplan.core.errors import UsageError
+        from moveplan.core.config import load_robot_config
         from moveplan.core.pipeline import benchmark as bench
+        from moveplan.core.pipeline.request import check_planning_time
 
         seed_list = parse_seeds(seeds)
-        time_s = parse_number(planning_time, "--planning-time")
-        if time_s <= 0:
-            raise UsageError(f"--planning-time: expected a positive number of seconds, got '{planning_time}'")
+        time_s = check_planning_time(parse_number(planning_time, "--planning-time"))
         found = bench.find_problems(problems, count)
         config = load_robot_config(robot)
         planners = [p.strip() for text in planner or [config.planning["planner"]] for p in text.split(",")]

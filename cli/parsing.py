@@ -1,4 +1,7 @@
-"""Flag values: numbers with pi expressions, joint lists, poses; errors are usage errors (exit 2)."""
+"""Flag values as core's typed values: numbers with pi expressions, joints, poses; errors are usage errors (exit 2).
+
+Only the spelling of one flag is checked here; rules between flags and ranges of values are core's.
+"""
 
 from __future__ import annotations
 
@@ -6,14 +9,19 @@ import ast
 import math
 import operator
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from moveplan.core.errors import UsageError
 
+if TYPE_CHECKING:  # imported where used: `moveplan --help` loads no config code
+    from moveplan.core.config.goals import JointGoal, PoseGoal, ShiftGoal
+
 __all__ = [
-    "parse_disturbance", "parse_joints", "parse_number", "parse_params", "parse_pose", "parse_scaling", "parse_seeds",
-    "parse_shift",
+    "parse_disturbance", "parse_joint_values", "parse_joints", "parse_number", "parse_optional", "parse_params",
+    "parse_pose", "parse_seeds", "parse_shift",
 ]
+
+_T = TypeVar("_T")
 
 _BINARY: dict[type, Callable[[float, float], float]] = {
     ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
@@ -43,56 +51,67 @@ def parse_number(text: str, what: str) -> float:
     return result
 
 
-def parse_scaling(text: str | None, what: str) -> float | None:
-    """Return a scaling factor in (0, 1], or None when the flag was not given."""
-    if text is None:
-        return None
-    factor = parse_number(text, what)
-    if not 0.0 < factor <= 1.0:
-        raise UsageError(f"{what}: expected a factor in (0, 1], got '{text}'")
-    return factor
+def parse_optional(parse: Callable[[str, str], _T], text: str | None, what: str) -> _T | None:
+    """Return `parse(text, what)`, or None when the flag was not given."""
+    return None if text is None else parse(text, what)
 
 
-def parse_joints(text: str, what: str) -> dict[str, Any]:
+def parse_joints(text: str, what: str) -> JointGoal:
     """Return a joints goal from "q1,...,qn" (all joints) or "name=value,..." (some joints)."""
+    from moveplan.core.config.goals import JointGoal
+
     items = [item.strip() for item in text.split(",")]
     if not text.strip() or any(not item for item in items):
         raise UsageError(f"{what}: expected comma-separated values like '0,-1.57,...' or 'elbow_joint=1.2'")
     if all("=" in item for item in items):
         pairs = [item.split("=", 1) for item in items]
-        return {"joints": {name.strip(): parse_number(v, f"{what} {name.strip()}") for name, v in pairs}}
+        return JointGoal.by_name({name.strip(): parse_number(v, f"{what} {name.strip()}") for name, v in pairs})
     if any("=" in item for item in items):
         raise UsageError(f"{what}: give either all values or name=value pairs, not a mix")
-    return {"joints": [parse_number(item, what) for item in items]}
+    return JointGoal(tuple(parse_number(item, what) for item in items))
 
 
-def parse_pose(text: str, what: str) -> dict[str, Any]:
-    """Return a pose goal from "x,y,z", "x,y,z,roll,pitch,yaw" or "x,y,z,qx,qy,qz,qw"."""
+def parse_joint_values(text: str, what: str) -> dict[str, float]:
+    """Return joint -> value from "name=value,..." (the joints not named are left alone)."""
+    named = parse_joints(text, what).named_values
+    if named is None:
+        raise UsageError(f"{what}: give joint=value pairs")
+    return named
+
+
+def parse_pose(text: str, what: str) -> PoseGoal:
+    """Return a pose goal from "x,y,z", "x,y,z,roll,pitch,yaw" or "x,y,z,qx,qy,qz,qw" (frame and link unset)."""
+    from moveplan.core.config.goals import PoseGoal
+
     values = [parse_number(item, what) for item in text.split(",")] if text.strip() else []
     if len(values) not in (3, 6, 7):
         raise UsageError(f"{what}: expected 'x,y,z', 'x,y,z,roll,pitch,yaw' or 'x,y,z,qx,qy,qz,qw', "
                          f"got {len(values)} values")
-    pose: dict[str, Any] = {"xyz": values[:3], "rpy": None, "quat": None}
-    if len(values) == 6:
-        pose["rpy"] = values[3:]
-    elif len(values) == 7:
-        if math.fsum(v * v for v in values[3:]) < 1e-12:
+    x, y, z, *orientation = values
+    if len(orientation) == 3:
+        roll, pitch, yaw = orientation
+        return PoseGoal(xyz=(x, y, z), rpy=(roll, pitch, yaw))
+    if len(orientation) == 4:
+        if math.fsum(v * v for v in orientation) < 1e-12:
             raise UsageError(f"{what}: the quaternion (qx,qy,qz,qw) has zero norm; it is not a rotation")
-        pose["quat"] = values[3:]
-    return pose
+        qx, qy, qz, qw = orientation
+        return PoseGoal(xyz=(x, y, z), quat=(qx, qy, qz, qw))
+    return PoseGoal(xyz=(x, y, z))
 
 
-def parse_shift(text: str, what: str) -> dict[str, Any]:
-    """Return shift displacements from "z=0.1" or "x=0.05,yaw=0.3" (metres and radians)."""
-    axes = ("x", "y", "z", "roll", "pitch", "yaw")
-    shift: dict[str, Any] = {}
+def parse_shift(text: str, what: str) -> ShiftGoal:
+    """Return a shift of the tip from "z=0.1" or "x=0.05,yaw=0.3" (metres and radians), along the tool's axes."""
+    from moveplan.core.config.goals import SHIFT_AXES, ShiftGoal
+
+    offsets: dict[str, float] = {}
     for item in text.split(","):
         name, _, value = item.partition("=")
         name = name.strip()
-        if name not in axes or not value.strip():
-            raise UsageError(f"{what}: expected axis=value pairs with axes {', '.join(axes)}, got '{item.strip()}'")
-        shift[name] = parse_number(value, f"{what} {name}")
-    return shift
+        if name not in SHIFT_AXES or not value.strip():
+            raise UsageError(f"{what}: expected axis=value pairs with axes {', '.join(SHIFT_AXES)}, "
+                             f"got '{item.strip()}'")
+        offsets[name] = parse_number(value, f"{what} {name}")
+    return ShiftGoal.of(offsets)
 
 
 def parse_params(items: list[str], what: str) -> dict[str, float]:

@@ -7,6 +7,7 @@ import logging
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -16,14 +17,12 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from moveplan.core.trajectory import peak_rates
-
 if TYPE_CHECKING:  # each command imports only the core modules it runs
-    from moveplan.core.bag.recording import BagSummary, PlanFile
     from moveplan.core.config.robot_config import RobotConfig
-    from moveplan.core.control.checking import CheckReport
+    from moveplan.core.control.check_report import CheckReport
     from moveplan.core.pipeline.benchmark import Run
     from moveplan.core.pipeline.execute import PlanExecution
+    from moveplan.core.pipeline.inspection import Inspection
     from moveplan.core.types import Plan
 
 __all__ = [
@@ -130,21 +129,10 @@ def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
         _console.print(f"[red]no acceleration limit[/red] for {', '.join(document['missing_acceleration'])}")
 
 
-def inspect_summary(path: Path, summary: BagSummary, plan: PlanFile | None, as_json: bool, quiet: bool) -> None:
+def inspect_summary(inspection: Inspection, as_json: bool, quiet: bool) -> None:
     """Print topics of any bag, and for a plan file each step's duration and peak rates."""
-    steps = []
-    if plan is not None:
-        for step in plan.steps:
-            peak_v, peak_a = peak_rates(step.trajectory)
-            names = step.trajectory.joint_names
-            v_limit = np.array([plan.limits[j]["max_velocity"] for j in names])
-            a_limit = np.array([plan.limits[j]["max_acceleration"] for j in names])
-            steps.append({
-                "name": step.name, "start_s": step.start_s, "duration_s": step.trajectory.duration_s,
-                "points": len(step.trajectory.times_s),
-                "peak_velocity_fraction": float(np.max(peak_v / v_limit)),
-                "peak_acceleration_fraction": float(np.max(peak_a / a_limit)),
-            })
+    path, summary, plan = inspection.path, inspection.summary, inspection.plan
+    steps = [asdict(step) for step in inspection.steps]
     document = {
         "file": str(path), "profile": summary.profile, "library": summary.library,
         "duration_s": summary.duration_s,
@@ -174,31 +162,10 @@ def inspect_summary(path: Path, summary: BagSummary, plan: PlanFile | None, as_j
         _console.print(table)
 
 
-def _result(result: Any) -> dict[str, Any]:
-    return {"code": result.code, "name": result.name, "message": result.message}
-
-
-def _violations(violations: Any) -> list[dict[str, Any]]:
-    return [{"check": v.check, "joint": v.joint, "time_s": v.time_s, "reference": v.reference, "actual": v.actual,
-             "error": v.error, "tolerance": v.tolerance, "step": step} for step, v in violations]
-
-
-def execution_document(outcome: PlanExecution) -> dict[str, Any]:
-    """Return the execute JSON document of an execution."""
-    return {
-        "ok": outcome.ok,
-        "result": _result(outcome.result),
-        "violations": _violations(outcome.violations),
-        "margins": outcome.margins,
-        "duration_s": outcome.duration_s,
-        "controller": outcome.controller.name,
-        "steps": [{"name": s.name, "ok": s.report.ok, "result": s.report.result.name,
-                   "duration_s": s.report.duration_s} for s in outcome.steps],
-    }
-
-
 def execution_summary(outcome: PlanExecution, output: Path | None, as_json: bool, quiet: bool) -> None:
     """Print the result, every violation and the per-joint margins, or the JSON document."""
+    from moveplan.core.pipeline.report import execution_document
+
     document = execution_document(outcome)
     if output is not None:
         document["output"] = str(output)
@@ -207,53 +174,44 @@ def execution_summary(outcome: PlanExecution, output: Path | None, as_json: bool
         return
     if quiet:
         return
-    _verdict(document, f"smallest margin to tolerance ({outcome.controller.name})")
-    _console.print(f"executed {len(outcome.steps)} of {len(outcome.plan.steps)} steps in {outcome.duration_s:.3f} s")
+    _verdict(document, f"smallest margin to tolerance ({document['controller']})")
+    _console.print(f"executed {len(document['steps'])} of {len(outcome.plan.steps)} steps in "
+                   f"{_number(document['duration_s'], '.3f')} s")
 
 
 def check_summary(report: CheckReport, recording: Path, as_json: bool, quiet: bool) -> None:
     """Print the verdict on a recording (per cycle with --start all), or its JSON document.
 
-    "ok" of a step or cycle is null when the recording cuts it off before a verdict (INCOMPLETE).
     A check with no complete execution is bad input (exit 3): the document says so under "error".
     """
-    for warning in report.warnings:
+    from moveplan.core.pipeline.report import check_document
+
+    document = check_document(report, recording)
+    for warning in document["warnings"]:
         logger.warning("%s", warning)
-    error = None if report.complete else {"exit_code": 3, "kind": "InputError",
-                                          "message": f"{recording}: {report.result.message}"}
-    document: dict[str, Any] = {
-        "ok": report.ok, "result": _result(report.result), "violations": _violations(report.violations),
-        "margins": report.margins, "duration_s": report.duration_s, "start_s": report.start_s,
-        "steps": [{"name": s.name, "ok": s.ok if s.complete else None, "result": s.report.result.name,
-                   "start_s": s.start_s, "duration_s": s.duration_s, "aligned_by": s.aligned_by}
-                  for s in report.steps],
-        "gaps": [{"start_s": start, "length_s": length} for start, length in report.gaps],
-        "warnings": list(report.warnings),
-        "error": error,
-    }
-    if report.cycles:
-        document["cycles"] = [{"index": c.index, "start_s": c.start_s, "ok": c.ok if c.complete else None,
-                               "result": _result(c.result), "worst_margin": c.worst_margin} for c in report.cycles]
-        document["failing_cycles"] = list(report.failing_cycles)
-        document["incomplete_cycles"] = list(report.incomplete_cycles)
     if as_json:
         _emit(document)
         return
-    if error is not None:
-        print(f"moveplan: error: {error['message']}", file=sys.stderr)
+    if document["error"] is not None:
+        print(f"moveplan: error: {document['error']['message']}", file=sys.stderr)
     if quiet:
         return
     _verdict(document, "smallest margin to tolerance")
-    if report.cycles:
-        failing = ", ".join(str(i) for i in report.failing_cycles) or "none"
-        incomplete = len(report.incomplete_cycles)
-        cut = ", ".join(map(str, report.incomplete_cycles))
-        cut = f" (cycle {cut}, cut off by the recording)" if incomplete else ""
-        _console.print(f"{len(report.cycles)} executions found; failing: {failing}; incomplete: {incomplete}{cut}")
-        for cycle in report.cycles:
-            if not cycle.ok:
-                _console.print(f"  cycle {cycle.index} at {cycle.start_s:.3f} s: {cycle.result.name}: "
-                               f"{cycle.result.message}")
+    if "cycles" in document:
+        _cycles(document)
+
+
+def _cycles(document: dict[str, Any]) -> None:
+    """Print how many executions a check found, which failed and which the recording cuts off."""
+    failing = ", ".join(str(i) for i in document["failing_cycles"]) or "none"
+    incomplete = len(document["incomplete_cycles"])
+    cut = ", ".join(map(str, document["incomplete_cycles"]))
+    cut = f" (cycle {cut}, cut off by the recording)" if incomplete else ""
+    _console.print(f"{len(document['cycles'])} executions found; failing: {failing}; incomplete: {incomplete}{cut}")
+    for cycle in document["cycles"]:
+        if not cycle["ok"]:
+            _console.print(f"  cycle {cycle['index']} at {_number(cycle['start_s'], '.3f')} s: "
+                           f"{cycle['result']['name']}: {cycle['result']['message']}")
 
 
 def _verdict(document: dict[str, Any], margins_title: str) -> None:
@@ -266,16 +224,22 @@ def _verdict(document: dict[str, Any], margins_title: str) -> None:
         for column in ("step", "check", "joint", "time [s]", "reference", "actual", "error", "tolerance"):
             table.add_column(column)
         for v in document["violations"]:
-            table.add_row(v["step"], v["check"], v["joint"], f"{v['time_s']:.3f}", f"{v['reference']:.4f}",
-                          f"{v['actual']:.4f}", f"{v['error']:.4f}", f"{v['tolerance']:.4f}")
+            table.add_row(v["step"], v["check"], v["joint"], _number(v["time_s"], ".3f"),
+                          *(_number(v[key], ".4f") for key in ("reference", "actual", "error", "tolerance")))
         _console.print(table)
     if document["margins"]:
         table = Table(title=margins_title)
         table.add_column("joint")
         table.add_column("margin [rad]")
         for joint, margin in document["margins"].items():
-            table.add_row(joint, f"[{'red' if margin < 0 else 'green'}]{margin:.4f}[/]")
+            colour = "red" if margin is None or margin < 0 else "green"
+            table.add_row(joint, f"[{colour}]{_number(margin, '.4f')}[/]")
         _console.print(table)
+
+
+def _number(value: float | None, spec: str) -> str:
+    """Return a document's number formatted, or "inf/nan" for its null: not finite (a diverged plant)."""
+    return "inf/nan" if value is None else format(value, spec)
 
 
 @contextmanager

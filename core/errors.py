@@ -8,19 +8,23 @@ valid alternatives where there are any.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import Self
 
 __all__ = [
     "ConfigError",
+    "CorruptData",
     "FrameNotFound",
     "GoalInCollision",
     "GoalOutsideLimits",
     "GoalUnreachable",
+    "InCollision",
     "InputError",
     "MoveplanError",
     "NoPlan",
     "PlanningFailed",
     "StartInCollision",
     "UnknownName",
+    "UnsupportedJoint",
     "UsageError",
     "known",
 ]
@@ -36,14 +40,30 @@ def known(names: Iterable[str], limit: int = 30) -> str:
 
 
 class MoveplanError(Exception):
-    """Base of every error moveplan raises on purpose."""
+    """Base of every error moveplan raises on purpose.
+
+    Attributes:
+        step: Name of the plan step the error happened in, None outside a step; when set,
+            the message begins with it: "step 'approach': ...".
+    """
 
     exit_code = 1
+    step: str | None = None
 
     @property
     def kind(self) -> str:
         """Return the error's class name, as reported in JSON output."""
         return type(self).__name__
+
+    def in_step(self, step: str) -> Self:
+        """Return this error, marked as raised while planning `step`; an error already marked keeps its step."""
+        if self.step is None:
+            self.step = step
+        return self
+
+    def __str__(self) -> str:
+        message = super().__str__()
+        return message if self.step is None else f"step '{self.step}': {message}"
 
 
 class UsageError(MoveplanError):
@@ -60,6 +80,22 @@ class InputError(MoveplanError):
 
 class ConfigError(InputError):
     """A robot, scene or task file is invalid; the message names file and key."""
+
+
+class CorruptData(InputError):
+    """A structural error inside a recording, or a malformed message in it.
+
+    The bag reader turns it into an InputError naming the file; one that escapes is still
+    bad input (exit 3), never an internal error.
+    """
+
+
+class UnsupportedJoint(InputError):
+    """The robot has a joint kind a model does not handle (the sphere filter: planar, free-flyer ...).
+
+    The collision district catches it and falls back to exact checks; one that escapes is
+    bad input (exit 3): a robot description moveplan cannot use, not a bug.
+    """
 
 
 class UnknownName(InputError):
@@ -84,19 +120,26 @@ class NoPlan(MoveplanError):
     exit_code = 4
 
 
-class StartInCollision(NoPlan):
-    """The start state collides; names the colliding pair."""
+class InCollision(NoPlan):
+    """A robot state collides; names the colliding pair and which state it is."""
 
-    def __init__(self, pair: tuple[str, str], where: str = "start state") -> None:
-        self.pair = pair
+    def __init__(self, pair: tuple[str, str], where: str) -> None:
+        self.pair, self.where = pair, where
         super().__init__(f"{where} is in collision: {pair[0]} touches {pair[1]}")
 
 
-class GoalInCollision(StartInCollision):
+class StartInCollision(InCollision):
+    """The start state collides (or, with `where="every state"`, a pair that never moves touches)."""
+
+    def __init__(self, pair: tuple[str, str], where: str = "start state") -> None:
+        super().__init__(pair, where)
+
+
+class GoalInCollision(InCollision):
     """The goal state collides; names the colliding pair."""
 
     def __init__(self, pair: tuple[str, str]) -> None:
-        super().__init__(pair, where="goal state")
+        super().__init__(pair, "goal state")
 
 
 class GoalOutsideLimits(NoPlan):

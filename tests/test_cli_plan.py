@@ -10,7 +10,7 @@ import pytest
 from conftest import SAMPLES, TABLE_SCENE, UR10E, Cli, dense_peaks, run_process
 from rosbags.highlevel import AnyReader
 
-from moveplan.core.bag.recording import read_plan
+from moveplan.core.bag import read_plan
 from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.model.robot import Robot
 from moveplan.core.model.scene_file import load_scene
@@ -129,6 +129,8 @@ def test_plan_json_has_the_documented_keys(cli: Cli, tmp_path: Path) -> None:
     assert document["ok"] is True and document["error"] is None
     assert document["robot"] == "ur10e" and document["group"] == "manipulator"
     assert document["output"].endswith("p.mcap")
+    (step,) = document["steps"]
+    assert (step["name"], step["goal"], step["status"]) == ("ready", {"named": "ready"}, "ok")
 
 
 BAD_FLAGS = [
@@ -146,6 +148,14 @@ BAD_FLAGS = [
     (["--joints", "elbow_joint=4"], 4, "elbow_joint"),
     (["--scene", TABLE_SCENE, "--start-joints", "0,0.3,0,0,0,0", "--named", "home"], 4, "upper_arm_link touches table"),
     (["--scene", TABLE_SCENE, "--start-named", "home", "--joints", "0,0.3,0,0,0,0"], 4, "goal state is in collision"),
+    (["--named", "home", "--joints", "0,0,0,0,0,0"], 2, "give one start flag and one goal flag, got --joints, --named"),
+    (["--named", "home", "--frame", "tool0"], 2, "--frame goes with --pose"),
+    (["--named", "home", "--linear"], 2, "--linear goes with --pose or --shift"),
+    (["--named", "home", "--planning-time", "0"], 2, "--planning-time: expected a positive number of seconds"),
+    (["--named", "home", "--planning-time", "soon"], 2, "--planning-time: expected a number"),
+    (["--pose", "0.5,0,0.5", "--linear", "--min-fraction", "2"], 2, "--min-fraction: expected a number in [0, 1]"),
+    (["--pose", "0.5,0,0.5,1"], 2, "--pose: expected 'x,y,z'"),
+    (["--shift", "up=1"], 2, "--shift: expected axis=value pairs"),
 ]
 
 
@@ -160,6 +170,15 @@ def test_bad_input_exits_with_documented_code_and_one_line(
     assert len(result.stderr.strip().splitlines()) == 1
     assert "Traceback" not in result.stderr
     assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_a_failing_task_step_is_named_in_the_one_line_error(cli: Cli, tmp_path: Path) -> None:
+    task = tmp_path / "task.yaml"
+    task.write_text(f"robot: {UR10E}\nstart: {{named: home}}\nsteps:\n  - {{name: up, named: ready}}\n"
+                    "  - {name: back, joints: {elbow_joint: 4}}\n")
+    code, document = cli.json("plan", task, "-o", tmp_path / "o.mcap")
+    assert code == 4 and document["error"]["kind"] == "GoalOutsideLimits"
+    assert document["error"]["message"].startswith("step 'back': goal for joint 'elbow_joint'")
 
 
 def test_goal_outside_limits_names_joint_value_and_limit(cli: Cli, tmp_path: Path) -> None:

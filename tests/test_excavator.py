@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from conftest import ROOT, SAMPLES, Cli
 
-from moveplan.core.bag.recording import PlanFile, read_plan
+from moveplan.core.bag.plan_file import PlanFile, read_plan
 from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.model.robot import Robot

@@ -13,8 +13,9 @@ import yaml
 from conftest import ROOT, Cli
 from rosbags.highlevel import AnyReader
 
-from moveplan.core.bag.recording import read_plan
+from moveplan.core.bag import read_plan
 from moveplan.core.collision.checker import CollisionChecker, coal_geometry
+from moveplan.core.config.goals import JointGoal, PoseGoal
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import ConfigError, FrameNotFound
 from moveplan.core.model.moveit_request import load_motion_plan_request, planner_name
@@ -166,7 +167,9 @@ def test_mbm_request_gives_group_start_goal_planner_and_moveit_scaling() -> None
     assert request.start == dict(zip([f"panda_joint{i}" for i in range(1, 8)], START, strict=True)) | {
         "panda_finger_joint1": 0.065, "panda_finger_joint2": 0.065}
     assert request.goal is not None and request.goal.name == "request0001"
-    assert request.goal.goal == {"joints": dict(zip([f"panda_joint{i}" for i in range(1, 8)], GOAL, strict=True))}
+    goal = dict(zip([f"panda_joint{i}" for i in range(1, 8)], GOAL, strict=True))
+    assert request.goal.goal == JointGoal.by_name(goal)
+    assert request.goal.goal.describe() == {"joints": goal}
     assert (request.planner, request.planning_time) == ("BKPIECE1", 60.0)
     # MoveIt reads a scaling factor of 0 as 1.0.
     assert (request.velocity_scaling, request.acceleration_scaling) == (1.0, 1.0)
@@ -207,7 +210,7 @@ def test_first_goal_alternative_is_used_with_a_warning(tmp_path: Path, caplog: p
     second = {"joint_constraints": [{"joint_name": "panda_joint1", "position": -0.5}]}
     with caplog.at_level(logging.WARNING):
         request = load_motion_plan_request(write(tmp_path / "r.yaml", request_with(goal_constraints=[first, second])))
-    assert request.goal is not None and request.goal.goal == {"joints": {"panda_joint1": 0.5}}
+    assert request.goal is not None and request.goal.goal == JointGoal.by_name({"panda_joint1": 0.5})
     assert "2 alternatives" in caplog.text
 
 
@@ -225,11 +228,12 @@ def test_position_and_orientation_constraints_become_a_pose_goal_of_their_link(t
     }
     request = load_motion_plan_request(write(tmp_path / "r.yaml", request_with(goal_constraints=[goal])))
     assert request.goal is not None
-    pose = request.goal.goal["pose"]
-    assert (pose["frame"], pose["link"], pose["rpy"]) == ("panda_link0", "panda_hand", None)
-    np.testing.assert_allclose(pose["quat"], [half, 0, 0, half])
+    pose = request.goal.goal
+    assert isinstance(pose, PoseGoal)
+    assert (pose.frame, pose.link, pose.rpy) == ("panda_link0", "panda_hand", None)
+    np.testing.assert_allclose(pose.quat, [half, 0, 0, half])
     # The hand's z axis points along -y: its origin sits 0.1 m back from the target point.
-    np.testing.assert_allclose(pose["xyz"], [0.5, 0.1, 0.4], atol=1e-12)
+    np.testing.assert_allclose(pose.xyz, [0.5, 0.1, 0.4], atol=1e-12)
 
 
 # --- the command line --------------------------------------------------------------------------

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from conftest import SAMPLES, Cli
 
-from moveplan.core.bag.recording import PlanFile, read_plan
+from moveplan.core.bag import PlanFile, read_plan
 from moveplan.core.model.robot import Robot
 from moveplan.core.trajectory import sample
 

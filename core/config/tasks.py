@@ -1,7 +1,8 @@
 """Task files (DESIGN section 4) and the step specifications they and the flags produce.
 
 A task names a robot and scene, a start, defaults, and steps; each step is one
-motion goal. Paths in a task resolve relative to the task file.
+motion goal, parsed here into a typed goal (goals.py). Paths in a task resolve
+relative to the task file.
 """
 
 from __future__ import annotations
@@ -11,15 +12,14 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from .robot_config import check_keys, load_yaml, mapping, number
+from .fields import check_keys, load_yaml, mapping, number
+from .goals import GOAL_KINDS, SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
 
 __all__ = [
     "GOAL_KINDS", "SHIFT_AXES", "StepSpec", "TaskFile", "load_task", "parse_goal", "parse_pose", "parse_scaling",
     "parse_shift",
 ]
 
-GOAL_KINDS = ("joints", "named", "pose", "shift")
-SHIFT_AXES = ("x", "y", "z", "roll", "pitch", "yaw")
 _TASK_KEYS = {"robot", "scene", "group", "start", "defaults", "steps", "seed"}
 _DEFAULT_KEYS = {"velocity_scaling", "acceleration_scaling", "planner", "planning_time"}
 _STEP_KEYS = {"name", "linear", "min_fraction", *GOAL_KINDS, *_DEFAULT_KEYS}
@@ -30,13 +30,12 @@ _POSE_KEYS = {"frame", "xyz", "rpy", "quat", "link"}
 class StepSpec:
     """One requested motion: a goal plus per-step overrides (None = use the plan's default).
 
-    `goal` holds exactly one kind: {"joints": [values] | {joint: value}}, {"named": name},
-    {"pose": {"frame", "xyz", "rpy" | "quat", "link"}} or {"shift": {axis: value, "frame"}}.
-    A `linear` step moves the tip along a straight line; below `min_fraction` of it, it fails.
+    A `linear` step moves the tip along a straight line (pose and shift goals); below
+    `min_fraction` of it, it fails.
     """
 
     name: str
-    goal: dict[str, Any]
+    goal: Goal
     velocity_scaling: float | None = None
     acceleration_scaling: float | None = None
     planner: str | None = None
@@ -53,7 +52,7 @@ class TaskFile:
     robot: Path | None
     scene: Path | None
     group: str | None
-    start: dict[str, Any]
+    start: Start
     defaults: dict[str, Any]
     steps: tuple[StepSpec, ...]
     seed: int | None = None
@@ -68,7 +67,7 @@ def parse_scaling(value: Any, where: str) -> float:
     return factor
 
 
-def parse_goal(entry: dict[str, Any], where: str) -> dict[str, Any]:
+def parse_goal(entry: dict[str, Any], where: str) -> Goal:
     """Return the one goal of a step or start entry, checked for shape."""
     kinds = [k for k in GOAL_KINDS if k in entry]
     if len(kinds) != 1:
@@ -76,52 +75,64 @@ def parse_goal(entry: dict[str, Any], where: str) -> dict[str, Any]:
     kind = kinds[0]
     value = entry[kind]
     if kind == "pose":
-        return {"pose": parse_pose(mapping(value, f"{where}.pose"), f"{where}.pose")}
+        return parse_pose(mapping(value, f"{where}.pose"), f"{where}.pose")
     if kind == "shift":
-        return {"shift": parse_shift(mapping(value, f"{where}.shift"), f"{where}.shift")}
+        return parse_shift(mapping(value, f"{where}.shift"), f"{where}.shift")
     if kind == "named":
         if not isinstance(value, str):
             raise ConfigError(f"{where}.named: expected a group_state name, got {value!r}")
-        return {"named": value}
+        return NamedGoal(value)
     if isinstance(value, list):
-        return {"joints": [number(v, f"{where}.joints[{i}]") for i, v in enumerate(value)]}
+        return JointGoal(tuple(number(v, f"{where}.joints[{i}]") for i, v in enumerate(value)))
     if isinstance(value, dict):
-        return {"joints": {str(k): number(v, f"{where}.joints.{k}") for k, v in value.items()}}
+        return JointGoal.by_name({str(k): number(v, f"{where}.joints.{k}") for k, v in value.items()})
     raise ConfigError(f"{where}.joints: expected a list of values or a mapping joint: value, got {value!r}")
 
 
-def parse_pose(entry: dict[str, Any], where: str) -> dict[str, Any]:
-    """Return a pose goal {frame, xyz, rpy | quat, link}, numbers checked; missing keys are None."""
+def parse_pose(entry: dict[str, Any], where: str) -> PoseGoal:
+    """Return a pose goal of `link` in `frame` (xyz, rpy | quat), numbers checked; missing keys are None."""
     check_keys(entry, _POSE_KEYS, where)
-    pose: dict[str, Any] = {"frame": entry.get("frame"), "link": entry.get("link"), "rpy": None, "quat": None}
-    for key in ("frame", "link"):
-        if pose[key] is not None and not isinstance(pose[key], str):
-            raise ConfigError(f"{where}.{key}: expected a frame or link name, got {pose[key]!r}")
+    names = {key: entry.get(key) for key in ("frame", "link")}
+    for key, name in names.items():
+        if name is not None and not isinstance(name, str):
+            raise ConfigError(f"{where}.{key}: expected a frame or link name, got {name!r}")
+    vectors: dict[str, Any] = {}
     for key, size in (("xyz", 3), ("rpy", 3), ("quat", 4)):
         value = entry.get(key, [0.0, 0.0, 0.0] if key == "xyz" else None)
         if value is None:
             continue
         if not isinstance(value, list) or len(value) != size:
             raise ConfigError(f"{where}.{key}: expected a list of {size} numbers, got {value!r}")
-        pose[key] = [number(v, f"{where}.{key}[{i}]") for i, v in enumerate(value)]
-    if pose["rpy"] is not None and pose["quat"] is not None:
+        vectors[key] = tuple(number(v, f"{where}.{key}[{i}]") for i, v in enumerate(value))
+    if "rpy" in vectors and "quat" in vectors:
         raise ConfigError(f"{where}: give rpy or quat, not both")
-    if pose["quat"] is not None and sum(v * v for v in pose["quat"]) < 1e-12:
+    if "quat" in vectors and sum(v * v for v in vectors["quat"]) < 1e-12:
         raise ConfigError(f"{where}.quat: a quaternion [x, y, z, w] of zero norm is not a rotation")
-    return pose
+    return PoseGoal(**vectors, **names)
 
 
-def parse_shift(entry: dict[str, Any], where: str) -> dict[str, Any]:
+def parse_shift(entry: dict[str, Any], where: str) -> ShiftGoal:
     """Return a shift goal: displacement per axis (x, y, z in [m]; roll, pitch, yaw in [rad]) and frame."""
     check_keys(entry, {*SHIFT_AXES, "frame"}, where)
-    shift: dict[str, Any] = {axis: number(entry[axis], f"{where}.{axis}") for axis in SHIFT_AXES if axis in entry}
-    if not shift:
+    offsets = {axis: number(entry[axis], f"{where}.{axis}") for axis in SHIFT_AXES if axis in entry}
+    if not offsets:
         raise ConfigError(f"{where}: give at least one of {', '.join(SHIFT_AXES)}")
     frame = entry.get("frame", "tool")
     if not isinstance(frame, str):
         raise ConfigError(f"{where}.frame: expected tool, base, moveit or a frame name, got {frame!r}")
-    shift["frame"] = frame
-    return shift
+    return ShiftGoal.of(offsets, frame)
+
+
+def _start(entry: dict[str, Any], folder: Path, where: str) -> Start:
+    """Return a task's start: a previous plan file (relative to the task), a joints or a named goal."""
+    check_keys(entry, {"named", "joints", "from"}, where)
+    if "from" in entry:
+        return StartFrom(folder / str(entry["from"]))
+    if not entry:
+        return None
+    goal = parse_goal(entry, where)
+    assert isinstance(goal, JointGoal | NamedGoal), "the keys are checked above"
+    return goal
 
 
 def _defaults(entry: dict[str, Any], where: str) -> dict[str, Any]:
@@ -152,12 +163,7 @@ def load_task(path: Path) -> TaskFile:
             raise ConfigError(f"{source}: {key}: expected a path, got {top[key]!r}")
         return folder / top[key]
 
-    start = mapping(top.get("start"), f"{source}: start")
-    check_keys(start, {"named", "joints", "from"}, f"{source}: start")
-    if "from" in start:
-        start = {"from": folder / str(start["from"])}
-    elif start:
-        start = parse_goal(start, f"{source}: start")
+    start = _start(mapping(top.get("start"), f"{source}: start"), folder, f"{source}: start")
     defaults = mapping(top.get("defaults"), f"{source}: defaults")
     check_keys(defaults, _DEFAULT_KEYS, f"{source}: defaults")
     steps_raw = top.get("steps") or []
@@ -178,8 +184,8 @@ def load_task(path: Path) -> TaskFile:
             if not 0.0 <= min_fraction <= 1.0:
                 raise ConfigError(f"{where}.min_fraction: expected a number in [0, 1], got {min_fraction!r}")
         goal = parse_goal(entry, where)
-        if linear and ("joints" in goal or "named" in goal):
-            raise ConfigError(f"{where}: linear applies to pose and shift goals, not {next(iter(goal))}")
+        if linear and isinstance(goal, JointGoal | NamedGoal):
+            raise ConfigError(f"{where}: linear applies to pose and shift goals, not {goal.kind}")
         steps.append(StepSpec(name=name, goal=goal, linear=linear, min_fraction=min_fraction,
                               **_defaults(entry, where)))
     names = [s.name for s in steps]

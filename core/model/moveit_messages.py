@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config.robot_config import check_keys, mapping, number
+from ..config.fields import check_keys, mapping, number
 from ..errors import ConfigError, UnknownName
 from .poses import pose_matrix
 from .robot import Robot

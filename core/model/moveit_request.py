@@ -31,8 +31,9 @@ from typing import Any
 
 import numpy as np
 
+from ..config.fields import check_keys, load_yaml, mapping, number
+from ..config.goals import JointGoal, PoseGoal
 from ..config.planners import PLANNERS
-from ..config.robot_config import check_keys, load_yaml, mapping, number
 from ..config.tasks import StepSpec
 from ..errors import ConfigError, known
 from .moveit_messages import header_frame, point, pose, quaternion, robot_state, yaml_list
@@ -184,7 +185,7 @@ def _scaling(top: dict[str, Any], key: str, source: str) -> float | None:
     return 1.0
 
 
-def _goal(value: Any, where: str) -> dict[str, Any]:
+def _goal(value: Any, where: str) -> JointGoal | PoseGoal:
     """Return the step goal of one moveit_msgs/Constraints: a joint goal or a pose goal."""
     entry = mapping(value, where)
     check_keys(entry, _CONSTRAINTS_KEYS, where)
@@ -207,15 +208,15 @@ def _goal(value: Any, where: str) -> dict[str, Any]:
             if name in goal:
                 raise ConfigError(f"{at}.joint_name: joint '{name}' is constrained twice")
             goal[name] = number(constraint.get("position"), f"{at}.position")
-        return {"joints": goal}
+        return JointGoal.by_name(goal)
     if len(positions) != 1 or len(orientations) != 1:
         raise ConfigError(f"{where}: a goal needs joint constraints, or one position and one orientation "
                           f"constraint (got {len(positions)} and {len(orientations)})")
-    return {"pose": _pose_goal(positions[0], orientations[0], where)}
+    return _pose_goal(positions[0], orientations[0], where)
 
 
-def _pose_goal(position_value: Any, orientation_value: Any, where: str) -> dict[str, Any]:
-    """Return a pose goal {frame, link, xyz, quat, rpy} from a position and an orientation constraint."""
+def _pose_goal(position_value: Any, orientation_value: Any, where: str) -> PoseGoal:
+    """Return the pose goal of a link from a position and an orientation constraint on it."""
     at_p, at_o = f"{where}.position_constraints[0]", f"{where}.orientation_constraints[0]"
     position = mapping(position_value, at_p)
     check_keys(position, _POSITION_KEYS, at_p)
@@ -243,5 +244,6 @@ def _pose_goal(position_value: Any, orientation_value: Any, where: str) -> dict[
     # The offset point, fixed in the link, must reach the centre: the link origin sits back from it.
     origin = centre - rotation @ offset
     norm = float(np.linalg.norm(quat))
-    return {"frame": frames[0] or None, "link": links[0], "xyz": [float(v) for v in origin],
-            "rpy": None, "quat": [v / norm for v in quat]}
+    x, y, z = (float(v) for v in origin)
+    qx, qy, qz, qw = (v / norm for v in quat)
+    return PoseGoal(xyz=(x, y, z), quat=(qx, qy, qz, qw), frame=frames[0] or None, link=links[0])

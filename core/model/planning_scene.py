@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config.robot_config import check_keys, mapping, number
+from ..config.fields import check_keys, mapping, number
 from ..errors import ConfigError, UnknownName
 from ..types import CollisionObject, Frame, Shape
 from .moveit_messages import (

@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
-from ..config.robot_config import number
+from ..config.fields import number
 from ..errors import ConfigError
 
 __all__ = ["pose_matrix", "vector"]

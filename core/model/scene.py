@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config.robot_config import check_keys, mapping, number
+from ..config.fields import check_keys, mapping, number
 from ..errors import ConfigError, FrameNotFound
 from ..types import CollisionObject, Frame, Shape
 from .poses import pose_matrix, vector

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..config.robot_config import load_yaml, mapping
+from ..config.fields import load_yaml, mapping
 from .planning_scene import planning_scene
 from .robot import Robot
 from .scene import PLANNING_SCENE_KEYS, Scene, moveplan_scene

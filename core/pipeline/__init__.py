@@ -1,6 +1,7 @@
 """The commands as library calls: plan, execute, check and benchmark compose the districts below.
 
-Modules: `plan` (resolve_request, plan), `execute` (execute, check), `report` (the result
-document and the executed file), `benchmark` (run_benchmark, summarize). Nothing is imported
+Modules: `plan` (plan, plan_to_file; one step's stages in `step`), `request` (PlanFlags,
+resolve_request), `execute` (execute, check), `report` (the result document and the executed
+file), `inspection` (inspect_file), `benchmark` (run_benchmark, summarize). Nothing is imported
 here, so that a command loads only what it runs (execute never loads OMPL).
 """

@@ -187,8 +187,8 @@ def _solve(problem: Problem, config: Any, planner: str, seed: int, planning_time
     from ..config.tasks import load_task
     from . import plan as pipeline
 
-    flags = {"robot": config.root, "scene": problem.scene, "request": problem.request, "planner": planner,
-             "planning_time": planning_time, "seed": seed}
+    flags = pipeline.PlanFlags(robot=config.root, scene=problem.scene, request=problem.request, planner=planner,
+                               planning_time=planning_time, seed=seed)
     request = pipeline.resolve_request(load_task(problem.task) if problem.task else None, flags)
     where = {"problem": problem.name, "scenario": problem.scenario, "planner": planner, "seed": seed}
     try:

@@ -17,11 +17,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from ..bag import recording
+from .. import bag as recording
 from ..bag.jointstates import read_joint_states
-from ..config.robot_config import CONFIG_FILE, ControllerConfig, RobotConfig, load_robot_config, parse_controllers
-from ..control.checking import CheckReport, check_recording, uses_velocities
-from ..control.tolerances import ExecutionResult, Violation
+from ..config.controllers import ControllerConfig, parse_controllers
+from ..config.robot_config import RobotConfig, load_robot_config
+from ..config.sources import CONFIG_FILE
+from ..control.check_report import CheckReport
+from ..control.checking import check_recording, uses_velocities
+from ..control.results import ExecutionResult, Violation
 from ..errors import ConfigError, InputError, UnknownName
 from ..types import TfSamples
 

@@ -1,130 +1,45 @@
 """The plan pipeline: request -> robot, scene, start -> per step goal, path, timing -> Plan.
 
-Data flows one way; this module is the only one that composes planning,
-timing and recording. Precedence of settings lives in `resolve_request`:
-flag > MoveIt request > task file > robot config > built-in default.
+Data flows one way; this module and step.py are the only ones that compose planning,
+timing and recording. Precedence of settings lives in `resolve_request` (request.py):
+flag > MoveIt request > task file > robot config > built-in default. Each step is
+planned in named stages (step.py).
 """
 
 from __future__ import annotations
 
-import logging
-import time
-from collections.abc import Callable
-from dataclasses import dataclass, field
-from functools import partial
 from importlib.metadata import version
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..bag import recording
+from ..bag import read_plan, write_plan
 from ..collision.motion import MotionChecker, exact_checks, scene_checks
-from ..config.robot_config import RobotConfig, load_robot_config
-from ..config.tasks import StepSpec, TaskFile
-from ..errors import (
-    ConfigError,
-    GoalInCollision,
-    GoalUnreachable,
-    PlanningFailed,
-    StartInCollision,
-    UnknownName,
-    UsageError,
-)
-from ..model.kinematics import solve_ik
+from ..config import JointGoal, RobotConfig, StartFrom, load_robot_config, load_task
+from ..errors import ConfigError, MoveplanError, StartInCollision, UnknownName
 from ..model.moveit_messages import known_joints
-from ..model.moveit_request import MotionPlanRequest, load_motion_plan_request
 from ..model.robot import Robot
 from ..model.scene import Scene, empty_scene
 from ..model.scene_file import load_scene
-from ..planning.cartesian import straight_line
-from ..planning.goals import check_limits, joint_target, pose_error, tip_target
-from ..planning.search import PathResult, Validity, plan_path, repair_path, seed_planner
-from ..timing import rest_to_rest, time_parameterize
+from ..planning.goals import joint_target
+from ..planning.search import seed_planner
 from ..trajectory import sample
-from ..types import JointTrajectory, Plan, StepResult, TfSamples
+from ..types import Plan, StepResult, TfSamples
+from .request import PlanFlags, PlanRequest, resolve_request
+from .step import plan_step
 
-__all__ = ["PlanRequest", "plan", "resolve_request"]
+__all__ = ["PlanFlags", "PlanRequest", "plan", "plan_to_file", "resolve_request"]
 
-logger = logging.getLogger(__name__)
-
-# The search checks edges every 0.05 rad; what is written is certified as the controller
-# interpolates it, with no robot point moving more than 5 mm between checked states. A
-# trajectory that fails certification has usually crossed a thin obstacle between two checked
-# states: the path's segments are checked again every 0.005 rad, those that fail are planned
-# again at that resolution, and the result is timed closer to the path.
-_COARSE_RAD, _FINE_RAD = 0.05, 0.005  # edge check resolutions
-_COARSE_STEP_RAD, _FINE_STEP_RAD = 0.05, 0.01  # timing resample steps
 _TF_RATE_HZ = 30.0
 
 
-@dataclass(frozen=True)
-class PlanRequest:
-    """Everything one `moveplan plan` run needs, after precedence has been applied."""
-
-    robot: Path
-    steps: tuple[StepSpec, ...]
-    scene: Path | None = None
-    group: str | None = None
-    start: dict[str, Any] = field(default_factory=dict)
-    planner: str | None = None
-    planning_time: float | None = None
-    velocity_scaling: float | None = None
-    acceleration_scaling: float | None = None
-    seed: int = 0
-    min_fraction: float = 1.0
-    package_paths: tuple[Path, ...] = ()
-    xacro_args: dict[str, str] = field(default_factory=dict)
-    task: TaskFile | None = None
-    motion_request: MotionPlanRequest | None = None
-
-
-def resolve_request(task: TaskFile | None, flags: dict[str, Any]) -> PlanRequest:
-    """Return the request that flags, a MoveIt request (flags["request"]) and task give together.
-
-    A flag wins over the MoveIt request, which wins over the task. A goal by flag replaces the
-    request's goal; a request's goal and a task's steps conflict, as a flag goal and task steps do.
-    The request's start state, when it has one, replaces the task's start.
-    """
-    motion = load_motion_plan_request(Path(flags["request"])) if flags.get("request") else None
-    task_values: dict[str, Any] = {}
-    if task is not None:
-        task_values = {"robot": task.robot, "scene": task.scene, "group": task.group, "seed": task.seed,
-                       **task.defaults}
-    request_values: dict[str, Any] = {}
-    if motion is not None:
-        request_values = {"group": motion.group_name, "planner": motion.planner,
-                          "planning_time": motion.planning_time, "velocity_scaling": motion.velocity_scaling,
-                          "acceleration_scaling": motion.acceleration_scaling}
-    merged = {k: v for k, v in task_values.items() if v is not None}
-    merged.update({k: v for k, v in request_values.items() if v is not None})
-    merged.update({k: v for k, v in flags.items() if v is not None and k not in ("steps", "start", "request")})
-    steps = tuple(flags.get("steps") or ())
-    if steps and task is not None and task.steps:
-        raise UsageError(f"{task.source} has steps; give a goal by flag or by task, not both")
-    if not steps and motion is not None and motion.goal is not None:
-        if task is not None and task.steps:
-            raise UsageError(f"{task.source} has steps and {motion.source} has goal_constraints; give one of them")
-        steps = (motion.goal,)
-    if task is not None and not steps:
-        steps = task.steps
-    if not steps:
-        raise UsageError("no goal: give --joints, --named, --pose, --shift, a --request with goal_constraints, "
-                         "or a task file with steps")
-    if "robot" not in merged:
-        raise UsageError("no robot: give --robot or a task file naming one")
-    start = flags.get("start") or {}
-    if not start and task is not None and not (motion is not None and motion.start):
-        start = task.start
-    return PlanRequest(
-        robot=Path(merged["robot"]), steps=steps, scene=merged.get("scene"), group=merged.get("group"),
-        start=start, planner=merged.get("planner"), planning_time=merged.get("planning_time"),
-        velocity_scaling=merged.get("velocity_scaling"), acceleration_scaling=merged.get("acceleration_scaling"),
-        seed=int(merged.get("seed") or 0), min_fraction=float(merged.get("min_fraction", 1.0)),
-        package_paths=tuple(flags.get("package_paths") or ()),
-        xacro_args=dict(flags.get("xacro_args") or {}), task=task, motion_request=motion,
-    )
+def plan_to_file(task: Path | None, flags: PlanFlags, output: Path, ros_distro: str = "jazzy") -> Plan:
+    """Plan what a task file (if any) and the flags ask for, write it to `output` for `ros_distro`, return it."""
+    request = resolve_request(load_task(task) if task is not None else None, flags)
+    result = plan(request)
+    write_plan(output, result, ros_distro)
+    return result
 
 
 def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: bool = False) -> Plan:
@@ -134,17 +49,38 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
     problems with one robot). With `exact_check`, each step's `stats["exact_valid"]` says
     whether its trajectory is free under the URDF's exact meshes, checked independently of
     the planner's geometry (1.0 or 0.0).
+
+    Raises:
+        MoveplanError: Any error while planning a step carries the step's name (`step`).
     """
     seed_planner(request.seed)
     if config is None:
         config = load_robot_config(request.robot, request.package_paths, request.xacro_args)
+    robot = _robot(request, config)
+    scene = load_scene(request.scene, robot) if request.scene else empty_scene()
+    base, current = _start_values(request, robot, scene)
+    checks = scene_checks(robot, scene, config.planning["collision"], base)
+    pair = checks.colliding_pair(current)
+    if pair:
+        raise StartInCollision(pair)
+    steps = _plan_steps(request, robot, scene, checks, current)
+    if exact_check:
+        referee = exact_checks(checks, scene)
+        for step in steps:
+            step.stats["exact_valid"] = float(referee.first_collision_on_trajectory(step.trajectory) is None)
+    return _assemble(request, config, robot, scene, base, steps)
+
+
+def _robot(request: PlanRequest, config: RobotConfig) -> Robot:
+    """Return the robot's planning group, with the request's group and joint names checked against it."""
     motion = request.motion_request
     if motion is not None and motion.group_name and request.group == motion.group_name:
         if motion.group_name not in config.srdf.groups:
             raise UnknownName("group", motion.group_name, f"{motion.source}: group_name", config.srdf.groups)
     robot = Robot(config, request.group)
     if motion is not None and motion.goal is not None and any(s is motion.goal for s in request.steps):
-        for joint in motion.goal.goal.get("joints", {}):
+        named = motion.goal.goal.named_values if isinstance(motion.goal.goal, JointGoal) else None
+        for joint in named or {}:
             if joint not in robot.joint_names:
                 raise UnknownName("joint", joint, f"{motion.source}: goal_constraints[0].joint_constraints "
                                   f"(group '{robot.group.name}')", robot.joint_names)
@@ -152,48 +88,7 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
     if missing:
         raise ConfigError(f"{config.root}: no acceleration limit for joints {', '.join(missing)} "
                           "(joint_limits.yaml: has_acceleration_limits, max_acceleration)")
-    scene = load_scene(request.scene, robot) if request.scene else empty_scene()
-    base, current = _start_values(request, robot, scene)
-    checks = scene_checks(robot, scene, config.planning["collision"], base)
-    pair = checks.colliding_pair(current)
-    if pair:
-        raise StartInCollision(pair)
-
-    steps: list[StepResult] = []
-    for spec in request.steps:
-        try:
-            step = _plan_step(spec, request, robot, scene, checks, current)
-        except (PlanningFailed, GoalUnreachable, StartInCollision, ConfigError) as exc:
-            raise _in_step(exc, spec.name) from None
-        steps.append(step)
-        current = step.trajectory.positions[-1].copy()
-    if exact_check:
-        referee = exact_checks(checks, scene)
-        for step in steps:
-            step.stats["exact_valid"] = float(referee.first_collision_on_trajectory(step.trajectory) is None)
-    return Plan(
-        robot_name=config.name,
-        group=robot.group.name,
-        planning_frame=robot.root_link,
-        steps=tuple(steps),
-        urdf=config.urdf,
-        static_frames=(*robot.fixed_frames(), *scene.frames),
-        objects=scene.objects,
-        tf=_tf_samples(robot, base, steps),
-        limits={j: {"lower": float(robot.lower[i]), "upper": float(robot.upper[i]),
-                    "max_velocity": float(robot.max_velocity[i]),
-                    "max_acceleration": float(robot.max_acceleration[i])}
-                for i, j in enumerate(robot.joint_names)},
-        attachments=_attachments(config, request),
-        metadata={"seed": str(request.seed), "moveplan_version": version("moveplan"),
-                  "planners": ",".join(s.planner for s in steps)},
-    )
-
-
-def _in_step(exc: Exception, step: str) -> Exception:
-    """Return `exc` with the failing step's name in front of its message."""
-    exc.args = (f"step '{step}': {exc.args[0] if exc.args else exc}",)
-    return exc
+    return robot
 
 
 def _start_values(
@@ -215,145 +110,54 @@ def _start_values(
             base = robot.set_joint(base, joint, value)
     start = request.start
     neutral = robot.values(base)
-    if not start:
+    if start is None:
         return base, neutral
-    if "from" in start:
-        last = recording.read_plan(Path(start["from"])).steps[-1].trajectory
+    if isinstance(start, StartFrom):
+        last = read_plan(Path(start.plan)).steps[-1].trajectory
         values = dict(zip(last.joint_names, last.positions[-1], strict=True))
-        start = {"joints": {j: float(v) for j, v in values.items() if j in robot.joint_names}}
+        start = JointGoal.by_name({j: float(v) for j, v in values.items() if j in robot.joint_names})
     source = str(request.task.source) if request.task else "--start-joints"
     return base, joint_target(robot, start, neutral, source)
 
 
-def _scaling(robot: Robot, request: PlanRequest, spec: StepSpec) -> tuple[float, float]:
-    config = robot.config
-    velocity = spec.velocity_scaling or request.velocity_scaling or config.default_velocity_scaling
-    acceleration = spec.acceleration_scaling or request.acceleration_scaling or config.default_acceleration_scaling
-    return velocity, acceleration
-
-
-def _plan_step(
-    spec: StepSpec,
-    request: PlanRequest,
-    robot: Robot,
-    scene: Scene,
-    checks: MotionChecker,
-    start: NDArray[np.float64],
-) -> StepResult:
-    began = time.perf_counter()
-    source = str(request.task.source) if request.task else "flags"
-    base = checks.base
-    planner = spec.planner or request.planner or robot.config.planning["planner"]
-    planning_time = spec.planning_time or request.planning_time or robot.config.planning["planning_time"]
-    fraction, target_pose, link = 1.0, None, robot.group.tip
-    search: Callable[[Validity], PathResult]
-    if "joints" in spec.goal or "named" in spec.goal:
-        goal = joint_target(robot, spec.goal, start, "--joints" if request.task is None else source)
-        pair = checks.colliding_pair(goal)
-        if pair:
-            raise GoalInCollision(pair)
-    else:
-        link, target_pose = tip_target(robot, scene, spec.goal, robot.configuration(start, base), source)
-        if not spec.linear:
-            # Exhaustive: the first valid solution from a far start is not always the nearest one.
-            goal = solve_ik(robot, target_pose, link, start, base=base, seed=request.seed, exhaustive=True,
-                            is_free=checks.state_free, colliding_pair=checks.checker.colliding_pair).values
-    if spec.linear:
-        planner = "linear"
-        line = straight_line(robot, link, start, target_pose, base, checks.free, checks.checker.colliding_pair)
-        fraction = line.fraction
-        minimum = spec.min_fraction if spec.min_fraction is not None else request.min_fraction
-        if fraction < minimum:
-            x, y, z = line.stopped_at
-            raise PlanningFailed(f"straight line achieved {fraction:.1%} of the way (minimum {minimum:.0%}): "
-                                 f"{line.reason}; stopped at [{x:.4f}, {y:.4f}, {z:.4f}] in {robot.root_link}")
-        line_path = PathResult(np.asarray(line.waypoints), planner, 0.0, 0.0)
-        search = lambda validity: line_path  # noqa: E731 - the line is already checked
-    else:
-        search = lambda validity: plan_path(  # noqa: E731
-            start, goal, robot.lower, robot.upper, validity, planner, planning_time)
-    v_scale, a_scale = _scaling(robot, request, spec)
-    max_velocity, max_acceleration = robot.max_velocity * v_scale, robot.max_acceleration * a_scale
-    stats = {"plan_s": 0.0, "simplify_s": 0.0, "timing_s": 0.0, "certify_s": 0.0, "checks": 0.0}
-    # The search checks the hulls, not the meshes, unless the start or goal is free only under the meshes.
-    ends = start[None, :] if spec.linear else np.array([start, goal])
-    conservative = checks.conservative_available and bool(checks.free(ends, conservative=True).all())
-
-    def checked(resolution: float) -> Validity:
-        return Validity(partial(checks.state_free, conservative=conservative),
-                        partial(checks.edge_free, resolution=resolution, conservative=conservative))
-
-    def certified(path: PathResult, max_step: float) -> tuple[JointTrajectory, NDArray[np.float64] | None]:
-        mark = time.perf_counter()
-        trajectory = time_parameterize(robot.joint_names, path.waypoints, max_velocity, max_acceleration,
-                                       max_step=max_step)
-        timed = time.perf_counter()
-        hit = checks.first_collision_on_trajectory(trajectory)
-        _add(stats, path, timed - mark, time.perf_counter() - timed)
-        return trajectory, hit
-
-    path = search(checked(_COARSE_RAD))
-    trajectory, hit = certified(path, _COARSE_STEP_RAD)
-    if hit is not None and not spec.linear:
-        logger.debug("trajectory collides when certified; planning its colliding segments again, finer")
+def _plan_steps(
+    request: PlanRequest, robot: Robot, scene: Scene, checks: MotionChecker, start: NDArray[np.float64]
+) -> list[StepResult]:
+    """Return every step planned in order, each from where the previous one ended."""
+    steps: list[StepResult] = []
+    current = start
+    for spec in request.steps:
         try:
-            path = repair_path(path.waypoints, robot.lower, robot.upper, checked(_FINE_RAD), planner, planning_time)
-            trajectory, hit = certified(path, _FINE_STEP_RAD)
-        except PlanningFailed:
-            pass  # a whole new search below
-    if hit is not None:
-        logger.debug("trajectory collides when certified; planning it all again, finer")
-        path = search(checked(_FINE_RAD))
-        trajectory, hit = certified(path, _FINE_STEP_RAD)
-    if hit is not None:
-        # A path hugging an obstacle defeats smoothing, and one through a thin obstacle can pass
-        # coarse edge checks. Last resort: plan with edges checked at the certification states
-        # and stop at each waypoint, so every joint, the controller's quintics included, stays on
-        # the straight segments exactly; certify those segments.
-        path = search(Validity(checks.state_free, checks.edge_free_certified))
-        mark = time.perf_counter()
-        trajectory = rest_to_rest(robot.joint_names, path.waypoints, max_velocity, max_acceleration)
-        timed = time.perf_counter()
-        hit = checks.first_collision_on_path(path.waypoints)
-        _add(stats, path, timed - mark, time.perf_counter() - timed)
-        if hit is not None:
-            pair = checks.colliding_pair(hit) or ("?", "?")
-            raise PlanningFailed(f"the timed trajectory collides ({pair[0]} touches {pair[1]}) where the path did not")
-    waypoints = path.waypoints
-    stats["path_length"] = float(np.sum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1)))
-    check_limits(robot, trajectory.positions.max(axis=0))
-    check_limits(robot, trajectory.positions.min(axis=0))
-    end = trajectory.positions[-1]
-    if target_pose is None:
-        residual = {"joints_rad": float(np.max(np.abs(end - waypoints[-1])))}
-    else:
-        reached = robot.frame_pose(robot.configuration(end, base), link)
-        position, angle = pose_error(reached, target_pose)
-        residual = {"position_m": position, "orientation_rad": angle}
-    return StepResult(
-        name=spec.name,
-        goal=_describe(spec.goal),
-        planner=path.planner,
-        planning_time_s=time.perf_counter() - began,
-        trajectory=trajectory,
-        fraction=fraction,
-        residual=residual,
-        stats=stats,
+            step = plan_step(spec, request, robot, scene, checks, current)
+        except MoveplanError as exc:
+            raise exc.in_step(spec.name) from None
+        steps.append(step)
+        current = step.trajectory.positions[-1].copy()
+    return steps
+
+
+def _assemble(
+    request: PlanRequest, config: RobotConfig, robot: Robot, scene: Scene, base: NDArray[np.float64],
+    steps: list[StepResult],
+) -> Plan:
+    """Return the plan of the planned steps, with what replaying and checking it needs."""
+    return Plan(
+        robot_name=config.name,
+        group=robot.group.name,
+        planning_frame=robot.root_link,
+        steps=tuple(steps),
+        urdf=config.urdf,
+        static_frames=(*robot.fixed_frames(), *scene.frames),
+        objects=scene.objects,
+        tf=_tf_samples(robot, base, steps),
+        limits={j: {"lower": float(robot.lower[i]), "upper": float(robot.upper[i]),
+                    "max_velocity": float(robot.max_velocity[i]),
+                    "max_acceleration": float(robot.max_acceleration[i])}
+                for i, j in enumerate(robot.joint_names)},
+        attachments=_attachments(config, request),
+        metadata={"seed": str(request.seed), "moveplan_version": version("moveplan"),
+                  "planners": ",".join(s.planner for s in steps)},
     )
-
-
-def _add(stats: dict[str, float], path: PathResult, timing_s: float, certify_s: float) -> None:
-    """Add one attempt's times to a step's statistics."""
-    stats["plan_s"] += path.planning_s
-    stats["simplify_s"] += path.simplify_s
-    stats["timing_s"] += timing_s
-    stats["certify_s"] += certify_s
-    stats["checks"] += path.checks
-
-
-def _describe(goal: dict[str, Any]) -> dict[str, Any]:
-    return {k: (dict(v) if isinstance(v, dict) else list(v) if isinstance(v, list | tuple) else v)
-            for k, v in goal.items()}
 
 
 def _tf_samples(robot: Robot, base: NDArray[np.float64], steps: list[StepResult]) -> TfSamples:
@@ -371,6 +175,7 @@ def _tf_samples(robot: Robot, base: NDArray[np.float64], steps: list[StepResult]
 
 
 def _attachments(config: RobotConfig, request: PlanRequest) -> dict[str, bytes]:
+    """Return the files a plan embeds: the robot config's, and the scene, task and request given."""
     files = dict(config.files)
     if request.scene is not None:
         files[f"scene{Path(request.scene).suffix}"] = Path(request.scene).read_bytes()

@@ -1,4 +1,4 @@
-"""Goals: turn a step's goal into target joint values for the planning group.
+"""Goals: turn a step's typed goal into target joint values, or a target pose, for the planning group.
 
 Joint goals may be complete (one value per group joint, in group order) or
 partial (joint: value; the others keep their start values). Named goals are
@@ -10,12 +10,11 @@ evaluated with the robot where the step starts (frames on moving links move).
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from ..config.goals import JointGoal, NamedGoal, PoseGoal, ShiftGoal
 from ..errors import ConfigError, GoalOutsideLimits, UnknownName, UsageError
 from ..model.poses import pose_matrix
 from ..model.robot import Robot
@@ -35,23 +34,27 @@ def named_state(robot: Robot, name: str, start: NDArray[np.float64]) -> NDArray[
     return _apply(robot, states[name], start, f"{robot.config.srdf_path} group_state '{name}'")
 
 
-def joint_target(robot: Robot, goal: dict[str, Any], start: NDArray[np.float64], source: str) -> NDArray[np.float64]:
-    """Return the group values a joints or named goal asks for, checked against the limits."""
-    if "named" in goal:
-        target = named_state(robot, goal["named"], start)
+def joint_target(
+    robot: Robot, goal: JointGoal | NamedGoal, start: NDArray[np.float64], source: str
+) -> NDArray[np.float64]:
+    """Return the group values a joints or named goal asks for, checked against the limits.
+
+    `source` names where the goal came from: a flag ("--joints"; a malformed one is a
+    UsageError) or a file (a ConfigError).
+    """
+    if isinstance(goal, NamedGoal):
+        target = named_state(robot, goal.name, start)
+    elif (named := goal.named_values) is not None:
+        target = _apply(robot, named, start, source)
     else:
-        joints = goal["joints"]
-        if isinstance(joints, dict):
-            target = _apply(robot, joints, start, source)
-        else:
-            if len(joints) != robot.dof:
-                # A count that does not fit is a malformed flag (exit 2) or a malformed file (exit 3).
-                error = UsageError if source.startswith("--") else ConfigError
-                raise error(
-                    f"{source}: joint goal has {len(joints)} values; group '{robot.group.name}' has "
-                    f"{robot.dof} joints: {', '.join(robot.joint_names)}"
-                )
-            target = np.array(joints, dtype=float)
+        if len(goal.values) != robot.dof:
+            # A count that does not fit is a malformed flag (exit 2) or a malformed file (exit 3).
+            error = UsageError if source.startswith("--") else ConfigError
+            raise error(
+                f"{source}: joint goal has {len(goal.values)} values; group '{robot.group.name}' has "
+                f"{robot.dof} joints: {', '.join(robot.joint_names)}"
+            )
+        target = np.array(goal.values, dtype=float)
     check_limits(robot, target)
     return target
 
@@ -75,27 +78,26 @@ def _apply(robot: Robot, values: dict[str, float], start: NDArray[np.float64], s
 
 
 def tip_target(
-    robot: Robot, scene: Scene, goal: dict[str, Any], q: NDArray[np.float64], source: str
+    robot: Robot, scene: Scene, goal: PoseGoal | ShiftGoal, q: NDArray[np.float64], source: str
 ) -> tuple[str, NDArray[np.float64]]:
     """Return (link, `root_T_link`) that a pose or shift goal asks for, from configuration `q`."""
-    if "pose" in goal:
-        pose = goal["pose"]
-        link = pose.get("link") or robot.group.tip
-        frame = pose.get("frame") or robot.root_link
-        anchor, anchor_T_frame = scene.anchor(frame, robot)
-        root_T_frame = robot.frame_pose(q, anchor) @ anchor_T_frame
-        # What the pose leaves out is the frame's own: no offset, no rotation.
-        return link, root_T_frame @ pose_matrix(pose["xyz"], pose.get("rpy"), pose.get("quat"), source)
-    return robot.group.tip, _shifted(robot, scene, goal["shift"], q)
+    if isinstance(goal, ShiftGoal):
+        return robot.group.tip, _shifted(robot, scene, goal, q)
+    link = goal.link or robot.group.tip
+    frame = goal.frame or robot.root_link
+    anchor, anchor_T_frame = scene.anchor(frame, robot)
+    root_T_frame = robot.frame_pose(q, anchor) @ anchor_T_frame
+    # What the pose leaves out is the frame's own: no offset, no rotation.
+    return link, root_T_frame @ pose_matrix(goal.xyz, goal.rpy, goal.quat, source)
 
 
-def _shifted(robot: Robot, scene: Scene, shift: dict[str, Any], q: NDArray[np.float64]) -> NDArray[np.float64]:
+def _shifted(robot: Robot, scene: Scene, shift: ShiftGoal, q: NDArray[np.float64]) -> NDArray[np.float64]:
     """Return the tip pose moved by `shift` from where it is in `q`."""
     now = robot.frame_pose(q, robot.group.tip)
-    t = np.array([shift.get(a, 0.0) for a in ("x", "y", "z")])
-    rpy = np.array([shift.get(a, 0.0) for a in ("roll", "pitch", "yaw")])
+    t = np.array(shift.translation())
+    rpy = np.array(shift.rotation())
     delta = pose_matrix(list(t), list(rpy), None, "shift")
-    frame = shift.get("frame", "tool")
+    frame = shift.frame
     if frame == "tool":
         return now @ delta
     goal = now.copy()

@@ -1,0 +1,71 @@
+"""What `moveplan inspect` shows of an MCAP file: its topics and, for a plan file, each step's peak rates."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..bag import BagSummary, PlanFile, read_plan, summarize
+from ..trajectory import peak_rates
+
+__all__ = ["Inspection", "StepPeaks", "inspect_file", "step_peaks"]
+
+
+@dataclass(frozen=True)
+class StepPeaks:
+    """One plan step's timing and how close it comes to the joint limits.
+
+    Attributes:
+        name: The step's name.
+        start_s: Start on the plan's timeline in [s].
+        duration_s: Duration in [s].
+        points: Trajectory points.
+        peak_velocity_fraction: Largest |velocity| / max_velocity over the joints, anywhere along
+            the interpolation (1.0: at the unscaled limit).
+        peak_acceleration_fraction: Largest |acceleration| / max_acceleration, likewise.
+    """
+
+    name: str
+    start_s: float
+    duration_s: float
+    points: int
+    peak_velocity_fraction: float
+    peak_acceleration_fraction: float
+
+
+@dataclass(frozen=True)
+class Inspection:
+    """An MCAP file's summary, and for a plan file the plan and its steps' peak rates (else None and ())."""
+
+    path: Path
+    summary: BagSummary
+    plan: PlanFile | None
+    steps: tuple[StepPeaks, ...] = ()
+
+
+def inspect_file(path: Path) -> Inspection:
+    """Return the summary of any MCAP file; a plan file (moveplan metadata) is read back too."""
+    summary = summarize(path)
+    if "moveplan" not in summary.metadata:
+        return Inspection(path, summary, None)
+    plan = read_plan(path)
+    return Inspection(path, summary, plan, step_peaks(plan))
+
+
+def step_peaks(plan: PlanFile) -> tuple[StepPeaks, ...]:
+    """Return each step's duration and peak velocity and acceleration as fractions of the plan's limits."""
+    steps = []
+    for step in plan.steps:
+        peak_v, peak_a = peak_rates(step.trajectory)
+        names = step.trajectory.joint_names
+        v_limit = np.array([plan.limits[j]["max_velocity"] for j in names])
+        a_limit = np.array([plan.limits[j]["max_acceleration"] for j in names])
+        steps.append(StepPeaks(
+            name=step.name, start_s=step.start_s, duration_s=step.trajectory.duration_s,
+            points=len(step.trajectory.times_s),
+            peak_velocity_fraction=float(np.max(peak_v / v_limit)),
+            peak_acceleration_fraction=float(np.max(peak_a / a_limit)),
+        ))
+    return tuple(steps)

@@ -1,0 +1,260 @@
+"""One plan step, in named stages: settings, target, search, certified timed path, residual.
+
+The target is joint values (a joints or named goal, or the IK solution of a pose or shift
+goal) or, for a linear step, the pose of a link; the search is OMPL's or a straight line of
+the tip; what is written is certified as the controller interpolates it.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import partial
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..collision.motion import MotionChecker
+from ..config import JointGoal, NamedGoal, StepSpec
+from ..errors import GoalInCollision, PlanningFailed
+from ..model.kinematics import solve_ik
+from ..model.robot import Robot
+from ..model.scene import Scene
+from ..planning.cartesian import straight_line
+from ..planning.goals import check_limits, joint_target, pose_error, tip_target
+from ..planning.search import PathResult, Validity, plan_path, repair_path
+from ..timing import rest_to_rest, time_parameterize
+from ..types import JointTrajectory, StepResult
+from .request import PlanRequest
+
+__all__ = ["plan_step"]
+
+logger = logging.getLogger(__name__)
+
+# The search checks edges every 0.05 rad; what is written is certified as the controller
+# interpolates it, with no robot point moving more than 5 mm between checked states. A
+# trajectory that fails certification has usually crossed a thin obstacle between two checked
+# states: the path's segments are checked again every 0.005 rad, those that fail are planned
+# again at that resolution, and the result is timed closer to the path.
+_COARSE_RAD, _FINE_RAD = 0.05, 0.005  # edge check resolutions
+_COARSE_STEP_RAD, _FINE_STEP_RAD = 0.05, 0.01  # timing resample steps
+
+_Search = Callable[[Validity], PathResult]
+
+
+@dataclass(frozen=True)
+class _Settings:
+    """A step's planner settings after precedence: step > request > robot config.
+
+    Attributes:
+        planner: OMPL planner name.
+        planning_time: Seconds the planner may search.
+        max_velocity: Scaled velocity limits per group joint in [rad]/[s] or [m]/[s].
+        max_acceleration: Scaled acceleration limits per group joint in [rad]/[s]^2 or [m]/[s]^2.
+        min_fraction: Smallest fraction of a straight line that is a success.
+    """
+
+    planner: str
+    planning_time: float
+    max_velocity: NDArray[np.float64]
+    max_acceleration: NDArray[np.float64]
+    min_fraction: float
+
+
+@dataclass(frozen=True)
+class _Target:
+    """Where a step goes: group values (None for a linear step), and the link and pose a tip goal asks for."""
+
+    values: NDArray[np.float64] | None
+    link: str
+    pose: NDArray[np.float64] | None = None
+
+
+def plan_step(
+    spec: StepSpec,
+    request: PlanRequest,
+    robot: Robot,
+    scene: Scene,
+    checks: MotionChecker,
+    start: NDArray[np.float64],
+) -> StepResult:
+    """Return one step planned from `start`: target, search, certified timing, residual."""
+    began = time.perf_counter()
+    settings = _settings(spec, request, robot)
+    target = _target(spec, request, robot, scene, checks, start)
+    search, fraction = _search(spec, settings, robot, checks, start, target)
+    path, trajectory, stats = _certified(spec, settings, robot, checks, start, target, search)
+    stats["path_length"] = float(np.sum(np.linalg.norm(np.diff(path.waypoints, axis=0), axis=1)))
+    check_limits(robot, trajectory.positions.max(axis=0))
+    check_limits(robot, trajectory.positions.min(axis=0))
+    residual = _residual(robot, checks.base, target, trajectory.positions[-1], path.waypoints[-1])
+    return StepResult(
+        name=spec.name,
+        goal=spec.goal.describe(),
+        planner=path.planner,
+        planning_time_s=time.perf_counter() - began,
+        trajectory=trajectory,
+        fraction=fraction,
+        residual=residual,
+        stats=stats,
+    )
+
+
+def _settings(spec: StepSpec, request: PlanRequest, robot: Robot) -> _Settings:
+    """Return a step's planner, planning time, scaled limits and minimum fraction."""
+    config = robot.config
+    velocity = spec.velocity_scaling or request.velocity_scaling or config.default_velocity_scaling
+    acceleration = spec.acceleration_scaling or request.acceleration_scaling or config.default_acceleration_scaling
+    return _Settings(
+        planner=spec.planner or request.planner or config.planning["planner"],
+        planning_time=spec.planning_time or request.planning_time or config.planning["planning_time"],
+        max_velocity=robot.max_velocity * velocity,
+        max_acceleration=robot.max_acceleration * acceleration,
+        min_fraction=spec.min_fraction if spec.min_fraction is not None else request.min_fraction,
+    )
+
+
+def _target(
+    spec: StepSpec, request: PlanRequest, robot: Robot, scene: Scene, checks: MotionChecker, start: NDArray[np.float64]
+) -> _Target:
+    """Return the group values a step goes to (checked free), or the pose of a link it moves to."""
+    source = str(request.task.source) if request.task else "flags"
+    goal = spec.goal
+    if isinstance(goal, JointGoal | NamedGoal):
+        values = joint_target(robot, goal, start, "--joints" if request.task is None else source)
+        pair = checks.colliding_pair(values)
+        if pair:
+            raise GoalInCollision(pair)
+        return _Target(values, robot.group.tip)
+    base = checks.base
+    link, pose = tip_target(robot, scene, goal, robot.configuration(start, base), source)
+    if spec.linear:
+        return _Target(None, link, pose)
+    # Exhaustive: the first valid solution from a far start is not always the nearest one.
+    solution = solve_ik(robot, pose, link, start, base=base, seed=request.seed, exhaustive=True,
+                        is_free=checks.state_free, colliding_pair=checks.checker.colliding_pair)
+    return _Target(solution.values, link, pose)
+
+
+def _search(
+    spec: StepSpec, settings: _Settings, robot: Robot, checks: MotionChecker, start: NDArray[np.float64],
+    target: _Target,
+) -> tuple[_Search, float]:
+    """Return the step's search under given collision checks, and the fraction of the way it covers.
+
+    A linear step's line is planned (and checked) here, once; the search then returns it.
+    """
+    if not spec.linear:
+        goal = target.values
+        assert goal is not None, "a step that is not linear has target values"
+        return (lambda validity: plan_path(start, goal, robot.lower, robot.upper, validity, settings.planner,
+                                           settings.planning_time)), 1.0
+    assert target.pose is not None, "a linear step has a target pose"
+    line = straight_line(robot, target.link, start, target.pose, checks.base, checks.free,
+                         checks.checker.colliding_pair)
+    if line.fraction < settings.min_fraction:
+        x, y, z = line.stopped_at
+        raise PlanningFailed(f"straight line achieved {line.fraction:.1%} of the way (minimum "
+                             f"{settings.min_fraction:.0%}): {line.reason}; stopped at [{x:.4f}, {y:.4f}, {z:.4f}] "
+                             f"in {robot.root_link}")
+    line_path = PathResult(np.asarray(line.waypoints), "linear", 0.0, 0.0)
+    return (lambda validity: line_path), line.fraction  # the line is already checked
+
+
+def _certified(
+    spec: StepSpec, settings: _Settings, robot: Robot, checks: MotionChecker, start: NDArray[np.float64],
+    target: _Target, search: _Search,
+) -> tuple[PathResult, JointTrajectory, dict[str, float]]:
+    """Return a path, its timed trajectory certified collision-free, and the step's statistics.
+
+    Coarse search and timing first; a trajectory that collides when certified has its colliding
+    segments planned again finer, then the whole search again finer, then (last resort) a search
+    with edges checked at the certification states, timed to stop at every waypoint.
+    """
+    # The search checks the hulls, not the meshes, unless the start or goal is free only under the meshes.
+    ends = start[None, :] if target.values is None else np.array([start, target.values])
+    conservative = checks.conservative_available and bool(checks.free(ends, conservative=True).all())
+    certifier = _Certifier(robot, checks, settings)
+
+    def checked(resolution: float) -> Validity:
+        return Validity(partial(checks.state_free, conservative=conservative),
+                        partial(checks.edge_free, resolution=resolution, conservative=conservative))
+
+    path = search(checked(_COARSE_RAD))
+    trajectory, hit = certifier.certified(path, _COARSE_STEP_RAD)
+    if hit is not None and not spec.linear:
+        logger.debug("trajectory collides when certified; planning its colliding segments again, finer")
+        try:
+            path = repair_path(path.waypoints, robot.lower, robot.upper, checked(_FINE_RAD), settings.planner,
+                               settings.planning_time)
+            trajectory, hit = certifier.certified(path, _FINE_STEP_RAD)
+        except PlanningFailed:
+            pass  # a whole new search below
+    if hit is not None:
+        logger.debug("trajectory collides when certified; planning it all again, finer")
+        path = search(checked(_FINE_RAD))
+        trajectory, hit = certifier.certified(path, _FINE_STEP_RAD)
+    if hit is not None:
+        path = search(Validity(checks.state_free, checks.edge_free_certified))
+        trajectory = certifier.rest_to_rest(path)
+    return path, trajectory, certifier.stats
+
+
+@dataclass
+class _Certifier:
+    """Times paths within a step's limits, certifies the result, and adds up the step's statistics."""
+
+    robot: Robot
+    checks: MotionChecker
+    settings: _Settings
+    stats: dict[str, float] = field(
+        default_factory=lambda: {"plan_s": 0.0, "simplify_s": 0.0, "timing_s": 0.0, "certify_s": 0.0, "checks": 0.0})
+
+    def certified(self, path: PathResult, max_step: float) -> tuple[JointTrajectory, NDArray[np.float64] | None]:
+        """Return the path timed (resampled every `max_step` [rad]) and its first colliding state, if any."""
+        mark = time.perf_counter()
+        trajectory = time_parameterize(self.robot.joint_names, path.waypoints, self.settings.max_velocity,
+                                       self.settings.max_acceleration, max_step=max_step)
+        timed = time.perf_counter()
+        hit = self.checks.first_collision_on_trajectory(trajectory)
+        self._add(path, timed - mark, time.perf_counter() - timed)
+        return trajectory, hit
+
+    def rest_to_rest(self, path: PathResult) -> JointTrajectory:
+        """Return the path timed to stop at every waypoint, its straight segments certified.
+
+        A path hugging an obstacle defeats smoothing, and one through a thin obstacle can pass
+        coarse edge checks. Stopping at each waypoint keeps every joint, the controller's
+        quintics included, on the straight segments exactly.
+        """
+        mark = time.perf_counter()
+        trajectory = rest_to_rest(self.robot.joint_names, path.waypoints, self.settings.max_velocity,
+                                  self.settings.max_acceleration)
+        timed = time.perf_counter()
+        hit = self.checks.first_collision_on_path(path.waypoints)
+        self._add(path, timed - mark, time.perf_counter() - timed)
+        if hit is not None:
+            pair = self.checks.colliding_pair(hit) or ("?", "?")
+            raise PlanningFailed(f"the timed trajectory collides ({pair[0]} touches {pair[1]}) where the path did not")
+        return trajectory
+
+    def _add(self, path: PathResult, timing_s: float, certify_s: float) -> None:
+        """Add one attempt's times to the step's statistics."""
+        self.stats["plan_s"] += path.planning_s
+        self.stats["simplify_s"] += path.simplify_s
+        self.stats["timing_s"] += timing_s
+        self.stats["certify_s"] += certify_s
+        self.stats["checks"] += path.checks
+
+
+def _residual(
+    robot: Robot, base: NDArray[np.float64], target: _Target, end: NDArray[np.float64], path_end: NDArray[np.float64]
+) -> dict[str, float]:
+    """Return how far the trajectory's end is from the goal: in joint space, or as a tip pose error."""
+    if target.pose is None:
+        return {"joints_rad": float(np.max(np.abs(end - path_end)))}
+    reached = robot.frame_pose(robot.configuration(end, base), target.link)
+    position, angle = pose_error(reached, target.pose)
+    return {"position_m": position, "orientation_rad": angle}
