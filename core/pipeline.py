@@ -29,6 +29,7 @@ from moveplan.core.errors import (
     GoalInCollision,
     GoalUnreachable,
     PlanningFailed,
+    PlanningTimeExceeded,
     StartInCollision,
     UnknownName,
     UsageError,
@@ -330,6 +331,8 @@ def _plan_step(
         try:
             path = repair_path(path.waypoints, robot.lower, robot.upper, checked(_FINE_RAD), planner, planning_time)
             trajectory, hit = certified(path, _FINE_STEP_RAD)
+        except PlanningTimeExceeded:
+            raise
         except PlanningFailed:
             pass  # a whole new search below
     if hit is not None:

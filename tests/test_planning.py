@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from moveplan.core import planning
-from moveplan.core.errors import PlanningFailed
+from moveplan.core.errors import PlanningFailed, PlanningTimeExceeded
 from moveplan.core.planning import Validity, interpolate, plan_path, repair_path
 
 LOWER, UPPER = np.array([-1.0, -1.0]), np.array([2.0, 2.0])
@@ -83,7 +83,7 @@ def test_a_search_stops_after_its_budget_of_checked_motions(monkeypatch: pytest.
 
 
 def test_a_slow_search_stops_at_the_wall_clock_cap_and_says_so() -> None:
-    with pytest.raises(PlanningFailed, match=r"planning time cap of 0.05 s after \d+ of its 1000 checked motions"):
+    with pytest.raises(PlanningTimeExceeded, match=r"planning time cap of 0.05 s after \d+ of its 1000 checked motions"):
         plan_path(np.array([-0.5, -0.5]), np.array([0.5, 0.5]), LOWER, UPPER, _boxed_in(0.002), "RRTConnect", 0.05)
 
 
