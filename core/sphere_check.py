@@ -154,6 +154,8 @@ class SphereFilter:
         """
         q = np.empty((len(values), self._nq))
         out = np.empty(len(values), dtype=np.int8)
+        if not values.flags.writeable:
+            values = np.array(values)  # one compiled version only: see `edge`
         judged = self._kernels.classify(values, stop, *self._packed, q, out)
         return out[:judged], q[:judged]
 
@@ -166,6 +168,10 @@ class SphereFilter:
         With `stop`, judging ends at the first state that COLLIDES. The arrays returned are
         overwritten by the next call.
         """
+        if not (a.flags.writeable and b.flags.writeable):
+            # numba compiles another version for read-only arrays (a frozen path's waypoints),
+            # which would take seconds in the middle of a search on a fresh machine.
+            a, b = np.array(a), np.array(b)
         worst, kept = self._kernels.edge(a, b, resolution, stop, *self._packed, self._verdicts, self._unclear)
         if kept < 0:  # more states than the buffers hold
             self._verdicts, self._unclear = np.empty(-kept, dtype=np.int8), np.empty((-kept, self._nq))
