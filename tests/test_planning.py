@@ -14,6 +14,12 @@ from moveplan.core.planning import Validity, interpolate, plan_path, repair_path
 LOWER, UPPER = np.array([-1.0, -1.0]), np.array([2.0, 2.0])
 
 
+@pytest.fixture(autouse=True)
+def _seeded() -> None:
+    """Seed every search: unseeded, a test draws whatever the tests before it left in OMPL's generator."""
+    planning.seed_planner(0)
+
+
 def _wall(resolution: float) -> Validity:
     """Return checks in a plane with a wall 1 cm thick at x = 0.51, open above y = 0.8."""
 
