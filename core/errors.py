@@ -22,6 +22,7 @@ __all__ = [
     "MoveplanError",
     "NoPlan",
     "PlanningFailed",
+    "PlanningTimeExceeded",
     "StartInCollision",
     "UnknownName",
     "UnsupportedJoint",
@@ -159,3 +160,10 @@ class GoalUnreachable(NoPlan):
 
 class PlanningFailed(NoPlan):
     """The planner found no path (or a linear path was incomplete)."""
+
+
+class PlanningTimeExceeded(PlanningFailed):
+    """A search reached the wall-clock planning time before its budget of checked motions.
+
+    Never caught to try something else: what a plan does next must not depend on the clock.
+    """

@@ -21,7 +21,7 @@ MISTUNED = SAMPLES / "excavator_mistuned_controllers.yaml"
 JOINTS = ["turret_joint", "shoulder_joint", "elbow_joint", "wrist_joint"]
 BODY_UNDERSIDE_Z = -0.125  # base_link is the body box's centre; the box is 0.25 m high
 GROUND_Z = -0.35  # where the wheels stand
-REALISTIC_DRIVE = ["--plant-param", "max_velocity=1.0", "--plant-param", "max_effort=3.0"]
+REALISTIC_DRIVE = ["--plant-param", "max_velocity=1.0", "--plant-param", "max_effort=3.5"]
 
 
 @pytest.fixture(scope="module")

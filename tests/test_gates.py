@@ -11,6 +11,7 @@ import pytest
 from conftest import ROOT, SAMPLES, Cli, run_process
 
 from moveplan.core.pipeline.benchmark import find_problems, run_benchmark
+from moveplan.core.planning import search as planning
 
 MBM = ROOT / "tests" / "data" / "mbm"
 TASKS = sorted(p for p in SAMPLES.glob("*.yaml") if "steps:" in p.read_text())
@@ -67,3 +68,14 @@ def test_a_seeded_plan_is_the_same_after_other_plans_in_one_process(cli: Cli, tm
     assert again.read_bytes() == first.read_bytes()
     assert other.read_bytes() != first.read_bytes()
 
+
+
+def test_a_search_cut_short_by_the_clock_fails_the_step_naming_the_cap(
+    cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setattr(planning._Work, "out_of_time", lambda self: True)  # a machine far too busy
+    out = tmp_path / "plan.mcap"
+    run = cli(*shelf_0093(), "-o", out)
+    assert run.exit_code == 4
+    assert "step 'bookshelf_request0093'" in run.stderr and "planning time cap of 1 s" in run.stderr
+    assert not out.exists()

@@ -114,6 +114,21 @@ def test_an_edge_is_judged_at_every_state_between_its_ends_once(
         assert stopped[0] == worst and (worst != COLLIDES or stopped[1][-1] == COLLIDES)
 
 
+def test_read_only_states_are_judged_without_compiling_the_kernels_again(
+    panda_in_box: tuple[Robot, CollisionChecker, CollisionChecker, SphereFilter],
+) -> None:
+    from moveplan.core.collision import _kernels as sphere_kernels
+
+    robot, _, _, spheres = panda_in_box
+    before = len(sphere_kernels.edge.signatures), len(sphere_kernels.classify.signatures)
+    path = np.array([robot.values(robot.neutral()), robot.upper * 0.5])
+    path.setflags(write=False)  # as a planned path's frozen waypoints
+    spheres.edge(path[0], path[1], 0.05)
+    spheres.classify(path)
+    # Compiling another version takes seconds on a fresh machine, inside a clocked search.
+    assert (len(sphere_kernels.edge.signatures), len(sphere_kernels.classify.signatures)) == before
+
+
 def test_edges_and_states_are_judged_alike_with_and_without_the_spheres_and_hulls(
     panda_in_box: tuple[Robot, CollisionChecker, CollisionChecker, SphereFilter]
 ) -> None:

@@ -110,7 +110,7 @@ class SphereFilter:
         """
         q = np.empty((len(values), self._nq))
         out = np.empty(len(values), dtype=np.int8)
-        judged = self._kernels.classify(values, stop, *self._packed, q, out)
+        judged = self._kernels.classify(_plain(values), stop, *self._packed, q, out)
         return out[:judged], q[:judged]
 
     def edge(
@@ -122,6 +122,7 @@ class SphereFilter:
         With `stop`, judging ends at the first state that COLLIDES. The arrays returned are
         overwritten by the next call.
         """
+        a, b = _plain(a), _plain(b)
         worst, kept = self._kernels.edge(a, b, resolution, stop, *self._packed, self._verdicts, self._unclear)
         if kept < 0:  # more states than the buffers hold
             self._verdicts, self._unclear = np.empty(-kept, dtype=np.int8), np.empty((-kept, self._nq))
@@ -216,6 +217,17 @@ def _world_checks(
     # checker tests those pairs once, when the scene loads, so no state needs to.
     return np.array([[frozenset((name, obj.name)) not in allowed and owner_joint[k] != 0 for obj in world]
                      for k, name in enumerate(names)]).reshape(len(names), len(world))
+
+
+def _plain(values: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Return `values` as a writable, C-ordered float64 array, copied only if it is not one already.
+
+    numba compiles a version of a kernel per array type, read-only and strided ones included
+    (a planned path's frozen waypoints): seconds on a fresh machine, in the middle of a search.
+    """
+    if values.dtype == np.float64 and values.flags.c_contiguous and values.flags.writeable:
+        return values
+    return np.array(values, dtype=np.float64, order="C")
 
 
 def _inner_arrays(inner: SphereSet, names: list[str]) -> dict[str, NDArray[Any]]:

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from ..collision.motion import MotionChecker
 from ..config import JointGoal, NamedGoal, StepSpec
-from ..errors import GoalInCollision, PlanningFailed
+from ..errors import GoalInCollision, PlanningFailed, PlanningTimeExceeded
 from ..model.kinematics import solve_ik
 from ..model.robot import Robot
 from ..model.scene import Scene
@@ -190,6 +190,8 @@ def _certified(
             path = repair_path(path.waypoints, robot.lower, robot.upper, checked(_FINE_RAD), settings.planner,
                                settings.planning_time)
             trajectory, hit = certifier.certified(path, _FINE_STEP_RAD)
+        except PlanningTimeExceeded:
+            raise  # the clock never decides what a plan does next
         except PlanningFailed:
             pass  # a whole new search below
     if hit is not None:

@@ -28,7 +28,7 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from ..config.planners import PLANNERS
-from ..errors import PlanningFailed, UsageError, known
+from ..errors import PlanningFailed, PlanningTimeExceeded, UsageError, known
 from ..types import frozen_array
 
 __all__ = ["PLANNERS", "PathResult", "Validity", "plan_path", "repair_path", "seed_planner"]
@@ -113,7 +113,7 @@ class _Work:
     def failure(self, planner: str, status: object) -> PlanningFailed:
         """Return the error for a search that found no path, naming what ended it."""
         if self.used < self.budget and self.out_of_time():
-            return PlanningFailed(
+            return PlanningTimeExceeded(
                 f"{planner} reached the planning time cap of {self.time_s:g} s after {self.used} of its "
                 f"{self.budget} checked motions; the machine is slower or busier than the budget assumes: "
                 "raise --planning-time")

@@ -16,7 +16,9 @@ from numpy.typing import NDArray
 
 from ..types import frozen_array
 
-__all__ = ["BlendedPath", "blended_path"]
+__all__ = ["BlendedPath", "blended_path", "distinct_waypoints"]
+
+_REPEAT = 1e-12  # [rad] a waypoint within this of the one before in every joint repeats it
 
 
 @dataclass(frozen=True)
@@ -102,7 +104,8 @@ def blended_path(waypoints: npt.ArrayLike, max_step: float, fraction: float) -> 
     [rad] per step. A corner's blend takes the same arc length h from both of its segments:
     `fraction` of the shorter of their steps, and at most half of either segment. It strays
     from the polyline by at most 3/16 h |d_out - d_in| (d: the segments' unit directions),
-    at its middle. Repeated waypoints are dropped; at least two distinct ones are needed.
+    at its middle. Repeated waypoints are dropped (distinct_waypoints); at least two distinct
+    ones are needed.
 
     Args:
         waypoints: Joint positions, shape (m, n).
@@ -112,8 +115,8 @@ def blended_path(waypoints: npt.ArrayLike, max_step: float, fraction: float) -> 
     points = np.asarray(waypoints, dtype=np.float64)
     steps = points[1:] - points[:-1]
     moves = np.abs(steps).max(axis=1)  # of the largest joint
-    if (moves <= 1e-12).any():
-        points = points[np.concatenate(([True], moves > 1e-12))]
+    if not (moves > _REPEAT).all():
+        points = distinct_waypoints(points)
         steps = points[1:] - points[:-1]
         moves = np.abs(steps).max(axis=1)
     if len(points) < 2:
@@ -145,3 +148,23 @@ def blended_path(waypoints: npt.ArrayLike, max_step: float, fraction: float) -> 
     turned = np.zeros(2 * count - 1)
     turned[1::2] = turn
     return BlendedPath(np.concatenate(([0.0], span[keep].cumsum())), coefficients[keep], turned[keep])
+
+
+def distinct_waypoints(waypoints: npt.ArrayLike) -> NDArray[np.float64]:
+    """Return the waypoints without repeats, from the first to the last as given (one point if all repeat).
+
+    A waypoint repeats the one kept before it if no joint differs by more than 1e-12 rad;
+    a repeat at the end replaces the waypoints it repeats, so the path ends where they do.
+    """
+    points = np.asarray(waypoints, dtype=np.float64)
+    if (np.abs(points[1:] - points[:-1]).max(axis=1) > _REPEAT).all():
+        return points
+    kept = [0]
+    for i in range(1, len(points) - 1):
+        if np.abs(points[i] - points[kept[-1]]).max() > _REPEAT:
+            kept.append(i)
+    while len(kept) > 1 and np.abs(points[-1] - points[kept[-1]]).max() <= _REPEAT:
+        kept.pop()
+    if np.abs(points[-1] - points[kept[-1]]).max() > _REPEAT:
+        kept.append(len(points) - 1)
+    return points[kept]

@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from ..errors import PlanningFailed
 from ..trajectory import quintic_peak_rates
 from ..types import JointTrajectory, frozen_array
-from .blends import BlendedPath, blended_path
+from .blends import BlendedPath, blended_path, distinct_waypoints
 from .topp import SpeedProfile, fastest_speeds
 
 __all__ = ["rest_to_rest", "time_parameterize"]
@@ -43,7 +43,10 @@ _GRID_PER_BLEND = 8  # intervals per blend; a straight piece is one exact interv
 _RAMP_S = 0.01  # [s] every switch of the path acceleration becomes a linear ramp this long,
 _RAMP_FRACTION = 0.0025  # or this fraction of the optimal duration if shorter,
 _MIN_RAMP_S = 1e-3  # but not shorter than this [s]
-_MIN_KNOT_GAP_S = 1e-4  # [s] closer knots make the quintic's coefficients lose precision
+_MIN_KNOT_GAP_S = 1e-4  # [s] closer knots make the quintic's coefficients lose precision (see _knot_gap)
+_EPS = float(np.finfo(np.float64).eps)
+_HUGE = 1e100  # [rad]/[s] or [rad]/[s]^2: larger limits count as this
+_LONGEST_S = 2.0**53 / 1e9  # [s] (104 days) float64 seconds hold whole nanoseconds up to this
 _REST_S = 1e9  # [s] the time law's rest before its start and after its end
 # Relative slow-down covering the rounding of knot times to whole nanoseconds: moving a knot by
 # 0.5 ns changes its acceleration by the jerk times that, < 1e-6 of a limit with ramps >= 1 ms.
@@ -65,26 +68,48 @@ def time_parameterize(
 
     Args:
         joint_names: Joint order of the columns.
-        waypoints: Joint positions, shape (m, n).
+        waypoints: Joint positions, shape (m, n), m >= 1; repeats are dropped (core.blends).
         max_velocity: In [rad]/[s], shape (n,).
         max_acceleration: In [rad]/[s]^2, shape (n,).
         max_step: Corners are rounded within 0.44 of a step from their waypoint, the
             segments divided into equal steps of at most max_step [rad] in every joint:
             closer to the polyline than a cubic spline through those steps.
+
+    Raises:
+        PlanningFailed: If a shape is wrong, a waypoint is not finite, a limit or max_step is
+            not positive and finite, or the motion would last longer than 2^53 ns (104 days,
+            beyond which float64 seconds skip nanoseconds); never for other paths and limits.
     """
-    points = np.asarray(waypoints, dtype=np.float64)
-    if not (np.abs(points - points[0]) > 1e-12).any():
-        zeros = np.zeros_like(points[:1])
-        return JointTrajectory(joint_names, np.zeros(1), points[:1], zeros, zeros)
-    path = blended_path(points, max_step, _CORNER_FRACTION)
+    points, max_velocity, max_acceleration = _checked(joint_names, waypoints, max_velocity, max_acceleration,
+                                                      max_step)
+    distinct = distinct_waypoints(points)
+    if len(distinct) == 1:
+        return _nudge(joint_names, points[0], points[-1], max_velocity, max_acceleration)
+    path = blended_path(distinct, max_step, _CORNER_FRACTION)
     grid, straight = _grid(path)
     points_and_middles = np.empty(2 * len(grid) - 1)
     points_and_middles[::2], points_and_middles[1::2] = grid, (grid[:-1] + grid[1:]) / 2
     first, second = path.derivatives(points_and_middles)
-    profile = fastest_speeds(grid, first, second, straight, max_velocity, max_acceleration)
-    law = _TimeLaw.of(profile)
-    times = law.knots()
-    positions, v, a = _sampled(path, law, points[[0, -1]], times)
+    try:
+        # A grid interval crossed in less than a knot gap would go without a knot of its own.
+        profile = fastest_speeds(grid, first, second, straight, max_velocity, max_acceleration, _MIN_KNOT_GAP_S)
+        law = _TimeLaw.of(profile)
+    except PlanningFailed:
+        # Limits so small that the squared path speeds underflow make the path look blocked.
+        span = points.max(axis=0) - points.min(axis=0)
+        # A joint crosses its span at most at its top speed, from rest at most at its top acceleration.
+        _check_duration(max(float((span / max_velocity).max()), math.sqrt(float((span / max_acceleration).max()))),
+                        "at least")
+        raise
+    changes = law.changes()
+    _check_duration(float(changes[-1]), "at least")
+    # |dq/ds| <= 1: no joint moves faster than the top path speed.
+    top_speeds = np.minimum(max_velocity, math.sqrt(profile.squared_speeds.max()))
+    gap = _knot_gap(np.abs(points).max(axis=0), top_speeds, max_velocity, max_acceleration, float(changes[-1]))
+    every, knots = _knots(changes, gap)
+    times = every[knots]
+    s, speed, acceleration = law.smoothed(every)
+    positions, v, a = _sampled(path, s[knots], speed[knots], acceleration[knots], points[[0, -1]])
     peak_v, peak_a = quintic_peak_rates(times, positions, v, a)
     excess = max(1.0, float((peak_v / max_velocity).max()), math.sqrt(float((peak_a / max_acceleration).max())))
     if excess > 1.0:
@@ -93,9 +118,69 @@ def time_parameterize(
     # Whole nanoseconds, as a message carries them. Each knot moves by less than a nanosecond
     # and its state moves along the motion with it, so the knots stay consistent with each other.
     stretched = np.rint(times * stretch * 1e9) / 1e9
+    _check_duration(float(stretched[-1]), "")
     shift = (stretched / stretch - times)[:, None]
     return JointTrajectory(joint_names, stretched, positions + shift * (v + shift * a / 2),
                            (v + shift * a) / stretch, a / stretch**2)
+
+
+def _checked(
+    joint_names: tuple[str, ...],
+    waypoints: npt.ArrayLike,
+    max_velocity: npt.ArrayLike,
+    max_acceleration: npt.ArrayLike,
+    max_step: float,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Return the waypoints and the velocity and acceleration limits as arrays, checked for what timing needs."""
+    n = len(joint_names)
+    points = np.asarray(waypoints, dtype=np.float64)
+    velocity, acceleration = np.asarray(max_velocity, np.float64), np.asarray(max_acceleration, np.float64)
+    if points.ndim != 2 or points.shape[0] == 0 or points.shape[1] != n or n == 0:
+        raise PlanningFailed(f"time parameterisation needs waypoints of shape (m >= 1, {n}) for the joints "
+                             f"{', '.join(joint_names)}; got shape {points.shape}")
+    if not np.isfinite(points).all():
+        i, j = np.argwhere(~np.isfinite(points))[0]
+        raise PlanningFailed(f"waypoint {i} has a non-finite position for joint '{joint_names[j]}': {points[i, j]}")
+    for name, limit, unit in (("max_velocity", velocity, "[rad]/[s]"),
+                              ("max_acceleration", acceleration, "[rad]/[s]^2")):
+        if limit.shape != (n,):
+            raise PlanningFailed(f"{name} has shape {limit.shape}; expected ({n},), one per joint")
+        for joint, value in zip(joint_names, limit.tolist(), strict=True):
+            if not 0.0 < value < math.inf:  # NaN fails too
+                raise PlanningFailed(f"{name} of joint '{joint}' is {value}; "
+                                     f"expected a positive finite number in {unit}")
+    if not (math.isfinite(max_step) and max_step > 0.0):
+        raise PlanningFailed(f"max_step is {max_step}; expected a positive finite number in [rad]")
+    # Squares of larger limits overflow; a motion within these is within the given ones.
+    return points, np.minimum(velocity, _HUGE), np.minimum(acceleration, _HUGE)
+
+
+def _check_duration(duration: float, qualifier: str) -> None:
+    """Raise PlanningFailed if a motion of `duration` [s] is too long for times in whole nanoseconds."""
+    if duration > _LONGEST_S:
+        raise PlanningFailed(f"the motion would last {qualifier + ' ' if qualifier else ''}{duration:.3g} s at these "
+                             f"limits, longer than the {_LONGEST_S:.3g} s (104 days) whose times a float64 "
+                             "holds in whole nanoseconds")
+
+
+def _nudge(
+    joint_names: tuple[str, ...],
+    start: NDArray[np.float64],
+    end: NDArray[np.float64],
+    max_velocity: NDArray[np.float64],
+    max_acceleration: NDArray[np.float64],
+) -> JointTrajectory:
+    """Return the trajectory from `start` to `end`, at most 1e-12 rad apart: one quintic, or one point if equal."""
+    distance = np.abs(end - start)
+    if not distance.any():
+        zeros = np.zeros((1, len(start)))
+        return JointTrajectory(joint_names, np.zeros(1), start[None], zeros, zeros)
+    # A quintic from rest to rest over T peaks at 1.875 d / T in velocity and 5.774 d / T^2 in acceleration.
+    duration = max(float(np.max(1.875 * distance / max_velocity)),
+                   math.sqrt(float(np.max(5.774 * distance / max_acceleration))))
+    duration = math.ceil(duration * (1.0 + _SAFETY) * 1e9) / 1e9
+    zeros = np.zeros((2, len(start)))
+    return JointTrajectory(joint_names, np.array([0.0, duration]), np.stack((start, end)), zeros, zeros)
 
 
 def _grid(path: BlendedPath) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
@@ -156,46 +241,111 @@ class _TimeLaw:
         return cls(times, np.concatenate((rest, profile.s, profile.s[-1:])), np.concatenate((rest, speeds, rest)),
                    np.concatenate((rest, accelerations, rest, rest)), ramp)
 
-    def knots(self) -> NDArray[np.float64]:
-        """Return the times in [s] where the smoothed motion changes form (it starts at 0, ends a ramp late)."""
+    def changes(self) -> NDArray[np.float64]:
+        """Return the sorted times in [s] where the smoothed motion changes form, from 0 to the end a ramp late.
+
+        Equal times (a change within rounding of another) are kept: each is a change.
+        """
         grid = self.times[1:-1]
-        times = np.sort(np.concatenate((grid, grid + self.ramp)))
-        keep = np.concatenate(([True], times[1:] - times[:-1] > _MIN_KNOT_GAP_S))  # drops repeats too
-        times = times[keep]
-        times[-1] = grid[-1] + self.ramp
-        return times
+        return np.sort(np.concatenate((grid, grid + self.ramp)))
 
     def smoothed(
         self, times: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        """Return s, ds/dt and d2s/dt2 of the motion averaged over the last ramp, at sorted `times` from 0.
+        """Return s, ds/dt and d2s/dt2 of the motion averaged over the last ramp, at `changes()` or a superset.
 
         The average of the position over [t - ramp, t] has as its velocity the mean
         velocity and as its acceleration the mean acceleration over that window.
         """
         count = len(times)
         at = np.concatenate((times, (times[:-1] + times[1:]) / 2))
-        at = np.concatenate((at, at - self.ramp))
-        interval = np.searchsorted(self.times[1:], at, side="right")  # times[0], -1e9 s, precedes them all
-        tau = at - self.times[interval]
+        both = np.concatenate((at, at - self.ramp))
+        interval = np.searchsorted(self.times[1:], both, side="right")  # times[0], -1e9 s, precedes them all
+        # Of the closed window [t - ramp, t], t is the end of an interval it falls on the start of.
+        now, before = slice(0, len(at)), slice(len(at), None)
+        interval[now] -= self.times[interval[now]] == at
+        tau = both - self.times[interval]
         u = self.accelerations[interval]
         speed = self.speeds[interval] + u * tau
         s = self.s[interval] + tau * (speed - 0.5 * u * tau)
-        mean_speed = (s[: 2 * count - 1] - s[2 * count - 1 :]) / self.ramp
-        acceleration = (speed[:count] - speed[2 * count - 1 : 3 * count - 1]) / self.ramp
-        # Integrate the mean speed knot to knot (Simpson's rule, exact: it is quadratic in
-        # between), rather than differencing a running integral, which would lose the digits
-        # that tell two close knots apart.
+        # A window within one interval has the mean speed of its middle and the interval's u:
+        # differencing s there would lose digits, which a long step of a long motion multiplies.
+        within = interval[now] == interval[before]
+        mean_speed = np.where(within, speed[now] - u[now] * (self.ramp / 2), (s[now] - s[before]) / self.ramp)
+        acceleration = np.where(within, u[now], (speed[now] - speed[before]) / self.ramp)[:count]
+        # Integrate the mean speed from change to change (Simpson's rule, exact: it is quadratic
+        # in between, but not across a change), rather than differencing a running integral,
+        # which would lose the digits that tell two close times apart.
         edge, middle = mean_speed[:count], mean_speed[count:]
         steps = (times[1:] - times[:-1]) / 6 * (edge[:-1] + 4 * middle + edge[1:])
         return np.minimum(np.concatenate(([0.0], steps.cumsum())), self.s[-1]), edge, acceleration
 
 
+def _knot_gap(
+    sizes: NDArray[np.float64],
+    speeds: NDArray[np.float64],
+    max_velocity: NDArray[np.float64],
+    max_acceleration: NDArray[np.float64],
+    duration: float,
+) -> float:
+    """Return the least time [s] between knots at which rounding keeps within half the safety margin.
+
+    Args:
+        sizes: The joints' largest |position| [rad], shape (n,).
+        speeds: The joints' top speeds in [rad]/[s], shape (n,).
+        max_velocity: In [rad]/[s], shape (n,).
+        max_acceleration: In [rad]/[s]^2, shape (n,).
+        duration: Of the motion, in [s].
+    """
+    # Rounding the positions and the times (to floats, after the check of the peaks) moves a
+    # knot's displacement from the one before by up to eps (|q| + speed t) [rad]; a quintic over
+    # h turns an error e in its displacement into a velocity of 1.875 e / h and an acceleration
+    # of 5.774 e / h^2 at most.
+    error = (sizes + speeds * duration) * (_EPS / (_SAFETY / 2))  # over the budget
+    return max(_MIN_KNOT_GAP_S, 1.875 * float((error / max_velocity).max()),
+               math.sqrt(5.774 * float((error / max_acceleration).max())))
+
+
+def _knots(changes: NDArray[np.float64], gap: float) -> tuple[NDArray[np.float64], slice | NDArray[np.intp]]:
+    """Return `changes` [s] with stand-ins, sorted, and which of them are knots, at least `gap` [s] apart.
+
+    A quintic between two knots follows the motion closely only if the motion changes
+    form near one of its ends at most: a change left out, within the gap after a knot,
+    gets a stand-in knot the gap after that knot (one before the end, if it precedes the end).
+    """
+    if (changes[1:] - changes[:-1] >= gap).all():
+        return changes, slice(None)
+    knots, stand_ins, skipped = [0.0], [], False
+    for t in changes[1:].tolist():
+        if t - knots[-1] < gap:
+            skipped = True
+            continue
+        if skipped and t - knots[-1] >= 2 * gap:
+            stand_ins.append(knots[-1] + gap)
+            knots.append(stand_ins[-1])
+        knots.append(t)
+        skipped = False
+    end = float(changes[-1])
+    if skipped:
+        # The end takes the place of the last knot, which lies within the gap before it.
+        if len(knots) > 1:
+            knots.pop()
+        if end - knots[-1] >= 2 * gap:
+            stand_ins.append(end - gap)
+            knots.append(end - gap)
+        knots.append(end)
+    every = np.sort(np.concatenate((changes, stand_ins)))
+    return every, np.searchsorted(every, knots)
+
+
 def _sampled(
-    path: BlendedPath, law: _TimeLaw, ends: NDArray[np.float64], times: NDArray[np.float64]
+    path: BlendedPath,
+    s: NDArray[np.float64],
+    speed: NDArray[np.float64],
+    acceleration: NDArray[np.float64],
+    ends: NDArray[np.float64],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """Return the positions, velocities and accelerations of the smoothed motion at `times` [s], at rest at `ends`."""
-    s, speed, acceleration = law.smoothed(times)
+    """Return the positions, velocities and accelerations of the motion s(t) along `path`, at rest at `ends`."""
     positions, first, second = path(s)
     velocities = first * speed[:, None]
     accelerations = second * (speed**2)[:, None] + first * acceleration[:, None]

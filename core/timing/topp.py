@@ -46,8 +46,9 @@ class SpeedProfile:
         object.__setattr__(self, "squared_speeds", frozen_array(self.squared_speeds, s.shape, "squared_speeds"))
 
 
-# A joint at rest along the path (a derivative of 0) gives an infinite bound: none.
-@np.errstate(divide="ignore", invalid="ignore")
+# A joint at rest along the path (a derivative of 0), or with a limit so large that its square
+# overflows, gives an infinite bound: none.
+@np.errstate(divide="ignore", invalid="ignore", over="ignore")
 def fastest_speeds(
     grid: NDArray[np.float64],
     first: NDArray[np.float64],
@@ -55,6 +56,7 @@ def fastest_speeds(
     straight: NDArray[np.bool_],
     max_velocity: NDArray[np.float64],
     max_acceleration: NDArray[np.float64],
+    min_interval_s: float = 0.0,
 ) -> SpeedProfile:
     """Return the time-optimal rest-to-rest speeds along a path within the joint limits.
 
@@ -69,16 +71,23 @@ def fastest_speeds(
         straight: Per interval, True where dq/ds is constant and d2q/ds2 zero, shape (N,).
         max_velocity: In [rad]/[s], shape (n,).
         max_acceleration: In [rad]/[s]^2, shape (n,).
+        min_interval_s: Each interval takes at least this long [s].
     """
     delta = grid[1:] - grid[:-1]
-    velocity = first[::2]
-    cap = np.min((max_velocity / velocity) ** 2, axis=1)[:-1]
+    # x is linear along an interval and dq/ds nearly so, but their product can peak inside
+    # (at a reversal, where dq/ds drops to 0 and x soars): x within the velocity limits at both
+    # ends and the middle, wherever it is on the interval, keeps the velocity within all along.
+    bounds = np.min((max_velocity / first) ** 2, axis=1)  # at the grid points and middles
+    ceiling = np.minimum(np.minimum(bounds[:-2:2], bounds[1::2]), bounds[2::2])  # per interval
+    if min_interval_s > 0.0:
+        ceiling = np.minimum(ceiling, (delta / min_interval_s) ** 2)  # ds/dt at most delta / min_interval_s
+    cap = np.minimum(ceiling, np.concatenate((ceiling[:1], ceiling[:-1])))  # x_i: on intervals i - 1 and i
     grow, step, cap = _step_lines(first, second, delta, cap, max_acceleration)
     grows, steps = grow.tolist(), step.tolist()
     x = _forward(_backward(cap.tolist(), grows, steps), grows, steps)
     if not np.all(np.isfinite(x)):
         raise PlanningFailed("time parameterisation found no motion along the path within the limits")
-    return _with_switches(grid, x, straight, velocity, max_velocity, max_acceleration)
+    return _with_switches(grid, x, straight, first[::2], ceiling, max_acceleration)
 
 
 def _step_lines(
@@ -169,17 +178,24 @@ def _with_switches(
     x: NDArray[np.float64],
     straight: NDArray[np.bool_],
     velocity: NDArray[np.float64],
-    max_velocity: NDArray[np.float64],
+    ceiling: NDArray[np.float64],
     max_acceleration: NDArray[np.float64],
 ) -> SpeedProfile:
-    """Return the profile with the exact optimum along each straight interval: ramp up, cruise, ramp down."""
+    """Return the profile with the exact optimum along each straight interval: ramp up, cruise, ramp down.
+
+    Args:
+        grid: Path parameter of the grid points, shape (N + 1,).
+        x: Squared path speeds at the grid points, shape (N + 1,).
+        straight: Per interval, True where dq/ds is constant, shape (N,).
+        velocity: dq/ds at the grid points, shape (N + 1, n).
+        ceiling: Per interval, the largest squared path speed, shape (N,).
+        max_acceleration: In [rad]/[s]^2, shape (n,).
+    """
     i = np.flatnonzero(straight)
-    speed = np.abs(velocity[i])
-    ramps = 2 * np.min(max_acceleration / speed, axis=1)  # dx/ds at full acceleration
-    cruises = np.min((max_velocity / speed) ** 2, axis=1)
+    ramps = 2 * np.min(max_acceleration / np.abs(velocity[i]), axis=1)  # dx/ds at full acceleration
     at, squares = grid.tolist(), x.tolist()
     ups, downs, tops = [], [], []
-    for k, ramp, cruise in zip(i.tolist(), ramps.tolist(), cruises.tolist(), strict=True):
+    for k, ramp, cruise in zip(i.tolist(), ramps.tolist(), ceiling[i].tolist(), strict=True):
         start, end, x_start, x_end = at[k], at[k + 1], squares[k], squares[k + 1]
         meet = (x_end - x_start + ramp * (start + end)) / (2 * ramp)  # where the two ramps cross
         peak = x_start + ramp * (meet - start)
@@ -193,9 +209,8 @@ def _with_switches(
     squared = np.concatenate((x, tops, tops))
     order = np.argsort(s, kind="stable")
     s, squared = s[order], squared[order]
-    # A switch at (or within rounding of) a grid point adds nothing: keep the grid point.
-    keep = np.concatenate(([True], np.diff(s) > 1e-12 * grid[-1]))
-    keep[-1] = True
-    s, squared = s[keep], squared[keep]
-    s[-1] = grid[-1]
-    return SpeedProfile(s, squared)
+    # A switch that rounds to a grid point's s adds nothing: keep the grid point, first of equals
+    # in the stable sort. Dropping a switch is always safe, as it only spreads a ramp over a longer
+    # interval; a grid point carries the speed that the ends and the neighbours were planned with.
+    keep = np.concatenate(([True], s[1:] > s[:-1]))
+    return SpeedProfile(s[keep], squared[keep])
