@@ -86,21 +86,7 @@ def time_parameterize(
     if len(distinct) == 1:
         return _nudge(joint_names, points[0], points[-1], max_velocity, max_acceleration)
     path = blended_path(distinct, max_step, _CORNER_FRACTION)
-    grid, straight = _grid(path)
-    points_and_middles = np.empty(2 * len(grid) - 1)
-    points_and_middles[::2], points_and_middles[1::2] = grid, (grid[:-1] + grid[1:]) / 2
-    first, second = path.derivatives(points_and_middles)
-    try:
-        # A grid interval crossed in less than a knot gap would go without a knot of its own.
-        profile = fastest_speeds(grid, first, second, straight, max_velocity, max_acceleration, _MIN_KNOT_GAP_S)
-        law = _TimeLaw.of(profile)
-    except PlanningFailed:
-        # Limits so small that the squared path speeds underflow make the path look blocked.
-        span = points.max(axis=0) - points.min(axis=0)
-        # A joint crosses its span at most at its top speed, from rest at most at its top acceleration.
-        _check_duration(max(float((span / max_velocity).max()), math.sqrt(float((span / max_acceleration).max()))),
-                        "at least")
-        raise
+    profile, law = _optimal_law(path, points, max_velocity, max_acceleration)
     changes = law.changes()
     _check_duration(float(changes[-1]), "at least")
     # |dq/ds| <= 1: no joint moves faster than the top path speed.
@@ -110,6 +96,37 @@ def time_parameterize(
     times = every[knots]
     s, speed, acceleration = law.smoothed(every)
     positions, v, a = _sampled(path, s[knots], speed[knots], acceleration[knots], points[[0, -1]])
+    return _within_limits(joint_names, times, positions, v, a, max_velocity, max_acceleration)
+
+
+def _optimal_law(
+    path: BlendedPath, points: NDArray[np.float64], max_velocity: NDArray[np.float64],
+    max_acceleration: NDArray[np.float64],
+) -> tuple[SpeedProfile, _TimeLaw]:
+    """Return the time-optimal speeds along `path` and the time law that follows them."""
+    grid, straight = _grid(path)
+    points_and_middles = np.empty(2 * len(grid) - 1)
+    points_and_middles[::2], points_and_middles[1::2] = grid, (grid[:-1] + grid[1:]) / 2
+    first, second = path.derivatives(points_and_middles)
+    try:
+        # A grid interval crossed in less than a knot gap would go without a knot of its own.
+        profile = fastest_speeds(grid, first, second, straight, max_velocity, max_acceleration, _MIN_KNOT_GAP_S)
+        return profile, _TimeLaw.of(profile)
+    except PlanningFailed:
+        # Limits so small that the squared path speeds underflow make the path look blocked.
+        span = points.max(axis=0) - points.min(axis=0)
+        # A joint crosses its span at most at its top speed, from rest at most at its top acceleration.
+        _check_duration(max(float((span / max_velocity).max()), math.sqrt(float((span / max_acceleration).max()))),
+                        "at least")
+        raise
+
+
+def _within_limits(
+    joint_names: tuple[str, ...], times: NDArray[np.float64], positions: NDArray[np.float64],
+    v: NDArray[np.float64], a: NDArray[np.float64], max_velocity: NDArray[np.float64],
+    max_acceleration: NDArray[np.float64],
+) -> JointTrajectory:
+    """Return the knots slowed by the one factor that brings their quintics within the limits, in whole ns."""
     peak_v, peak_a = quintic_peak_rates(times, positions, v, a)
     excess = max(1.0, float((peak_v / max_velocity).max()), math.sqrt(float((peak_a / max_acceleration).max())))
     if excess > 1.0:
