@@ -52,7 +52,7 @@ def _logging(verbose: bool, quiet: bool) -> None:
 
 @app.command()
 def plan(
-    task: Annotated[Path | None, typer.Argument(help="Task file (DESIGN section 4).", show_default=False)] = None,
+    task: Annotated[Path | None, typer.Argument(help="Task file (docs/formats.md).", show_default=False)] = None,
     output: Annotated[Path, typer.Option("--output", "-o", help="Plan file to write (.mcap).")] = Path("plan.mcap"),
     robot: Annotated[Path | None, typer.Option(help="Robot config: a moveplan.yaml or a folder holding one.")] = None,
     scene: Annotated[Path | None, typer.Option(

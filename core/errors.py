@@ -1,6 +1,6 @@
 """The one error hierarchy of moveplan: what went wrong, with what the user needs to fix it.
 
-Each class carries the process exit code the CLI maps it to (DESIGN section 1):
+Each class carries the process exit code the CLI maps it to (docs/cli.md):
 2 usage, 3 bad input, 4 no plan. Messages name the file, key or joint and list
 valid alternatives where there are any.
 """

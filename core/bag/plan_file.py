@@ -1,4 +1,4 @@
-"""Plan files: their layout (topics, types, metadata keys; DESIGN section 6), and plans read back.
+"""Plan files: their layout (topics, types, metadata keys; docs/formats.md), and plans read back.
 
 A plan file is a ROS 2 bag: /robot_description, /tf_static, /planning_scene_markers and
 /display_planned_path once and latched, one /planned_trajectory message per step at the

@@ -1,4 +1,4 @@
-"""Task files (DESIGN section 4) and the step specifications they and the flags produce.
+"""Task files (docs/formats.md) and the step specifications they and the flags produce.
 
 A task names a robot and scene, a start, defaults, and steps; each step is one
 motion goal, parsed here into a typed goal (goals.py). Paths in a task resolve

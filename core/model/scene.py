@@ -1,4 +1,4 @@
-"""Scene: named static frames and collision objects around a robot (DESIGN section 3).
+"""Scene: named static frames and collision objects around a robot.
 
 Frames may chain and may hang off robot links. Everything is resolved to the
 planning frame (the URDF root) with the robot at its neutral configuration,
