@@ -33,6 +33,9 @@ __all__ = ["app", "main"]
 app = typer.Typer(
     name="moveplan",
     help="MoveIt-style planning and ros2_control execution checks from one command line: files in, files out.",
+    epilog="Exit codes: 0 success, 1 internal error, 2 usage error, 3 bad input file, 4 no plan, "
+           "5 tolerances violated. Reference (file formats, JSON keys, planning and execution rules): "
+           "docs/ in the moveplan repository.",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
