@@ -49,7 +49,8 @@ from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.model.robot import Robot
 from moveplan.core.types import CollisionObject, Shape
 
-MBM = Path("/work/shared/benchmarks/mbm")
+# The repository carries 10 problems a scenario; --mbm names a folder with more.
+MBM = Path(__file__).resolve().parent.parent / "tests" / "data" / "mbm"
 SCENARIOS = ("table_pick_panda", "bookshelf_small_panda", "box_panda")
 GROUP = "panda_arm"
 # examples/rrt_panda.py's RRTPlannerOptions; max_planning_time and rng_seed are set per run,

@@ -5,7 +5,7 @@ Run from the repository root with moveplan installed:
 
 Paths (fixed seed), each timed at velocity and acceleration scaling 1.0 and 0.1 with the
 limits of configs/panda and configs/ur10e (the Panda's arm limits are those of
-/work/shared/benchmarks/mbm/panda_robot/joint_limits.yaml):
+tests/data/mbm/panda_robot/joint_limits.yaml):
   - 60 %: Panda, 2-8 waypoints, the largest joint moving 1-4 rad from start to goal, the
     inner waypoints on the straight line between them pushed off it by N(0, 0.3 rad) per
     joint (a planner's path after shortcutting: a few waypoints, detours around obstacles);
