@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 import toppra
-from hypothesis import HealthCheck, assume, example, given, settings
+from hypothesis import HealthCheck, assume, example, given, seed, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
@@ -25,12 +25,13 @@ MAX_STEP = 0.05  # [rad] time_parameterize's default
 RATE_TOLERANCE = 1e-6  # relative, on the exact peaks of the controller's quintics
 # Between knots the controller's quintic can leave the motion it samples (where the path's
 # third derivative jumps, at the end of a corner blend): by up to 4e-6 rad past the waypoints'
-# range in 2 x 10^4 random cases like those below.
-RANGE_SLACK = 1e-5  # [rad]
+# range in 2 x 10^4 random cases like those below, 3.3e-5 rad in CORNER_DIP.
+RANGE_SLACK = 1e-4  # [rad]
 
-# Fixed examples (derandomize) and no example database: CI runs the same cases every time.
+# A fixed seed and no example database: every checkout, wherever it lies, runs the same cases
+# (derandomize hashes the test's location, so a clone in another folder drew others).
 # These budgets keep the whole file near 20 s on a 2-core machine.
-PROPERTIES = settings(deadline=None, derandomize=True, database=None, max_examples=800,
+PROPERTIES = settings(deadline=None, database=None, max_examples=800,
                       suppress_health_check=[HealthCheck.too_slow])
 
 
@@ -163,6 +164,8 @@ REPEATS = ([[0.0, 0.0], [0.9e-12, 0.0], [1.8e-12, 0.0]], [1.0, 1.0], [1.0, 1.0])
 NUDGE = ([[0.0, 0.0], [5e-13, 0.0]], [1.0, 1.0], [1.0, 1.0])  # ended 5e-13 rad short
 HUGE_ACCELERATION = ([[0.0, 0.0], [1.0, 0.0]], [1.0, 1.0], [1e20, 1e20])  # "path blocked"
 LONG = ([[0.0, 0.0], [1.0, 0.5], [2.0, 0.0]], [3e-7, 3e-7], [1.0, 1.0])  # 77 days, still whole nanoseconds
+CORNER_DIP = ([[0.0, 0.0], [1.0, 0.0], [1.0001, 0.0], [1.1001, 0.1], [2.1001, 0.1], [3.1001, 0.1]],
+              [1.0, 0.17782794], [31.6227766, 31.6227766])  # dips 3.3e-5 rad below j1's range
 ROUNDING = ([[-6.370732752985129], [-6.370836567216275], [-6.370837523938305]],  # knots 1e-4 s apart peak
             [19.44967878254027], [0.00263400883138655])  # at 1.00002 of the limit once rounded
 
@@ -172,6 +175,7 @@ def as_case(case: tuple[list[list[float]], list[float], list[float]]) -> Case:
 
 
 @PROPERTIES
+@seed(20261125)
 @given(cases())
 @example(as_case(SLOW_JOINT))
 @example(as_case(REVERSAL))
@@ -181,6 +185,7 @@ def as_case(case: tuple[list[list[float]], list[float], list[float]]) -> Case:
 @example(as_case(HUGE_ACCELERATION))
 @example(as_case(ROUNDING))
 @example(as_case(LONG))
+@example(as_case(CORNER_DIP))
 def test_any_polyline_within_any_limits_gives_a_valid_trajectory(case: Case) -> None:
     waypoints, max_velocity, max_acceleration = case
     trajectory = time_parameterize(names(waypoints.shape[1]), waypoints, max_velocity, max_acceleration)
@@ -207,6 +212,7 @@ STOPPING_RATIO = 1.10
 
 
 @PROPERTIES
+@seed(20261125)
 @given(cases(shortest=0.01, at_limits=False))
 @example(as_case(SLOW_JOINT))
 @example(as_case(REVERSAL))  # 1.27 before
@@ -317,7 +323,8 @@ def smooth_paths(draw: st.DrawFn) -> Case:
 TOPPRA_RATIO = 1.06
 
 
-@settings(deadline=None, derandomize=True, database=None, max_examples=40)
+@settings(deadline=None, database=None, max_examples=40)
+@seed(20261125)
 @given(smooth_paths())
 def test_duration_is_within_six_percent_of_toppra_on_smooth_paths(case: Case) -> None:
     waypoints, max_velocity, max_acceleration = case
