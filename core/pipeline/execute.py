@@ -24,6 +24,7 @@ from ..config.robot_config import RobotConfig, load_robot_config
 from ..config.sources import CONFIG_FILE
 from ..control.check_report import CheckReport
 from ..control.checking import check_recording, uses_velocities
+from ..control.margins import merged_margins
 from ..control.results import ExecutionResult, Violation
 from ..errors import ConfigError, InputError, UnknownName
 from ..types import TfSamples
@@ -92,11 +93,7 @@ class PlanExecution:
     @property
     def margins(self) -> dict[str, float]:
         """Return per joint the smallest margin to its tolerance over all steps."""
-        margins: dict[str, float] = {}
-        for step in self.steps:
-            for joint, margin in step.report.margins.items():
-                margins[joint] = min(margin, margins.get(joint, margin))
-        return margins
+        return merged_margins(step.report.margins for step in self.steps)
 
     @property
     def duration_s(self) -> float:
