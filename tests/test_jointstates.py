@@ -198,7 +198,8 @@ def test_other_topics_in_the_same_chunks_and_two_channels(tmp_path: Path) -> Non
 
 def test_series_is_sorted_by_time(tmp_path: Path) -> None:
     stamps, positions, _ = motion(100)
-    order = np.random.default_rng(1).permutation(100)
+    # Neighbours swapped, as two publishers' messages cross in transport (a jump back is refused).
+    order = np.arange(100).reshape(50, 2)[:, ::-1].reshape(-1)
     payloads = encode_joint_states(JOINTS, stamps[order], positions[order])
     path = write_bag(tmp_path / "js.mcap", [("/joint_states", JOINT_STATE_TYPE, EPOCH_NS, p)
                                           for p in payloads])

@@ -11,7 +11,6 @@ The CDR layout itself is core.bag.jointstate_cdr's, which also encodes payloads
 from __future__ import annotations
 
 import logging
-import mmap
 import struct
 from collections.abc import Sequence
 from pathlib import Path
@@ -21,6 +20,7 @@ from numpy.typing import NDArray
 
 from ..errors import CorruptData, InputError, known
 from ..types import JointStateSeries, TimeSource
+from .joint_state_checks import check_finite, check_order, seconds_text
 from .jointstate_cdr import (
     JOINT_STATE_TYPE,
     JointStateLayout,
@@ -28,6 +28,7 @@ from .jointstate_cdr import (
     encode_joint_states,
     parse_layout,
 )
+from .sample_columns import SampleColumns
 from .topic_reader import Channel, byte_rows, read_topic
 
 __all__ = ["JOINT_STATE_TYPE", "JointStateSeries", "encode_joint_states", "read_joint_states"]
@@ -50,7 +51,8 @@ def read_joint_states(
 
     Messages may list joints in any order and carry extra joints. Messages that lack one
     of `joints` (another publisher on the same topic, a gripper) are skipped, with a
-    warning when some are. Samples are sorted by time.
+    warning when some are. Samples are sorted by time: a time up to 50 ms earlier than one
+    before it (two publishers' messages crossing) with a warning, further back is an error.
 
     Args:
         path: An MCAP file, or a rosbag2 folder whose *.mcap files are read in split order.
@@ -64,7 +66,9 @@ def read_joint_states(
     Raises:
         InputError: The file is missing, not MCAP, truncated or corrupt; the topic is
             absent (the message lists the topics present) or not JointState; or no
-            message carries all of `joints` (the message lists the joints present).
+            message carries all of `joints` (the message lists the joints present); a
+            message names a joint twice; a time goes back more than 50 ms; or a wanted
+            joint has no finite position in any message.
 
     """
     if time_source not in ("header", "log"):
@@ -82,7 +86,7 @@ class _Decoder:
         self, source: Path, topic: str, joints: tuple[str, ...] | None, velocities: bool = True
     ) -> None:
         self.source, self.topic, self.joints = source, topic, joints
-        self.columns = _Columns(velocities)
+        self.columns = SampleColumns(velocities)
         # The layout of the last rows decoded together, and a row laid out so.
         self.template: tuple[NDArray[np.uint8], JointStateLayout] | None = None
         self.joint_columns: dict[tuple[str, ...], NDArray[np.intp] | None] = {}
@@ -116,8 +120,9 @@ class _Decoder:
             if not layout.little or not _matches(rows, rows[0], layout).all():
                 return False
             template = self.template = (np.array(rows[0]), layout)
+        first = self.messages
         self.messages += len(rows)
-        self._add_rows(rows, template[1], log_times)
+        self._add_rows(rows, template[1], log_times, first)
         return True
 
     def add(
@@ -125,6 +130,7 @@ class _Decoder:
         log_times: NDArray[np.int64],
     ) -> None:
         """Decode the payloads buf[starts[i] : starts[i] + lengths[i]]."""
+        first = self.messages
         self.messages += len(starts)
         remaining = np.arange(len(starts))
         for _ in range(_MAX_LAYOUTS):
@@ -136,11 +142,14 @@ class _Decoder:
             same = remaining[lengths[remaining] == template.length]
             rows = byte_rows(buf, starts[same], template.length)
             match = _matches(rows, rows[0], template)
-            self._add_rows(rows if match.all() else rows[match], template, log_times[same[match]])
+            kept = same[match]
+            indices = first if len(kept) == len(starts) else first + kept
+            self._add_rows(rows if match.all() else rows[match], template, log_times[kept], indices)
             matched = np.zeros(len(starts), dtype=bool)
             matched[same[match]] = True
             remaining = remaining[~matched[remaining]]
-        self._add_each(buf, starts[remaining], lengths[remaining], log_times[remaining])
+        self._add_each(buf, starts[remaining], lengths[remaining], log_times[remaining],
+                       first + remaining)
 
     def _layout(self, buf: NDArray[np.uint8], start: int, length: int) -> JointStateLayout:
         try:
@@ -150,9 +159,19 @@ class _Decoder:
         except ValueError as exc:
             raise CorruptData(str(exc)) from None
 
-    def _columns(self, names: tuple[str, ...], size: int) -> NDArray[np.intp] | None:
-        """Return the columns of the wanted joints in a message with `names`, or None."""
+    def _columns(
+        self, names: tuple[str, ...], size: int, index: int, stamp_ns: int
+    ) -> NDArray[np.intp] | None:
+        """Return the columns of the wanted joints in a message with `names`, or None.
+
+        `index` and `stamp_ns` say which message it is (the first laid out so), for errors.
+        """
         if names not in self.joint_columns:
+            if len(set(names)) < len(names):
+                twice = next(name for i, name in enumerate(names) if name in names[:i])
+                raise InputError(
+                    f"{self.source}: {self.topic} message {index} (stamp {seconds_text(stamp_ns)}) "
+                    f"names joint {twice} twice: a JointState must name each joint once")
             self.seen_joints.update(names)
             if self.joints is None and size == len(names) and names:
                 self.joints = tuple(dict.fromkeys(names))
@@ -166,9 +185,12 @@ class _Decoder:
         return columns if columns is not None and size == len(names) else None
 
     def _add_rows(
-        self, rows: NDArray[np.uint8], layout: JointStateLayout, log_times: NDArray[np.int64]
+        self, rows: NDArray[np.uint8], layout: JointStateLayout, log_times: NDArray[np.int64],
+        indices: int | NDArray[np.int64],
     ) -> None:
-        columns = self._columns(layout.names, layout.position_size)
+        """Decode rows laid out as `layout`: messages `indices` of the topic (int: from there on)."""
+        first = indices if isinstance(indices, int) else int(indices[0])
+        columns = self._columns(layout.names, layout.position_size, first, layout.stamp_ns)
         if columns is None:
             self.skipped += len(rows)
             return
@@ -179,21 +201,22 @@ class _Decoder:
         if layout.velocity_size == n:
             velocities = _floats(rows, layout.velocity_at, n, columns)
         self.columns.append(times, log_times, _floats(rows, layout.position_at, n, columns),
-                            velocities)
+                            velocities, indices)
 
     def _add_each(
         self, buf: NDArray[np.uint8], starts: NDArray[np.int64], lengths: NDArray[np.int64],
-        log_times: NDArray[np.int64],
+        log_times: NDArray[np.int64], indices: NDArray[np.int64],
     ) -> None:
         """Decode payloads one by one: big-endian ones, or layouts beyond the templates tried."""
-        times, kept_log_times, positions, velocities = [], [], [], []
-        for start, length, log_time in zip(starts.tolist(), lengths.tolist(), log_times.tolist(),
-                                           strict=True):
+        times, kept_log_times, positions, velocities, kept = [], [], [], [], []
+        for start, length, log_time, index in zip(starts.tolist(), lengths.tolist(),
+                                                  log_times.tolist(), indices.tolist(), strict=True):
             layout = self._layout(buf, start, length)
-            columns = self._columns(layout.names, layout.position_size)
+            columns = self._columns(layout.names, layout.position_size, index, layout.stamp_ns)
             if columns is None:
                 self.skipped += 1
                 continue
+            kept.append(index)
             data = bytes(buf[start : start + length])
             kind = ("<" if layout.little else ">") + "f8"
             n = layout.position_size
@@ -207,7 +230,8 @@ class _Decoder:
             self.columns.append(np.array(times, dtype=np.int64),
                                 np.array(kept_log_times, dtype=np.int64),
                                 np.array(positions, dtype=np.float64),
-                                np.array(velocities, dtype=np.float64) if complete else None)
+                                np.array(velocities, dtype=np.float64) if complete else None,
+                                np.array(kept, dtype=np.int64))
 
     def series(self, time_source: TimeSource) -> JointStateSeries:
         """Return the collected samples as a series, sorted by time."""
@@ -226,7 +250,7 @@ class _Decoder:
             logger.warning("%s: skipped %d of %d messages on %s that lack one of the joints %s",
                            source, self.skipped, self.messages, self.topic,
                            ", ".join(self.joints or ()))
-        times, log_times, positions, velocities = self.columns.take()
+        times, log_times, positions, velocities, indices = self.columns.take()
         if time_source == "log" or not times.any():
             if time_source == "header":
                 logger.warning("%s: every header stamp on %s is zero; using log times", source,
@@ -238,9 +262,11 @@ class _Decoder:
             logger.warning("%s: only some messages on %s carry velocities; ignoring velocities",
                            source, self.topic)
         if np.any(times[1:] < times[:-1]):
+            check_order(times, indices, time_source, f"{self.source}: {self.topic}")
             order = np.argsort(times, kind="stable")
             times, positions = times[order], positions[order]
             velocities = velocities[order] if velocities is not None else None
+        check_finite(positions, tuple(self.joints or ()), f"{self.source}: {self.topic}")
         start_ns = int(times[0])
         times -= start_ns  # in place: a fresh hour-long array costs more in page faults
         times_s = times / 1e9
@@ -251,93 +277,6 @@ class _Decoder:
                                 time_source, str(source))
 
 
-class _Columns:
-    """Decoded samples, appended per batch into arrays sized from the file's statistics.
-
-    Filling preallocated arrays keeps the peak near one copy of the result (an hour at
-    1 kHz is 170 MB per float array); batches beyond the reserved size are kept apart and
-    concatenated at the end. Velocities are kept only if `velocities`; whether every
-    batch had them is noted either way.
-    """
-
-    def __init__(self, velocities: bool = True) -> None:
-        self.keep_velocities = velocities
-        self.capacity = 0
-        self.count = 0
-        self._filled = 0
-        self._arrays: list[np.ndarray] | None = None
-        self._velocities: NDArray[np.float64] | None = None
-        self._extra: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]] = []
-        self.some_velocities = False
-        self.all_velocities = True
-
-    def reserve(self, count: int) -> None:
-        """Expect `count` more samples (an upper bound)."""
-        if self._arrays is None:
-            self.capacity += count
-
-    def append(
-        self, times: NDArray[np.int64], log_times: NDArray[np.int64],
-        positions: NDArray[np.float64], velocities: NDArray[np.float64] | None,
-    ) -> None:
-        """Add a batch: stamps and log times [ns], (m, n) positions and velocities or None."""
-        m, n = positions.shape
-        self.count += m
-        self.some_velocities |= velocities is not None
-        self.all_velocities &= velocities is not None
-        if not self.keep_velocities:
-            velocities = None
-        if self._arrays is None and self.capacity >= m:
-            self._arrays = [_touched((self.capacity,), np.int64),
-                            _touched((self.capacity,), np.int64),
-                            _touched((self.capacity, n), np.float64)]
-        if self._arrays is None or self._filled + m > self.capacity or self._extra:
-            # Copies: values may be views of a chunk buffer that is about to be reused.
-            kept = None if velocities is None else np.array(velocities)
-            self._extra.append((np.array(times), np.array(log_times), np.array(positions), kept))
-            return
-        rows = slice(self._filled, self._filled + m)
-        for array, values in zip(self._arrays, (times, log_times, positions), strict=True):
-            array[rows] = values
-        if velocities is not None and self.all_velocities:
-            if self._velocities is None:
-                self._velocities = _touched((self.capacity, n), np.float64)
-            self._velocities[rows] = velocities
-        self._filled += m
-
-    def take(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
-        """Return times, log times, positions and velocities (None unless every batch had them)."""
-        parts = list(self._extra)
-        if self._arrays is not None:
-            filled = self._filled
-            velocities = self._velocities[:filled] if self._velocities is not None else None
-            times, log_times, positions = (array[:filled] for array in self._arrays)
-            parts.insert(0, (times, log_times, positions, velocities))
-        self._arrays, self._velocities, self._extra = None, None, []
-        if len(parts) == 1:
-            times, log_times, positions, velocities = parts[0]
-        else:
-            times, log_times, positions = (np.concatenate([p[i] for p in parts]) for i in range(3))
-            velocities = None
-            if self.all_velocities and self.keep_velocities:
-                velocities = np.concatenate([p[3] for p in parts if p[3] is not None])
-        return times, log_times, positions, velocities if self.all_velocities else None
-
-
-def _touched(shape: tuple[int, ...], dtype: type[np.generic]) -> np.ndarray:
-    """Return a zeroed array whose pages are already mapped.
-
-    Pages first touched one batch at a time, between the decompressor's allocations,
-    cost ten times more than one sweep over them; where the system maps them all in one
-    call (Linux MAP_POPULATE), that costs about half a sweep.
-    """
-    size = int(np.prod(shape)) * np.dtype(dtype).itemsize
-    populate = getattr(mmap, "MAP_POPULATE", 0)
-    if populate and size:
-        memory = mmap.mmap(-1, size, flags=mmap.MAP_PRIVATE | mmap.MAP_ANONYMOUS | populate)
-        return np.frombuffer(memory, dtype=dtype).reshape(shape)
-    # A bytearray is zero-filled, which touches every page.
-    return np.frombuffer(bytearray(size), dtype=dtype).reshape(shape)
 
 
 def _matches(rows: np.ndarray, template: np.ndarray, layout: JointStateLayout) -> NDArray[np.bool_]:
@@ -368,4 +307,3 @@ def _floats(rows: np.ndarray, at: int, n: int, columns: NDArray[np.intp]) -> NDA
     if len(columns) == n and np.array_equal(columns, np.arange(n)):
         return values
     return values[:, columns]
-

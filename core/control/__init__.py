@@ -3,10 +3,11 @@
 from .check_report import CheckReport, CycleCheck, StepCheck
 from .checking import check_recording, uses_velocities
 from .controller import Disturbance, ExecutionReport, simulate
+from .goal_validation import validate_goal
 from .plants import PLANTS, make_plant
 from .results import ExecutionResult, Violation
 
 __all__ = [
     "PLANTS", "CheckReport", "CycleCheck", "Disturbance", "ExecutionReport", "ExecutionResult", "StepCheck",
-    "Violation", "check_recording", "make_plant", "simulate", "uses_velocities",
+    "Violation", "check_recording", "make_plant", "simulate", "uses_velocities", "validate_goal",
 ]

@@ -165,6 +165,13 @@ class Samples:
         result = np.zeros(end - begin)
         # Block by block: a block's columns stay in cache, where the columns of an hour-long
         # recording would be read from memory once per joint.
+        with np.errstate(invalid="ignore"):  # a non-finite sample is far from any point
+            self._distance(begin, end, point, result)
+        return result
+
+    def _distance(
+        self, begin: int, end: int, point: NDArray[np.float64], result: NDArray[np.float64]
+    ) -> None:
         for at in range(begin, end, _DISTANCE_BLOCK):
             block = self.positions[at : min(at + _DISTANCE_BLOCK, end)]
             out = result[at - begin : at - begin + len(block)]
@@ -175,7 +182,6 @@ class Samples:
                 else:
                     gap = np.abs(values - point[j])
                 np.maximum(out, gap, out=out)
-        return result
 
 
 def find_gaps(samples: Samples, warnings: list[str]) -> tuple[tuple[float, float], ...]:

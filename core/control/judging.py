@@ -9,6 +9,7 @@ trajectory's last point.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -227,7 +228,10 @@ def _outcomes(
     before = np.asarray(before_last_point, dtype=bool)
     path_checked = before.copy()
     path_checked[starts] = True
+    # A NaN error (a NaN sample) counts as an infinite one: outside every checked tolerance,
+    # no margin, as JTC's `>` would not see it.
     magnitude = np.abs(series.error)
+    np.fmin(magnitude, np.inf, out=magnitude)
     path_failed = _outside(magnitude, series.velocity_error, tolerances.state)
     goal_failed = _outside(magnitude, series.velocity_error, tolerances.goal)
     aborts_path = _any_per_row(path_failed) & path_checked
@@ -260,10 +264,10 @@ def _outside_parts(
     """Return per joint (of one cycle) whether position, resp. velocity, is outside its tolerance."""
     position, velocity = tolerance_limits(tolerances)
     # No acceleration errors are computed (no acceleration state), so they never fail.
-    position_out = (position > 0.0) & (np.abs(error) > position)
+    position_out = (position > 0.0) & ~(np.abs(error) <= position)  # NaN is outside
     if velocity_error is None:
         return position_out, np.zeros_like(position_out)
-    return position_out, (velocity > 0.0) & (np.abs(velocity_error) > velocity)
+    return position_out, (velocity > 0.0) & ~(np.abs(velocity_error) <= velocity)
 
 
 def _outside(
@@ -275,7 +279,7 @@ def _outside(
     # A tolerance of 0 is not checked: nothing is above an infinite one.
     outside: NDArray[np.bool_] = magnitude > np.where(position > 0.0, position, np.inf)
     if velocity_error is not None and np.any(velocity > 0.0):
-        outside |= (velocity > 0.0) & (np.abs(velocity_error) > velocity)
+        outside |= (velocity > 0.0) & ~(np.abs(velocity_error) <= velocity)  # NaN is outside
     return outside
 
 
@@ -352,10 +356,22 @@ def _goal_details(violations: Sequence[Violation]) -> str:
     if not violations:
         return ""
     return "; outside goal tolerance: " + ", ".join(
-        f"{v.joint} {v.check} error {v.error:.6g} > {v.tolerance:g}" for v in violations
+        f"{v.joint} {v.check} {_error(v)}" for v in violations
     )
 
 
+def _error(violation: Violation) -> str:
+    """Return "error 0.21 > 0.2", or what is not finite: "actual nan (not a number)"."""
+    if math.isfinite(violation.error):
+        return f"error {violation.error:.6g} > {violation.tolerance:g}"
+    which, value = "actual", violation.actual
+    if math.isfinite(value):
+        which, value = "reference", violation.reference
+    if math.isfinite(value):
+        return f"error {violation.error} > {violation.tolerance:g}"
+    return f"{which} {value} ({'not a number' if math.isnan(value) else 'infinite'})"
+
+
 def _path_message(violations: Sequence[Violation]) -> str:
-    details = ", ".join(f"{v.joint} error {v.error:.6g} > {v.tolerance:g}" for v in violations)
+    details = ", ".join(f"{v.joint} {_error(v)}" for v in violations)
     return f"Aborted due to path tolerance violation at {violations[0].time_s:.4f} s: {details}"

@@ -56,7 +56,7 @@ def check_start_state(
         Violation("start_tolerance", joint, 0.0, float(reference[j]), float(actual[j]),
                   float(error[j]), allowed_start_tolerance)
         for j, joint in enumerate(joint_names)
-        if abs(error[j]) > allowed_start_tolerance
+        if not abs(error[j]) <= allowed_start_tolerance  # a NaN state is no start within it
     )
     if not violations:
         return None

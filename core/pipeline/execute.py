@@ -24,6 +24,7 @@ from ..config.robot_config import RobotConfig, load_robot_config
 from ..config.sources import CONFIG_FILE
 from ..control.check_report import CheckReport
 from ..control.checking import check_recording, uses_velocities
+from ..control.goal_validation import validate_goal
 from ..control.margins import merged_margins
 from ..control.results import ExecutionResult, Violation
 from ..errors import ConfigError, InputError, UnknownName
@@ -37,7 +38,7 @@ _TF_RATE_HZ = 30.0
 
 __all__ = [
     "CheckRequest", "ExecuteRequest", "PlanExecution", "StepExecution", "check", "execute", "pick_controller",
-    "plan_config",
+    "plan_config", "read_valid_plan",
 ]
 
 
@@ -118,6 +119,20 @@ def plan_config(plan: recording.PlanFile, source: Path) -> RobotConfig:
             raise InputError(f"{source}: embedded config: {exc}") from None
 
 
+def read_valid_plan(path: Path) -> recording.PlanFile:
+    """Return the plan file at `path`, each step checked as JTC validates a goal.
+
+    Raises:
+        InputError: The file is unreadable, or a step holds a NaN or infinite value or
+            times that are not strictly increasing (the message names step, point and joint).
+
+    """
+    plan = recording.read_plan(path)
+    for step in plan.steps:
+        validate_goal(step.trajectory, f"{path}: step '{step.name}' on /planned_trajectory")
+    return plan
+
+
 def pick_controller(
     controllers: Mapping[str, ControllerConfig], joints: Sequence[str], source: str
 ) -> ControllerConfig:
@@ -135,7 +150,7 @@ def execute(request: ExecuteRequest) -> PlanExecution:
     from ..control.controller import Disturbance, simulate
     from ..control.plants import make_plant
 
-    plan = recording.read_plan(request.plan)
+    plan = read_valid_plan(request.plan)
     config = plan_config(plan, request.plan)
     controller = _controller(config, plan, request.controllers)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
@@ -197,7 +212,7 @@ def _start_positions(
 
 def check(request: CheckRequest) -> CheckReport:
     """Return the verdict of the controller's and MoveIt's rules on a recorded execution of a plan."""
-    plan = recording.read_plan(request.plan)
+    plan = read_valid_plan(request.plan)
     config = plan_config(plan, request.plan)
     controller = _controller(config, plan, request.controllers)
     series = read_joint_states(request.recording, request.topic, joints=controller.joints,

@@ -7,8 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bag import BagSummary, PlanFile, read_plan, summarize
+from ..bag import BagSummary, PlanFile, summarize
 from ..trajectory import peak_rates
+from .execute import read_valid_plan
 
 __all__ = ["Inspection", "StepPeaks", "inspect_file", "step_peaks"]
 
@@ -50,7 +51,7 @@ def inspect_file(path: Path) -> Inspection:
     summary = summarize(path)
     if "moveplan" not in summary.metadata:
         return Inspection(path, summary, None)
-    plan = read_plan(path)
+    plan = read_valid_plan(path)
     return Inspection(path, summary, plan, step_peaks(plan))
 
 

@@ -14,10 +14,10 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ..bag import read_plan, write_plan
+from ..bag import write_plan
 from ..collision.motion import MotionChecker, exact_checks, scene_checks
 from ..config import JointGoal, RobotConfig, StartFrom, load_robot_config, load_task
-from ..errors import ConfigError, MoveplanError, StartInCollision, UnknownName
+from ..errors import ConfigError, InputError, MoveplanError, StartInCollision, UnknownName
 from ..model.moveit_messages import known_joints
 from ..model.robot import Robot
 from ..model.scene import Scene, empty_scene
@@ -26,6 +26,7 @@ from ..planning.goals import joint_target
 from ..planning.search import seed_planner
 from ..trajectory import sample
 from ..types import Plan, StepResult, TfSamples
+from .execute import read_valid_plan
 from .request import PlanFlags, PlanRequest, resolve_request
 from .step import plan_step
 
@@ -113,11 +114,30 @@ def _start_values(
     if start is None:
         return base, neutral
     if isinstance(start, StartFrom):
-        last = read_plan(Path(start.plan)).steps[-1].trajectory
-        values = dict(zip(last.joint_names, last.positions[-1], strict=True))
-        start = JointGoal.by_name({j: float(v) for j, v in values.items() if j in robot.joint_names})
+        start = _start_from(Path(start.plan), robot)
     source = str(request.task.source) if request.task else "--start-joints"
     return base, joint_target(robot, start, neutral, source)
+
+
+def _start_from(path: Path, robot: Robot) -> JointGoal:
+    """Return where the plan file at `path` ends, as a start for `robot`'s group.
+
+    Raises:
+        InputError: The file is no readable plan, ends on a non-finite value, is a plan of
+            another robot, or moves none of the group's joints.
+
+    """
+    plan = read_valid_plan(path)
+    name = robot.config.name
+    last = plan.steps[-1].trajectory
+    shared = [j for j in last.joint_names if j in robot.joint_names]
+    if plan.robot_name != name or not shared:
+        raise InputError(
+            f"--start-from {path}: a plan of robot '{plan.robot_name}' (joints "
+            f"{', '.join(last.joint_names)}), not of robot '{name}' (group '{robot.group.name}': "
+            f"{', '.join(robot.joint_names)})")
+    values = dict(zip(last.joint_names, last.positions[-1].tolist(), strict=True))
+    return JointGoal.by_name({j: values[j] for j in shared})
 
 
 def _plan_steps(
