@@ -1,21 +1,139 @@
-"""Map moveplan errors to one line on stderr (or a JSON document) and the documented exit code."""
+"""Map moveplan errors to one line on stderr (or a JSON document) and the documented exit code.
+
+Also what happens to the process as a whole: output paths checked before any work
+(`check_outputs`), SIGTERM and SIGHUP handled like Ctrl-C (`handle_signals`), and a
+reader that closes stdout early (`moveplan inspect F | head -1`, `GuardedGroup`).
+"""
 
 from __future__ import annotations
 
 import json
 import logging
+import os
+import signal
 import sys
 import traceback
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
+from pathlib import Path
+from types import FrameType
+from typing import Any
 
 import typer
+from typer.core import TyperGroup
 
-from moveplan.core.errors import MoveplanError
+from moveplan.core.errors import MoveplanError, UsageError
 
-__all__ = ["exit_codes"]
+__all__ = ["PIPE_CLOSED", "GuardedGroup", "Interrupted", "check_outputs", "exit_codes", "handle_signals"]
 
 logger = logging.getLogger("moveplan")
+
+PIPE_CLOSED = 128 + signal.SIGPIPE
+"""Exit code when the reader of stdout or stderr went away: 141, as for a process killed by SIGPIPE."""
+
+_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT, SIGTERM or SIGHUP, raised where the program was, so that files being written are cleaned up."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+def handle_signals() -> None:
+    """Make SIGINT, SIGTERM and SIGHUP raise Interrupted (exit 128 + signal); ignored signals stay ignored."""
+    for signum in _SIGNALS:
+        if signal.getsignal(signum) is not signal.SIG_IGN:  # nohup, or a background job's SIGINT
+            signal.signal(signum, _interrupt)
+
+
+def _interrupt(signum: int, _frame: FrameType | None) -> None:
+    for other in _SIGNALS:  # one clean-up: a second signal must not cut it short
+        signal.signal(other, signal.SIG_IGN)
+    raise Interrupted(signum)
+
+
+def _interrupt_message(exc: KeyboardInterrupt) -> tuple[int, str]:
+    signum = getattr(exc, "signum", signal.SIGINT)
+    name = "" if signum == signal.SIGINT else f" ({signal.Signals(signum).name})"
+    return 128 + signum, f"interrupted{name}"
+
+
+class GuardedGroup(TyperGroup):
+    """The app's command group: a closed stdout exits PIPE_CLOSED quietly, an interrupt 128 + signal.
+
+    Around the whole command, rendering included (exit_codes covers only the work).
+    """
+
+    def invoke(self, ctx: Any) -> Any:
+        """Invoke the command; then flush stdout, so that a closed pipe is noticed here, not at exit."""
+        try:
+            try:
+                return super().invoke(ctx)
+            finally:
+                if sys.stdout is not None:  # None when started with stdout closed
+                    sys.stdout.flush()
+        except BrokenPipeError:
+            _pipe_closed()
+        except SystemExit as exc:
+            # rich's Console.on_broken_pipe exits 1 while handling the BrokenPipeError: same case.
+            if isinstance(exc.__context__, BrokenPipeError):
+                _pipe_closed()
+            raise
+        except KeyboardInterrupt as exc:
+            code, message = _interrupt_message(exc)
+            print(f"moveplan: error: {message}", file=sys.stderr)
+            raise typer.Exit(code) from None
+
+
+def _pipe_closed() -> None:
+    """Exit PIPE_CLOSED, quietly: later writes (the interpreter's last flush too) go to /dev/null."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)
+    os.dup2(devnull, 2)
+    os.close(devnull)
+    raise typer.Exit(PIPE_CLOSED) from None
+
+
+def check_outputs(outputs: Mapping[str, Path | None], inputs: Mapping[str, Path | Sequence[Path] | None]) -> None:
+    """Refuse output paths before any work is done; return None.
+
+    `outputs` maps a flag (-o, --csv) to the path given, `inputs` an argument or flag to the
+    file(s) the command reads. An output may not be an input (writing it would replace
+    it), another output, a directory, a symbolic link, or a device or special file.
+
+    Raises:
+        UsageError: Naming the flag, the path and why.
+
+    """
+    from moveplan.core.bag.bag_writer import output_problem
+
+    read = [(name, p) for name, given in inputs.items() if given is not None
+            for p in ([given] if isinstance(given, Path) else given)]
+    seen: dict[str, str] = {}
+    for flag, path in outputs.items():
+        if path is None:
+            continue
+        problem = output_problem(path)
+        if problem:
+            raise UsageError(f"{flag} '{path}': {problem}")
+        for name, source in read:
+            if _same_file(path, source):
+                raise UsageError(f"{flag} '{path}': is also {name}, read by this command; "
+                                 "an output must not replace an input")
+        where = os.path.realpath(path)
+        if where in seen:
+            raise UsageError(f"{flag} '{path}': is also {seen[where]}; name two different files")
+        seen[where] = flag
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (yet)
+        return False
 
 
 @contextmanager
@@ -24,18 +142,20 @@ def exit_codes(as_json: bool) -> Iterator[None]:
     try:
         yield
     except MoveplanError as exc:
-        _report(exc.exit_code, exc.kind, str(exc), as_json)
-    except KeyboardInterrupt:
-        _report(130, "Interrupted", "interrupted", as_json)
+        _report(exc.exit_code, str(exc), as_json, kind=exc.kind)
+    except KeyboardInterrupt as exc:  # Ctrl-C, and SIGTERM/SIGHUP once handle_signals ran
+        _report(*_interrupt_message(exc), as_json, kind="Interrupted")
+    except BrokenPipeError:
+        raise  # stdout or stderr closed: GuardedGroup exits quietly
     except Exception as exc:  # noqa: BLE001 - the last line of defence: a bug must still exit cleanly
         logger.debug("internal error", exc_info=True)
         detail = traceback.extract_tb(exc.__traceback__)[-1]
         message = (f"internal error (a bug in moveplan, please report it): {type(exc).__name__}: {exc} "
                    f"[{detail.filename.rsplit('/', 1)[-1]}:{detail.lineno}]")
-        _report(1, "InternalError", message, as_json)
+        _report(1, message, as_json, kind="InternalError")
 
 
-def _report(code: int, kind: str, message: str, as_json: bool) -> None:
+def _report(code: int, message: str, as_json: bool, *, kind: str) -> None:
     if as_json:
         print(json.dumps({"ok": False, "error": {"exit_code": code, "kind": kind, "message": message}}))
     else:

@@ -9,17 +9,20 @@ in the messages is the plan and execution writers' business.
 from __future__ import annotations
 
 import os
+import secrets
+import stat
 from collections.abc import Iterator, Mapping
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from importlib.metadata import version
 from pathlib import Path
+from typing import BinaryIO
 
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 
-from ..errors import InputError
+from ..errors import InputError, UsageError
 from .qos import offered_qos_profiles
 
-__all__ = ["write_bag"]
+__all__ = ["atomic_file", "output_problem", "write_bag"]
 
 _MEDIA_TYPES = {".urdf": "application/xml", ".srdf": "application/xml", ".yaml": "application/yaml"}
 
@@ -39,6 +42,7 @@ def write_bag(
     order; then metadata records and attachments, in order.
 
     Raises:
+        UsageError: `path` cannot be an output file: a directory, a symbolic link, a device.
         InputError: `path` cannot be written.
 
     """
@@ -60,24 +64,79 @@ def write_bag(
             writer.add_attachment(0, 0, name, media_type, content)
 
 
-@contextmanager
-def _atomic_writer(path: Path) -> Iterator[Writer]:
-    """Yield a started mcap Writer on a temporary file beside `path`; finish, then rename.
+def output_problem(path: Path) -> str | None:
+    """Return why `path` must not be replaced by a new regular file (an output), None if it may.
 
-    On any error the temporary file is removed: `path` is either untouched or complete.
+    Refused: an empty name, a directory, a symbolic link (replacing it would drop the link, and
+    writing through it would change a file elsewhere), and anything not a regular file (a
+    device such as /dev/null, a FIFO, a socket). A path that does not exist yet is fine.
     """
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    library = f"moveplan {version('moveplan')}; {LIBRARY_IDENTIFIER}"
+    if str(path) in ("", "."):
+        return "is empty (or '.'): not a file name"
     try:
-        # open(mode "x"), not tempfile: the output gets the user's umask permissions.
-        with temporary.open("xb") as stream:
-            writer = Writer(stream, compression=CompressionType.ZSTD, enable_data_crcs=True)
-            writer.start(profile="ros2", library=library)
-            yield writer
-            writer.finish()  # type: ignore[no-untyped-call]  # mcap leaves it unannotated
+        mode = os.lstat(path).st_mode
+    except OSError:
+        return None  # missing (fine), or unreachable: writing it reports why
+    if stat.S_ISLNK(mode):
+        return "is a symbolic link; name the file it points to, or another file"
+    if stat.S_ISDIR(mode):
+        return "is a directory; name a file"
+    if not stat.S_ISREG(mode):
+        return "is a device or special file, not a regular file"
+    return None
+
+
+@contextmanager
+def atomic_file(path: Path) -> Iterator[BinaryIO]:
+    """Yield a binary stream on a new temporary file beside `path`; when the block ends, rename it to `path`.
+
+    The temporary file has a random name (`.NAME.RANDOM.tmp`), created exclusively, so a stale
+    one left by a killed process never gets in the way. On any error or interruption
+    (BaseException) it is removed and `path` is left as it was: untouched or complete.
+
+    Raises:
+        UsageError: `path` cannot be an output file (`output_problem`).
+        InputError: `path` cannot be written (missing or read-only folder, full disk).
+
+    """
+    problem = output_problem(path)
+    if problem:
+        raise UsageError(f"{path}: {problem}")
+    try:
+        temporary, stream = _create_beside(path)
+    except OSError as exc:
+        raise InputError(f"{path}: cannot write: {exc.strerror or exc}") from None
+    try:
+        with stream:
+            yield stream
         temporary.replace(path)
     except BaseException as exc:
-        temporary.unlink(missing_ok=True)
+        with suppress(OSError):
+            temporary.unlink()
         if isinstance(exc, OSError):
             raise InputError(f"{path}: cannot write: {exc.strerror or exc}") from exc
         raise
+
+
+def _create_beside(path: Path) -> tuple[Path, BinaryIO]:
+    """Return a new, exclusively created temporary file beside `path` and its open binary stream."""
+    for _ in range(100):
+        temporary = path.with_name(f".{path.name}.{secrets.token_hex(6)}.tmp")
+        try:
+            # os.open with mode 0o666, not tempfile (0o600): the output gets the user's umask permissions.
+            descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0), 0o666)
+        except FileExistsError:
+            continue
+        return temporary, os.fdopen(descriptor, "wb")
+    raise FileExistsError(f"no free temporary name beside {path}")
+
+
+@contextmanager
+def _atomic_writer(path: Path) -> Iterator[Writer]:
+    """Yield a started mcap Writer on a temporary file beside `path`; finish, then rename (`atomic_file`)."""
+    library = f"moveplan {version('moveplan')}; {LIBRARY_IDENTIFIER}"
+    with atomic_file(path) as stream:
+        writer = Writer(stream, compression=CompressionType.ZSTD, enable_data_crcs=True)
+        writer.start(profile="ros2", library=library)
+        yield writer
+        writer.finish()  # type: ignore[no-untyped-call]  # mcap leaves it unannotated

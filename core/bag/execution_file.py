@@ -65,8 +65,9 @@ def write_execution(
     only if `tf` is given (times on the execution's timeline). No steps write no cycles.
 
     Raises:
-        UsageError: `distro` has no shipped message definitions.
-        InputError: `path` cannot be written.
+        UsageError: `distro` has no shipped message definitions, or `path` cannot be an
+            output file (a directory, a symbolic link, a device: bag_writer.output_problem).
+        InputError: `path` cannot be written (missing or read-only folder, full disk).
 
     """
     state_topic = f"/{controller}/controller_state"

@@ -22,8 +22,9 @@ def write_plan(path: Path, plan: Plan, distro: str = "jazzy") -> None:
     """Write `plan` to `path` as a ROS 2 bag for `distro`, atomically; return None.
 
     Raises:
-        UsageError: `distro` has no shipped message definitions.
-        InputError: `path` cannot be written.
+        UsageError: `distro` has no shipped message definitions, or `path` cannot be an
+            output file (a directory, a symbolic link, a device: bag_writer.output_problem).
+        InputError: `path` cannot be written (missing or read-only folder, full disk).
 
     """
     schemas = {msgtype: schema_text(msgtype, distro) for msgtype, _ in PLAN_TOPICS.values()}

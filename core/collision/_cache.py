@@ -1,24 +1,40 @@
 """Per-robot data computed once and kept on disk between runs (fitted spheres, distance tables).
 
 Entries are pickles named by a digest of what they were computed from, in
-$MOVEPLAN_CACHE_DIR, else $XDG_CACHE_HOME/moveplan, else ~/.cache/moveplan. An entry
-that cannot be read is recomputed; one that cannot be written is skipped.
+$MOVEPLAN_CACHE_DIR, else $XDG_CACHE_HOME/moveplan, else ~/.cache/moveplan.
+
+An entry is a header line, `moveplan-cache FORMAT SHA256` and a newline, then the pickle; the sha256
+is the pickle's. An entry that is missing is computed silently; one that cannot be
+trusted (another format, a checksum that does not match, a pickle that does not load or
+holds the wrong type) is recomputed and replaced, with one warning. An entry that cannot
+be written (a read-only folder, a full disk) is skipped and leaves no partial file. The
+value read back is the value written, so a plan is the same with a cold or warm cache.
 """
 
 from __future__ import annotations
 
+import contextlib
+import glob
 import hashlib
 import logging
 import os
 import pickle
+import tempfile
+import time
 from pathlib import Path
 from typing import Any
 
 import pinocchio as pin
 
-__all__ = ["digest", "path", "read", "write"]
+__all__ = ["FORMAT", "digest", "path", "read", "write"]
 
 logger = logging.getLogger(__name__)
+
+FORMAT = 2
+"""Version of the entry layout; bump it when the layout changes (the old entries are rebuilt)."""
+
+_MAGIC = b"moveplan-cache"
+_STALE_S = 3600.0  # a partial file this old belongs to no running writer
 
 
 def digest(text: str, geometry: pin.GeometryModel) -> str:
@@ -38,22 +54,65 @@ def path(name: str) -> Path:
 
 
 def read(where: Path, kind: type) -> Any:
-    """Return the object cached at `where` if it is a `kind`, else None (missing, unreadable or stale)."""
+    """Return the object cached at `where` if it is a trustworthy `kind`, else None (missing or rebuilt)."""
     try:
-        with where.open("rb") as stream:
-            value = pickle.load(stream)  # noqa: S301 - our own cache file, written by `write`
-    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ValueError, ImportError):
+        data = where.read_bytes()
+    except FileNotFoundError:
         return None
-    return value if isinstance(value, kind) else None
+    except OSError as exc:
+        return _untrusted(where, exc.strerror or str(exc))
+    header, newline, payload = data.partition(b"\n")
+    fields = header.split(b" ")
+    if not newline or len(fields) != 3 or fields[0] != _MAGIC or fields[1] != str(FORMAT).encode():
+        return _untrusted(where, f"not a moveplan cache entry of format {FORMAT}: another version wrote it, or damaged")
+    if fields[2] != hashlib.sha256(payload).hexdigest().encode():
+        return _untrusted(where, "checksum mismatch (a damaged file)")
+    try:
+        value = pickle.loads(payload)  # noqa: S301 - our own cache file, written by `write`, checksum verified
+    except Exception as exc:  # noqa: BLE001 - whatever an old pickle raises, the entry is rebuilt
+        return _untrusted(where, f"{type(exc).__name__}: {exc}")
+    if not isinstance(value, kind):
+        return _untrusted(where, f"holds a {type(value).__name__}, not a {kind.__name__}")
+    return value
+
+
+def _untrusted(where: Path, why: str) -> None:
+    logger.warning("cache entry %s cannot be used (%s): recomputing it", where, why)
 
 
 def write(where: Path, value: Any) -> None:
-    """Cache `value` at `where`, atomically; a cache that cannot be written is skipped."""
+    """Cache `value` at `where`, atomically; a cache that cannot be written is skipped, leaving no partial file.
+
+    Concurrent writers of one entry each write their own temporary file (a random name beside
+    `where`) and rename it: the entry is always one complete file, the same whichever wins.
+    """
+    payload = pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
+    header = b"%s %d %s\n" % (_MAGIC, FORMAT, hashlib.sha256(payload).hexdigest().encode())
     try:
         where.parent.mkdir(parents=True, exist_ok=True)
-        partial = where.with_name(f"{where.name}.{os.getpid()}.partial")
-        with partial.open("wb") as stream:
-            pickle.dump(value, stream)
-        partial.replace(where)
+        descriptor, name = tempfile.mkstemp(prefix=f"{where.name}.", suffix=".partial", dir=where.parent)
     except OSError as exc:
         logger.debug("cache entry %s not written: %s", where, exc)
+        return
+    partial = Path(name)
+    try:
+        with os.fdopen(descriptor, "wb") as stream:
+            stream.write(header + payload)
+        partial.replace(where)
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            partial.unlink()
+        if not isinstance(exc, OSError):
+            raise
+        logger.debug("cache entry %s not written: %s", where, exc)
+        return
+    _sweep(where)
+
+
+def _sweep(where: Path) -> None:
+    """Remove partial files of `where` left by killed runs (or older versions); a writer's own is younger."""
+    stale = time.time() - _STALE_S
+    for leftover in where.parent.glob(f"{glob.escape(where.name)}.*.partial"):
+        with contextlib.suppress(OSError):
+            if leftover.stat().st_mtime < stale:
+                leftover.unlink()

@@ -9,6 +9,7 @@ so a problem and seed give the same path here as with `moveplan plan`.
 from __future__ import annotations
 
 import csv
+import io
 import logging
 import multiprocessing
 import queue as queue_module
@@ -21,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from ..bag.bag_writer import atomic_file
 from ..errors import ConfigError, InputError, MoveplanError, NoPlan, UsageError
 
 __all__ = ["STAGES", "Problem", "Run", "find_problems", "plot", "run_benchmark", "summarize", "write_csv"]
@@ -239,19 +241,26 @@ def summarize(runs: Iterable[Run]) -> list[dict[str, Any]]:
 
 
 def write_csv(runs: Iterable[Run], path: Path) -> None:
-    """Write one CSV row per run to `path` (through a temporary file, so a failure leaves none)."""
+    """Write one CSV row per run to `path` (through a temporary file, so a failure leaves none).
+
+    Raises:
+        UsageError: `path` cannot be an output file (a directory, a symbolic link, a device).
+        InputError: `path` cannot be written.
+
+    """
     fields = list(Run.__dataclass_fields__)
-    partial = path.with_name(path.name + ".partial")
-    with partial.open("w", newline="") as stream:
-        writer = csv.DictWriter(stream, fieldnames=fields)
+    with atomic_file(path) as stream:
+        text = io.TextIOWrapper(stream, encoding="utf-8", newline="")
+        writer = csv.DictWriter(text, fieldnames=fields)
         writer.writeheader()
         for run in runs:
             writer.writerow(run.as_dict())
-    partial.replace(path)
+        text.flush()
+        text.detach()  # the stream is atomic_file's to close
 
 
 def plot(runs: Iterable[Run], path: Path) -> None:
-    """Write a PNG of the distributions of search and total times, one panel per scenario."""
+    """Write a PNG of the distributions of search and total times, one panel per scenario (as `write_csv`)."""
     import matplotlib
 
     matplotlib.use("Agg")  # files only; never a window
@@ -280,7 +289,8 @@ def plot(runs: Iterable[Run], path: Path) -> None:
         axis.grid(True, which="both", alpha=0.3)
         axis.legend(fontsize="small", loc="lower right")
     figure.tight_layout()
-    partial = path.with_name(path.name + ".partial.png")
-    figure.savefig(partial, dpi=100)
-    pyplot.close(figure)
-    partial.replace(path)
+    try:
+        with atomic_file(path) as stream:
+            figure.savefig(stream, format="png", dpi=100)
+    finally:
+        pyplot.close(figure)
