@@ -12,8 +12,9 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from moveplan.cli.errors import exit_codes
+from moveplan.cli.errors import GuardedGroup, check_outputs, exit_codes, handle_signals
 from moveplan.cli.parsing import (
+    MAX_SEED,
     parse_disturbance,
     parse_joint_values,
     parse_joints,
@@ -23,6 +24,7 @@ from moveplan.cli.parsing import (
     parse_pose,
     parse_seeds,
     parse_shift,
+    parse_time,
 )
 
 if TYPE_CHECKING:  # each command imports the core it runs, so that `moveplan --help` stays fast
@@ -36,6 +38,7 @@ app = typer.Typer(
     epilog="Exit codes: 0 success, 1 internal error, 2 usage error, 3 bad input file, 4 no plan, "
            "5 tolerances violated. Reference (file formats, JSON keys, planning and execution rules): "
            "docs/ in the moveplan repository.",
+    cls=GuardedGroup,  # a closed stdout or a signal outside a command's work exits quietly too
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
@@ -78,7 +81,7 @@ def plan(
     min_fraction: Annotated[str | None, typer.Option(help="With --linear: fail below this fraction (1).")] = None,
     planner: Annotated[str | None, typer.Option(help="OMPL geometric planner (default RRTConnect).")] = None,
     planning_time: Annotated[str | None, typer.Option(help="Seconds the planner may search per step.")] = None,
-    seed: Annotated[int | None, typer.Option(min=0, help="Random seed: same seed, same plan.")] = None,
+    seed: Annotated[int | None, typer.Option(min=0, max=MAX_SEED, help="Random seed: same seed, same plan.")] = None,
     velocity_scaling: Annotated[str | None, typer.Option(help="Fraction of the velocity limits, in (0, 1].")] = None,
     acceleration_scaling: Annotated[str | None, typer.Option(help="Fraction of the acceleration limits.")] = None,
     package_path: Annotated[list[Path] | None, typer.Option(help="Folder searched for package:// URIs.")] = None,
@@ -91,6 +94,8 @@ def plan(
     """Plan collision-free, time-parameterised motions and write them to MCAP."""
     _logging(verbose, quiet)
     with exit_codes(as_json):
+        check_outputs({"-o": output}, {"TASK": task, "--robot": robot, "--scene": scene, "--request": motion_request,
+                                       "--start-from": start_from})
         flags = _plan_flags(locals())
         from moveplan.cli import render
         from moveplan.core.pipeline.plan import plan_to_file
@@ -131,7 +136,7 @@ def execute(
     disturb: Annotated[list[str] | None, typer.Option(help="Fault: 't=1.2,joint=elbow_joint,delta=0.05'.")] = None,
     start_joints: Annotated[str | None, typer.Option(help="Robot away from the plan start: 'joint=value'.")] = None,
     controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml overriding the plan's.")] = None,
-    seed: Annotated[int, typer.Option(min=0, help="Seed for plant noise.")] = 0,
+    seed: Annotated[int, typer.Option(min=0, max=MAX_SEED, help="Seed for plant noise.")] = 0,
     ros_distro: Annotated[str, typer.Option(help="Controller-state layout to write: jazzy or humble.")] = "jazzy",
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
@@ -144,6 +149,7 @@ def execute(
 
         if not fake:
             raise UsageError("only fake execution exists yet: add --fake to replay through a simulated controller")
+        check_outputs({"-o": output}, {"PLAN": plan_file, "--controllers": controllers})
         from moveplan.cli import render
         from moveplan.core.pipeline.execute import ExecuteRequest
         from moveplan.core.pipeline.execute import execute as run
@@ -188,7 +194,7 @@ def check_tolerances(
 
         if time_source not in ("header", "log"):
             raise UsageError(f"--time-source: expected header or log, got '{time_source}'")
-        when: str | float = start if start in ("auto", "all") else parse_number(start, "--start (auto, all or seconds)")
+        when: str | float = start if start in ("auto", "all") else parse_time(start, "--start (auto, all or seconds)")
         report = check(CheckRequest(plan_file, recording_file, topic, controllers, when, time_source))
     render.check_summary(report, recording_file, as_json, quiet)
     # Cut off before any verdict: the check could not be done on this recording (bad input).
@@ -256,6 +262,7 @@ def benchmark(
         from moveplan.core.pipeline import benchmark as bench
         from moveplan.core.pipeline.request import check_planning_time
 
+        check_outputs({"--csv": csv, "--plot": plot}, {"PROBLEMS": problems, "--robot": robot})
         seed_list = parse_seeds(seeds)
         time_s = check_planning_time(parse_number(planning_time, "--planning-time"))
         found = bench.find_problems(problems, count)
@@ -271,7 +278,8 @@ def benchmark(
 
 
 def main() -> None:
-    """Run the moveplan command line."""
+    """Run the moveplan command line: SIGTERM and SIGHUP clean up and exit like Ctrl-C (128 + signal)."""
+    handle_signals()
     app()
 
 

@@ -17,38 +17,76 @@ if TYPE_CHECKING:  # imported where used: `moveplan --help` loads no config code
     from moveplan.core.config.goals import JointGoal, PoseGoal, ShiftGoal
 
 __all__ = [
-    "parse_disturbance", "parse_joint_values", "parse_joints", "parse_number", "parse_optional", "parse_params",
-    "parse_pose", "parse_seeds", "parse_shift",
+    "MAX_EXPRESSION_LENGTH", "MAX_SEED", "MAX_SEEDS", "parse_disturbance", "parse_joint_values", "parse_joints",
+    "parse_number", "parse_optional", "parse_params", "parse_pose", "parse_seeds", "parse_shift", "parse_time",
 ]
 
 _T = TypeVar("_T")
+
+MAX_SEED = 2**32 - 1
+"""Largest seed: OMPL's random generator takes 32-bit seeds (the same bound as core/config/tasks.py's,
+kept here so that `moveplan --help` imports no config code)."""
+MAX_SEEDS = 10_000
+"""Seeds one benchmark may run per planner and problem."""
 
 _BINARY: dict[type, Callable[[float, float], float]] = {
     ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
 }
 
 
+MAX_EXPRESSION_LENGTH = 100
+"""Characters of one number or pi expression: `-pi/2+0.25` is 10, a double written in full 25."""
+
+
 def parse_number(text: str, what: str) -> float:
-    """Return the finite number `text` spells: a decimal, or an expression of numbers and pi."""
+    """Return the number `text` spells: a decimal, or an expression of numbers and pi.
+
+    Raises:
+        UsageError: Not such an expression, longer than MAX_EXPRESSION_LENGTH characters, or a
+            value (or an intermediate value) beyond MAX_MAGNITUDE: no flag needs more than a
+            million radians, metres or seconds, and beyond it a typo must not reach the planner.
+    """
+    from moveplan.core.config.fields import MAX_MAGNITUDE
+
+    text = text.strip()
+    shown = f"'{text}'" if len(text) <= 40 else f"'{text[:20]}...{text[-10:]}' ({len(text)} characters)"
+    if len(text) > MAX_EXPRESSION_LENGTH:
+        raise UsageError(f"{what}: {shown} is longer than {MAX_EXPRESSION_LENGTH} characters, "
+                         "the longest number or pi expression moveplan reads")
+
+    def bounded(result: float) -> float:
+        if not abs(result) <= MAX_MAGNITUDE:  # NaN and inf fail this too
+            raise OverflowError
+        return result
+
     def value(node: ast.AST) -> float:
         if isinstance(node, ast.Constant) and isinstance(node.value, int | float) and not isinstance(node.value, bool):
-            return float(node.value)
+            return bounded(float(node.value))
         if isinstance(node, ast.Name) and node.id == "pi":
             return math.pi
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
             return -value(node.operand) if isinstance(node.op, ast.USub) else value(node.operand)
         if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
-            return _BINARY[type(node.op)](value(node.left), value(node.right))
+            return bounded(_BINARY[type(node.op)](value(node.left), value(node.right)))
         raise ValueError
 
-    expected = f"{what}: expected a number or an expression like pi/2, got '{text.strip()}'"
     try:
-        result = value(ast.parse(text.strip(), mode="eval").body)
-    except (SyntaxError, ValueError, ZeroDivisionError, RecursionError):
-        raise UsageError(expected) from None
-    if not math.isfinite(result):
-        raise UsageError(expected)
-    return result
+        return value(ast.parse(text, mode="eval").body)
+    except (SyntaxError, ValueError, ZeroDivisionError, RecursionError, MemoryError):
+        raise UsageError(f"{what}: expected a number or an expression like pi/2, got {shown}") from None
+    except OverflowError:
+        raise UsageError(f"{what}: {shown} is out of range; values are limited to "
+                         f"|value| <= {MAX_MAGNITUDE:,.0f} (rad, m or s)") from None
+
+
+def parse_time(text: str, what: str) -> float:
+    """Return a time in [s] from `text` (a number or expression), checked to lie in [0, MAX_MAGNITUDE]."""
+    from moveplan.core.config.fields import MAX_MAGNITUDE
+
+    time_s = parse_number(text, what)
+    if time_s < 0:
+        raise UsageError(f"{what}: a time must lie in [0, {MAX_MAGNITUDE:,.0f}] s, got '{text.strip()}'")
+    return time_s
 
 
 def parse_optional(parse: Callable[[str, str], _T], text: str | None, what: str) -> _T | None:
@@ -133,22 +171,25 @@ def parse_disturbance(text: str) -> Any:
     fields = {k.strip(): v.strip() for k, v in fields.items()}
     if set(fields) != {"t", "joint", "delta"} or not fields["joint"]:
         raise UsageError(f"--disturb: expected 't=SECONDS,joint=NAME,delta=RAD', got '{text}'")
-    time_s = parse_number(fields["t"], "--disturb t")
-    if time_s < 0:
-        raise UsageError(f"--disturb: t must not be negative, got '{fields['t']}'")
+    time_s = parse_time(fields["t"], "--disturb t")
     return Disturbance(time_s, fields["joint"], parse_number(fields["delta"], "--disturb delta"))
 
 
 def parse_seeds(text: str) -> list[int]:
     """Return the seeds `text` lists: '0-4' (inclusive), '0,3,7', or a mix of both."""
     seeds: list[int] = []
+    shown = text if len(text) <= 40 else f"{text[:37]}..."
     try:
         for part in text.split(","):
             low, _, high = part.strip().partition("-")
-            first, last = int(low), int(high or low)
-            if first < 0 or last < first:
+            if len(low) > 10 or len(high) > 10:  # int() of a 10,000-digit string is slow
                 raise ValueError
+            first, last = int(low), int(high or low)
+            if first < 0 or last < first or last > MAX_SEED:
+                raise ValueError
+            if len(seeds) + last - first + 1 > MAX_SEEDS:
+                raise UsageError(f"--seeds: '{shown}' lists more than {MAX_SEEDS} seeds")
             seeds.extend(range(first, last + 1))
     except ValueError:
-        raise UsageError(f"--seeds: expected '0-4' or '0,3,7' (non-negative), got '{text}'") from None
+        raise UsageError(f"--seeds: expected '0-4' or '0,3,7' with seeds in 0..{MAX_SEED}, got '{shown}'") from None
     return list(dict.fromkeys(seeds))

@@ -6,6 +6,7 @@ Shared by every parser of a configuration file: robot config, scene, task and Mo
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -14,11 +15,41 @@ import yaml
 
 from ..errors import ConfigError, known
 
-__all__ = ["boolean", "check_keys", "load_yaml", "mapping", "number", "string_list"]
+__all__ = [
+    "MAX_ALIAS_EXPANSION", "MAX_MAGNITUDE", "boolean", "check_keys", "coordinate", "load_yaml", "mapping", "number",
+    "string_list",
+]
+
+
+MAX_MAGNITUDE = 1e6
+"""Largest |value| of a position in [rad] or [m] or a time in [s] from a flag or a task: a million
+radians, a thousand kilometres, eleven days. Beyond it, a typo (1e308) must not reach the planner."""
+
+MAX_ALIAS_EXPANSION = 100_000
+"""Values YAML aliases may add to a file once expanded: ROS files reuse a joint list or a block of
+gains a few times; a "billion laughs" file adds billions (docs/formats.md, Limits)."""
+
+# ROS 2 reads a parameter as a double when strtod accepts it, and yaml-cpp (MoveIt's scenes and requests)
+# likewise: `1.0e9`, `1e9` and `1e-3` are numbers there, strings to YAML 1.1's float pattern.
+_ROS_FLOAT = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$")
+
+
+class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: ignore[misc]
+    """PyYAML's safe loader, reading numbers with an exponent as ROS does.
+
+    libyaml's where PyYAML has it: it reads a MotionBenchMaker scene 10x faster.
+    """
+
+
+_Loader.add_implicit_resolver("tag:yaml.org,2002:float", _ROS_FLOAT, list("-+0123456789."))
 
 
 def load_yaml(path: Path) -> Any:
-    """Return the parsed content of a YAML file; ConfigError names the file and line."""
+    """Return the parsed content of a YAML file; ConfigError names the file and line.
+
+    Aliases may add at most MAX_ALIAS_EXPANSION values to the document (and may not contain
+    themselves), so that no reader of the result walks a billion shared copies.
+    """
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
@@ -26,13 +57,47 @@ def load_yaml(path: Path) -> Any:
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(f"{path}: cannot read: {exc}") from None
     try:
-        # libyaml's loader, where PyYAML has it, reads a MotionBenchMaker scene 10x faster.
-        return yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # noqa: S506 - a safe loader
+        content = yaml.load(text, Loader=_Loader)  # noqa: S506 - a safe loader
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" line {mark.line + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
         raise ConfigError(f"{path}:{where} malformed YAML: {problem}") from None
+    _check_aliases(content, path)
+    return content
+
+
+def _check_aliases(content: Any, path: Path) -> None:
+    """Raise ConfigError if aliases make `content` contain itself or grow by more than MAX_ALIAS_EXPANSION values.
+
+    An alias is the same Python object in several places: the document as written holds each
+    container once, as expanded once per place. Both counts are made without expanding anything.
+    """
+    written = 0
+    expanded: dict[int, int] = {}  # id(container) -> values in it, expanded
+    open_ids: set[int] = set()
+    stack: list[tuple[Any, bool]] = [(content, False)] if isinstance(content, dict | list) else []
+    while stack:
+        node, done = stack.pop()
+        key = id(node)
+        children = list(node.values()) + list(node) if isinstance(node, dict) else node
+        if done:
+            open_ids.discard(key)
+            expanded[key] = 1 + sum(expanded.get(id(c), 1) for c in children)
+            continue
+        if key in expanded:
+            continue
+        if key in open_ids:
+            raise ConfigError(f"{path}: a YAML alias refers to a node that contains it; "
+                              "moveplan reads no recursive documents")
+        open_ids.add(key)
+        written += 1 + len(children)
+        stack.append((node, True))
+        stack.extend((c, False) for c in children if isinstance(c, dict | list))
+    total = expanded.get(id(content), 1)
+    if total - written > MAX_ALIAS_EXPANSION:
+        raise ConfigError(f"{path}: YAML aliases expand the document by more than {MAX_ALIAS_EXPANSION} values "
+                          "(moveplan's limit, against alias bombs)")
 
 
 def mapping(value: Any, where: str) -> dict[str, Any]:
@@ -51,13 +116,33 @@ def check_keys(value: Mapping[str, Any], allowed: set[str] | frozenset[str], whe
             raise ConfigError(f"{where}: unknown key '{key}'; expected one of: {known(allowed)}")
 
 
-def number(value: Any, where: str, positive: bool = False) -> float:
-    """Return `value` as a finite float, else raise ConfigError at `where`."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ConfigError(f"{where}: expected a finite number, got {value!r}")
+def number(value: Any, where: str, positive: bool = False, bound: float | None = None) -> float:
+    """Return `value` as a finite float, else raise ConfigError at `where`.
+
+    With `bound`, |value| must not exceed it (MAX_MAGNITUDE for positions and times).
+    """
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ConfigError(f"{where}: expected a finite number, got {_shown(value)}")
+    if isinstance(value, int) and abs(value) > 1e300:  # float() of a 400-digit integer overflows
+        value = math.inf
+    if not math.isfinite(value):
+        raise ConfigError(f"{where}: expected a finite number, got {_shown(value)}")
     if positive and value <= 0:
         raise ConfigError(f"{where}: expected a positive number, got {value!r}")
+    if bound is not None and abs(value) > bound:
+        raise ConfigError(f"{where}: {value:g} is out of range; values are limited to |value| <= {bound:,.0f}")
     return float(value)
+
+
+def coordinate(value: Any, where: str) -> float:
+    """Return a position in [rad] or [m] or a time in [s], checked to be finite and within MAX_MAGNITUDE."""
+    return number(value, where, bound=MAX_MAGNITUDE)
+
+
+def _shown(value: Any) -> str:
+    """Return repr(value), shortened to 60 characters: a message is one line, not a copy of the file."""
+    text = repr(value)
+    return text if len(text) <= 60 else f"{text[:45]}... ({len(text)} characters)"
 
 
 def boolean(value: Any, where: str) -> bool:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -89,7 +90,11 @@ def _group_states(
             jname = joint.get("name", "")
             if jname not in joints:
                 raise UnknownName("joint", jname, f"{path} group_state '{name}'", joints)
-            values[jname] = float_attr(joint, "value", path, 0.0)
+            value = float_attr(joint, "value", path, 0.0)
+            if not math.isfinite(value):
+                raise ConfigError(f"{path}: group_state '{name}' joint '{jname}': value='{joint.get('value')}' "
+                                  "is not a finite number")
+            values[jname] = value
         states[group][name] = values
     return states
 

@@ -12,13 +12,16 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from .fields import check_keys, load_yaml, mapping, number
+from .fields import MAX_MAGNITUDE, check_keys, coordinate, load_yaml, mapping, number
 from .goals import GOAL_KINDS, SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
 
 __all__ = [
     "GOAL_KINDS", "SHIFT_AXES", "StepSpec", "TaskFile", "load_task", "parse_goal", "parse_pose", "parse_scaling",
     "parse_shift",
 ]
+
+MAX_SEED = 2**32 - 1
+"""Largest seed: OMPL's random generator takes 32-bit seeds (cli/parsing.py has the same bound for --seed)."""
 
 _TASK_KEYS = {"robot", "scene", "group", "start", "defaults", "steps", "seed"}
 _DEFAULT_KEYS = {"velocity_scaling", "acceleration_scaling", "planner", "planning_time"}
@@ -83,9 +86,9 @@ def parse_goal(entry: dict[str, Any], where: str) -> Goal:
             raise ConfigError(f"{where}.named: expected a group_state name, got {value!r}")
         return NamedGoal(value)
     if isinstance(value, list):
-        return JointGoal(tuple(number(v, f"{where}.joints[{i}]") for i, v in enumerate(value)))
+        return JointGoal(tuple(coordinate(v, f"{where}.joints[{i}]") for i, v in enumerate(value)))
     if isinstance(value, dict):
-        return JointGoal.by_name({str(k): number(v, f"{where}.joints.{k}") for k, v in value.items()})
+        return JointGoal.by_name({str(k): coordinate(v, f"{where}.joints.{k}") for k, v in value.items()})
     raise ConfigError(f"{where}.joints: expected a list of values or a mapping joint: value, got {value!r}")
 
 
@@ -103,7 +106,8 @@ def parse_pose(entry: dict[str, Any], where: str) -> PoseGoal:
             continue
         if not isinstance(value, list) or len(value) != size:
             raise ConfigError(f"{where}.{key}: expected a list of {size} numbers, got {value!r}")
-        vectors[key] = tuple(number(v, f"{where}.{key}[{i}]") for i, v in enumerate(value))
+        read = coordinate if key != "quat" else number  # a quaternion is normalised: any scale is fine
+        vectors[key] = tuple(read(v, f"{where}.{key}[{i}]") for i, v in enumerate(value))
     if "rpy" in vectors and "quat" in vectors:
         raise ConfigError(f"{where}: give rpy or quat, not both")
     if "quat" in vectors and sum(v * v for v in vectors["quat"]) < 1e-12:
@@ -114,7 +118,7 @@ def parse_pose(entry: dict[str, Any], where: str) -> PoseGoal:
 def parse_shift(entry: dict[str, Any], where: str) -> ShiftGoal:
     """Return a shift goal: displacement per axis (x, y, z in [m]; roll, pitch, yaw in [rad]) and frame."""
     check_keys(entry, {*SHIFT_AXES, "frame"}, where)
-    offsets = {axis: number(entry[axis], f"{where}.{axis}") for axis in SHIFT_AXES if axis in entry}
+    offsets = {axis: coordinate(entry[axis], f"{where}.{axis}") for axis in SHIFT_AXES if axis in entry}
     if not offsets:
         raise ConfigError(f"{where}: give at least one of {', '.join(SHIFT_AXES)}")
     frame = entry.get("frame", "tool")
@@ -145,7 +149,8 @@ def _defaults(entry: dict[str, Any], where: str) -> dict[str, Any]:
             raise ConfigError(f"{where}.planner: expected a planner name, got {entry['planner']!r}")
         result["planner"] = entry["planner"]
     if "planning_time" in entry:
-        result["planning_time"] = number(entry["planning_time"], f"{where}.planning_time", positive=True)
+        result["planning_time"] = number(entry["planning_time"], f"{where}.planning_time", positive=True,
+                                         bound=MAX_MAGNITUDE)
     return result
 
 
@@ -193,8 +198,9 @@ def load_task(path: Path) -> TaskFile:
         if names.count(name) > 1:
             raise ConfigError(f"{source}: step name '{name}' is used twice")
     seed = top.get("seed")
-    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
-        raise ConfigError(f"{source}: seed: expected a non-negative integer, got {seed!r}")
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_SEED):
+        shown = repr(seed) if len(repr(seed)) <= 40 else f"{repr(seed)[:37]}..."
+        raise ConfigError(f"{source}: seed: expected an integer in 0..{MAX_SEED}, got {shown}")
     group = top.get("group")
     return TaskFile(
         source=path,

@@ -30,6 +30,7 @@ class UrdfJoint:
     lower: float = math.nan
     upper: float = math.nan
     velocity: float = math.nan
+    mimic: str = ""  # the joint this one follows (<mimic joint="..."/>), "" for none
 
 
 @dataclass(frozen=True)
@@ -82,11 +83,37 @@ def parse_urdf(text: str, path: Path) -> dict[str, UrdfJoint]:
             lower = float_attr(limit, "lower", path, 0.0)
             upper = float_attr(limit, "upper", path, 0.0)
             velocity = float_attr(limit, "velocity", path)
+        mimic = element.find("mimic")
         joints[name] = UrdfJoint(
             name, element.get("type", ""), parent.get("link", ""), child.get("link", ""),
-            lower, upper, velocity,
+            lower, upper, velocity, "" if mimic is None else mimic.get("joint", ""),
         )
+    for joint in joints.values():
+        if joint.mimic and joint.mimic not in joints:
+            raise ConfigError(f"{path}: joint '{joint.name}' mimics joint '{joint.mimic}', which is not defined")
+    _check_tree(joints, path)
     return joints
+
+
+def _check_tree(joints: dict[str, UrdfJoint], path: Path) -> None:
+    """Raise ConfigError unless the joints make a tree: one parent joint per link, no link its own ancestor."""
+    parent_joint: dict[str, UrdfJoint] = {}
+    for joint in joints.values():
+        if joint.child in parent_joint:
+            raise ConfigError(f"{path}: link '{joint.child}' is the child of two joints, "
+                              f"'{parent_joint[joint.child].name}' and '{joint.name}'; a URDF is a tree")
+        parent_joint[joint.child] = joint
+    done: set[str] = set()
+    for start in parent_joint:
+        seen: list[str] = []
+        link = start
+        while link in parent_joint and link not in done:
+            if link in seen:
+                loop = " -> ".join([*seen[seen.index(link):], link])
+                raise ConfigError(f"{path}: link '{link}' is its own ancestor ({loop}); a URDF is a tree")
+            seen.append(link)
+            link = parent_joint[link].parent
+        done.update(seen)
 
 
 def resolve_collision_meshes(

@@ -227,6 +227,10 @@ def process_xacro(path: Path, args: Mapping[str, str], packages: PackagePath, sh
         if isinstance(exc, xml.parsers.expat.ExpatError):
             raise ConfigError(f"{where}: malformed XML: {exc}") from None
         message = "; ".join(line.strip() for line in str(exc).splitlines() if line.strip())
+        if isinstance(cause, RecursionError) or "maximum recursion depth" in message:
+            message = "a macro expands itself without end"
+        elif len(message) > 300:
+            message = message[:297] + "..."
         raise ConfigError(f"{where}: xacro error: {message or type(exc).__name__}") from None
     finally:
         for line in captured.getvalue().splitlines():
@@ -247,7 +251,10 @@ def _location(path: Path) -> str:
         # macro is where that one was expanded; the text that defines it says where it is.
         files = dict.fromkeys([str(path), *(str(f) for f in _xacro.all_includes)])
         defined_in = next((f for f in files if _defines(f, macros[0])), stack[-1])
-        calls = " <- ".join(repr(name) for name in macros)
+        distinct = list(dict.fromkeys(macros))  # a recursive macro repeats: name each once
+        calls = " <- ".join(repr(name) for name in distinct)
+        if len(distinct) < len(macros):
+            calls += f" (recursive: {len(macros)} nested expansions)"
         where = f"{defined_in}: in macro {calls}, expanded from {where}"
     return where
 

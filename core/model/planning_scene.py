@@ -48,7 +48,7 @@ from .moveit_messages import (
     yaml_list,
 )
 from .robot import Robot
-from .scene import PLANNING_SCENE_KEYS, Scene, resolve_frames
+from .scene import PLANNING_SCENE_KEYS, Scene, check_shape_count, first_repeated, resolve_frames
 
 __all__ = ["planning_scene"]
 
@@ -94,6 +94,7 @@ def planning_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
     world = mapping(top.get("world"), f"{source}: world")
     check_keys(world, _WORLD_KEYS, f"{source}: world")
     _check_octomap(world.get("octomap"), f"{source}: world.octomap")
+    check_shape_count(_shape_count(world.get("collision_objects"), attached), source)
     placed = [
         _place(value, f"{source}: world.collision_objects[{k}]", "", robot, anchors, q)
         for k, value in enumerate(yaml_list(world.get("collision_objects"), f"{source}: world.collision_objects"))
@@ -109,15 +110,11 @@ def planning_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
         placed.append(_place(entry.get("object"), f"{where}.object", link, robot, anchors, q, touch))
 
     objects = [obj for group in placed for obj in group[1]]
-    names = [o.name for o in objects]
-    for name in names:
-        if names.count(name) > 1:
-            raise ConfigError(f"{source}: collision object '{name}' is defined twice")
+    if (twice := first_repeated(o.name for o in objects)) is not None:
+        raise ConfigError(f"{source}: collision object '{twice}' is defined twice")
     frames.extend(frame for group in placed for frame in group[2])
-    frame_names = [f.name for f in frames]
-    for name in frame_names:
-        if frame_names.count(name) > 1:
-            raise ConfigError(f"{source}: frame '{name}' is defined twice")
+    if (twice := first_repeated(f.name for f in frames)) is not None:
+        raise ConfigError(f"{source}: frame '{twice}' is defined twice")
     parts_of = {object_id: [o.name for o in parts] for object_id, parts, _ in placed}
     pairs = _allowed_pairs(top.get("allowed_collision_matrix"), f"{source}: allowed_collision_matrix",
                            [*robot.link_names, *parts_of])
@@ -156,6 +153,14 @@ def _place(
     return parsed.id, parts, subframes
 
 
+def _shape_count(collision_objects: Any, attached: list[Any]) -> int:
+    """Return the primitives and meshes of the scene's objects, counted before any is read (malformed entries: 0)."""
+    entries = [*(collision_objects if isinstance(collision_objects, list) else []),
+               *(a.get("object") for a in attached if isinstance(a, dict))]
+    return sum(len(e.get(key) or ()) if isinstance(e, dict) and isinstance(e.get(key), list) else 0
+               for e in entries for key in ("primitives", "meshes"))
+
+
 def _anchor(
     frame: str, anchors: dict[str, tuple[str, NDArray[np.float64]]], robot: Robot, where: str
 ) -> tuple[str, NDArray[np.float64]]:
@@ -166,7 +171,10 @@ def _anchor(
 def _warn_ignored(top: dict[str, Any], source: str, robot: Robot) -> None:
     """Log a warning for each PlanningScene field that would change the result but is ignored."""
     model = top.get("robot_model_name")
+    if model is not None and not isinstance(model, str):
+        raise ConfigError(f"{source}: robot_model_name: expected a robot name, got a {type(model).__name__}")
     if model not in (None, "", robot.config.name, robot.config.srdf.name):
+        model = model if len(model) <= 80 else model[:77] + "..."
         logger.warning("%s: robot_model_name '%s' is not the loaded robot '%s'", source, model, robot.config.name)
     for key, field_name, neutral in (("link_padding", "padding", 0.0), ("link_scale", "scale", 1.0)):
         for k, value in enumerate(yaml_list(top.get(key), f"{source}: {key}")):
@@ -226,12 +234,12 @@ def _collision_object(value: Any, where: str, default_frame: str) -> _Object:
     for key, poses_key, read in (("primitives", "primitive_poses", _primitive), ("meshes", "mesh_poses", _mesh)):
         items = yaml_list(entry.get(key), f"{where}.{key}")
         poses = yaml_list(entry.get(poses_key), f"{where}.{poses_key}")
-        if len(poses) > len(items):
-            raise ConfigError(f"{where}.{poses_key}: {len(poses)} poses for {len(items)} {key}")
+        if len(poses) != len(items):
+            # MoveIt refuses such an object ("Number of primitive shapes does not match number of poses").
+            raise ConfigError(f"{where}.{poses_key}: object '{name}' has {len(items)} {key} and {len(poses)} "
+                              f"{poses_key}; give one pose per shape")
         shapes.extend(read(item, f"{where}.{key}[{i}]") for i, item in enumerate(items))
-        # As in MoveIt, a shape without a pose sits at the object's origin.
         shape_poses.extend(pose(p, f"{where}.{poses_key}[{i}]") for i, p in enumerate(poses))
-        shape_poses.extend(np.eye(4) for _ in range(len(items) - len(poses)))
     if not shapes:
         raise ConfigError(f"{where}: object '{name}' has no primitives or meshes")
     header_T_object = pose(entry.get("pose"), f"{where}.pose")

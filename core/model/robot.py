@@ -34,6 +34,7 @@ class Robot:
         self.joint_names: tuple[str, ...] = self.group.joints
         if not self.joint_names:
             raise ConfigError(f"{config.srdf_path}: group '{self.group.name}' has no movable joints")
+        _check_group(config, self.group)
         limits = [config.limits[j] for j in self.joint_names]
         self.lower = _readonly([lim.lower for lim in limits])
         self.upper = _readonly([lim.upper for lim in limits])
@@ -126,6 +127,29 @@ class Robot:
     def root_link(self) -> str:
         """Return the URDF root link, the planning frame."""
         return str(self.model.frames[1].name) if len(self.model.frames) > 1 else "world"
+
+
+def _check_group(config: RobotConfig, group: Group) -> None:
+    """Raise ConfigError for a group joint moveplan cannot plan: a mimic or its leader, a joint that cannot move.
+
+    pinocchio ignores <mimic>: a planned motion would move a leader while its mimic stays put.
+    A joint with lower == upper would divide by its zero range in the collision tables.
+    """
+    where = f"{config.urdf_path}: group '{group.name}'"
+    for joint in config.urdf_joints.values():
+        if not joint.mimic:
+            continue
+        if joint.name in group.joints:
+            raise ConfigError(f"{where} has joint '{joint.name}', which mimics '{joint.mimic}'; "
+                              "mimic joints are not supported yet: plan with a group without them")
+        if joint.mimic in group.joints:
+            raise ConfigError(f"{where} moves joint '{joint.mimic}', which joint '{joint.name}' mimics; "
+                              "mimic joints are not supported yet: plan with a group without them")
+    for name in group.joints:
+        limit = config.limits[name]
+        if not limit.continuous and limit.lower == limit.upper:
+            raise ConfigError(f"{where}: joint '{name}' has lower limit = upper limit ({limit.lower:g}), so it "
+                              "cannot move; make it a fixed joint in the URDF, or widen its limits")
 
 
 def _readonly(values: list[float]) -> NDArray[np.float64]:

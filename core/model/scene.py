@@ -12,6 +12,7 @@ core/model/scene_file.py tells the two apart.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -25,7 +26,16 @@ from ..types import CollisionObject, Frame, Shape
 from .poses import pose_matrix, vector
 from .robot import Robot
 
-__all__ = ["PLANNING_SCENE_KEYS", "Scene", "empty_scene", "moveplan_scene", "resolve_frames"]
+__all__ = [
+    "MAX_SCENE_FRAMES", "MAX_SCENE_SHAPES", "PLANNING_SCENE_KEYS", "Scene", "check_shape_count", "empty_scene",
+    "first_repeated", "moveplan_scene", "resolve_frames",
+]
+
+MAX_SCENE_SHAPES = 10_000
+"""Collision shapes a scene may hold: MotionBenchMaker's scenes hold tens, a detailed cell a few thousand;
+each shape costs collision checks at every state of every motion (docs/formats.md, Limits)."""
+MAX_SCENE_FRAMES = 10_000
+"""Frames a scene may define, subframes of PlanningScene objects included."""
 
 _FRAME_KEYS = {"name", "parent", "xyz", "rpy", "quat"}
 _SHAPE_KEYS = {"box", "cylinder", "sphere", "mesh", "scale"}
@@ -104,7 +114,7 @@ def moveplan_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
     source = str(path)
     check_keys(top, {"frames", "objects", "attached"}, source)
     frames: list[Frame] = []
-    for k, entry in enumerate(top.get("frames") or []):
+    for k, entry in enumerate(_entries(top, "frames", source)):
         where = f"{source}: frames[{k}]"
         entry = mapping(entry, where)
         check_keys(entry, _FRAME_KEYS, where)
@@ -115,9 +125,10 @@ def moveplan_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
         frames.append(Frame(entry["name"], entry["parent"], transform))
     anchors = resolve_frames(frames, robot, source)
 
+    check_shape_count(len(_entries(top, "objects", source)) + len(_entries(top, "attached", source)), source)
     root_q = robot.neutral()
     objects: list[CollisionObject] = []
-    for k, entry in enumerate(top.get("objects") or []):
+    for k, entry in enumerate(_entries(top, "objects", source)):
         where = f"{source}: objects[{k}]"
         entry = mapping(entry, where)
         check_keys(entry, _OBJECT_KEYS, where)
@@ -131,7 +142,7 @@ def moveplan_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
         root_T_object = robot.frame_pose(root_q, link) @ link_T_frame @ pose_matrix(
             entry.get("xyz"), entry.get("rpy"), entry.get("quat"), where)
         objects.append(CollisionObject(name, _shape(entry, where, path.parent), root_T_object))
-    for k, entry in enumerate(top.get("attached") or []):
+    for k, entry in enumerate(_entries(top, "attached", source)):
         where = f"{source}: attached[{k}]"
         entry = mapping(entry, where)
         check_keys(entry, _ATTACHED_KEYS, where)
@@ -143,37 +154,64 @@ def moveplan_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
         touch = tuple(str(t) for t in entry.get("touch_links") or [])
         transform = pose_matrix(entry.get("xyz"), entry.get("rpy"), entry.get("quat"), where)
         objects.append(CollisionObject(name, _shape(entry, where, path.parent), transform, link, touch))
-    names = [o.name for o in objects]
-    for name in names:
-        if names.count(name) > 1:
-            raise ConfigError(f"{source}: object name '{name}' is used twice")
+    if (twice := first_repeated(o.name for o in objects)) is not None:
+        raise ConfigError(f"{source}: object name '{twice}' is used twice")
     return Scene(source, tuple(frames), tuple(objects), anchors)
+
+
+def check_shape_count(count: int, source: str) -> None:
+    """Raise ConfigError if a scene has more than MAX_SCENE_SHAPES collision shapes."""
+    if count > MAX_SCENE_SHAPES:
+        raise ConfigError(f"{source}: {count} collision shapes; moveplan checks at most {MAX_SCENE_SHAPES} "
+                          "per scene (merge small ones into boxes or meshes)")
+
+
+def first_repeated(names: Iterable[str]) -> str | None:
+    """Return the first name that comes a second time, None if all differ."""
+    seen: set[str] = set()
+    for name in names:
+        if name in seen:
+            return name
+        seen.add(name)
+    return None
+
+
+def _entries(top: dict[str, Any], key: str, source: str) -> list[Any]:
+    """Return the list under `key` (absent or null: empty), else raise ConfigError."""
+    value = top.get(key)
+    if value is None:
+        return []
+    if not isinstance(value, list):
+        raise ConfigError(f"{source}: {key}: expected a list, got {type(value).__name__}")
+    return value
 
 
 def resolve_frames(
     frames: list[Frame], robot: Robot, source: str
 ) -> dict[str, tuple[str, NDArray[np.float64]]]:
     """Return each frame's robot link and `link_T_frame`, following parent chains."""
+    if len(frames) > MAX_SCENE_FRAMES:
+        raise ConfigError(f"{source}: {len(frames)} frames; moveplan reads at most {MAX_SCENE_FRAMES} per scene")
     by_name = {f.name: f for f in frames}
     for frame in frames:
         if frame.name in robot.link_names:
             raise ConfigError(f"{source}: frame '{frame.name}' has the name of a robot link")
     anchors: dict[str, tuple[str, NDArray[np.float64]]] = {}
-
-    def resolve(name: str, seen: tuple[str, ...]) -> tuple[str, NDArray[np.float64]]:
-        if name in anchors:
-            return anchors[name]
-        if name in robot.link_names:
-            return name, np.eye(4)
-        if name not in by_name:
-            raise FrameNotFound(name, source, [*by_name, *robot.link_names])
-        if name in seen:
-            raise ConfigError(f"{source}: frames form a loop: {' -> '.join((*seen, name))}")
-        frame = by_name[name]
-        link, link_T_parent = resolve(frame.parent, (*seen, name))
-        anchors[name] = (link, link_T_parent @ frame.transform)
-        return anchors[name]
-
     for frame in frames:
-        resolve(frame.name, ())
+        # Up the parents to a resolved frame or a link, then down again: no recursion, chains of any length.
+        chain: list[str] = []
+        on_chain: set[str] = set()
+        name = frame.name
+        while name not in anchors and name not in robot.link_names:
+            if name not in by_name:
+                raise FrameNotFound(name, source, [*by_name, *robot.link_names])
+            if name in on_chain:
+                raise ConfigError(f"{source}: frames form a loop: {' -> '.join((*chain, name))}")
+            chain.append(name)
+            on_chain.add(name)
+            name = by_name[name].parent
+        link, link_T = anchors[name] if name in anchors else (name, np.eye(4))
+        for child in reversed(chain):
+            link_T = link_T @ by_name[child].transform
+            anchors[child] = (link, link_T)
     return anchors
