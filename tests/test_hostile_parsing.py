@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import UR10E, Cli
+from conftest import ROOT, UR10E, Cli
 
 from moveplan.cli.parsing import parse_disturbance, parse_number, parse_seeds
 from moveplan.core.config.controllers import parse_controllers
@@ -353,3 +353,22 @@ def test_group_moving_a_mimics_leader_is_refused(cli: Cli, ur10e_copy: Path, tmp
     assert not output.exists()
     assert one_line(result).endswith("group 'manipulator' moves joint 'elbow_joint', which joint 'follower_joint' "
                                      "mimics; mimic joints are not supported yet: plan with a group without them")
+
+
+def test_a_scaling_below_a_thousandth_is_a_usage_error(cli: Cli, tmp_path: Path) -> None:
+    out = tmp_path / "plan.mcap"
+    run = cli("plan", "--robot", "ur10e", "--joints", "elbow_joint=-1", "--velocity-scaling", "1e-9", "-o", out)
+    assert run.exit_code == 2 and "--velocity-scaling: expected a factor in [0.001, 1], got 1e-09" in run.stderr
+    assert not out.exists()
+
+
+def test_an_update_rate_beyond_ten_kilohertz_is_an_input_error_naming_the_limit(cli: Cli, tmp_path: Path) -> None:
+    controllers = tmp_path / "ros2_controllers.yaml"
+    text = (ROOT / "configs" / "ur10e" / "ros2_controllers.yaml").read_text()
+    controllers.write_text(text.replace("update_rate: 500", "update_rate: 1.0e+9"))
+    assert "update_rate: 1.0e+9" in controllers.read_text()
+    plan, out = tmp_path / "plan.mcap", tmp_path / "executed.mcap"
+    assert cli("plan", "--robot", "ur10e", "--joints", "elbow_joint=-1", "-o", plan).exit_code == 0
+    run = cli("execute", plan, "--fake", "--controllers", controllers, "-o", out)
+    assert run.exit_code == 3 and "1e+09 Hz is beyond moveplan's limit of 10000 Hz" in run.stderr
+    assert not out.exists()

@@ -57,7 +57,7 @@ def test_start_flags_become_typed_starts() -> None:
     ({"named": "home", "linear": True}, "--linear goes with --pose or --shift"),
     ({"named": "home", "min_fraction": 1.5}, r"--min-fraction: expected a number in \[0, 1\], got 1.5"),
     ({"named": "home", "planning_time": 0.0}, "--planning-time: expected a positive number of seconds, got 0"),
-    ({"named": "home", "velocity_scaling": 0.0}, r"--velocity-scaling: expected a factor in \(0, 1\], got 0"),
+    ({"named": "home", "velocity_scaling": 0.0}, r"--velocity-scaling: expected a factor in \[0.001, 1\], got 0"),
     ({"named": "home", "acceleration_scaling": 1.5}, r"--acceleration-scaling: .* got 1.5"),
 ])
 def test_flags_that_break_a_rule_are_a_usage_error(flags: dict[str, object], message: str) -> None:

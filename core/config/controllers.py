@@ -16,7 +16,7 @@ from typing import Any
 from ..errors import ConfigError
 from .fields import boolean, check_keys, load_yaml, mapping, number
 
-__all__ = ["ControllerConfig", "ExecutionConfig", "parse_controllers", "parse_execution"]
+__all__ = ["MAX_UPDATE_RATE_HZ", "ControllerConfig", "ExecutionConfig", "parse_controllers", "parse_execution"]
 
 # What a JointTrajectoryController declares, in any release from Humble to master: ros2_controllers'
 # joint_trajectory_controller/src/joint_trajectory_controller_parameters.yaml (@9c53e68, Humble-era
@@ -30,6 +30,7 @@ _JTC_KEYS = frozenset({
 })
 # Every controller's node also takes these: controller_interface's update_rate, is_async and
 # async_parameters (ControllerInterfaceBase), the spawner's `type`, rclcpp's use_sim_time.
+MAX_UPDATE_RATE_HZ = 10_000.0
 _NODE_KEYS = frozenset({"update_rate", "is_async", "async_parameters", "type", "use_sim_time"})
 # ur_controllers' ScaledJointTrajectoryController adds scaled_joint_trajectory_controller_parameters.yaml.
 _SCALED_JTC_KEYS = frozenset({
@@ -83,8 +84,12 @@ def parse_controllers(path: Path) -> dict[str, ControllerConfig]:
     """
     top = mapping(load_yaml(path), str(path))
     manager = _ros_parameters(top, "controller_manager", path)
-    rate = number(manager.get("update_rate", 100), f"{path}: controller_manager.ros__parameters.update_rate",
-                  positive=True)
+    where = f"{path}: controller_manager.ros__parameters.update_rate"
+    rate = number(manager.get("update_rate", 100), where, positive=True)
+    if rate > MAX_UPDATE_RATE_HZ:
+        # Each simulated second costs `rate` control cycles of state: 1e9 Hz asked for 24 GB.
+        raise ConfigError(f"{where}: {rate:g} Hz is beyond moveplan's limit of {MAX_UPDATE_RATE_HZ:g} Hz "
+                          "(ros2_control loops run at up to a few kHz)")
     controllers: dict[str, ControllerConfig] = {}
     for name, entry in manager.items():
         kind = str(entry.get("type", "")) if isinstance(entry, dict) else ""

@@ -16,8 +16,8 @@ from .fields import MAX_MAGNITUDE, check_keys, coordinate, load_yaml, mapping, n
 from .goals import GOAL_KINDS, SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
 
 __all__ = [
-    "GOAL_KINDS", "SHIFT_AXES", "StepSpec", "TaskFile", "load_task", "parse_goal", "parse_pose", "parse_scaling",
-    "parse_shift",
+    "GOAL_KINDS", "MIN_SCALING", "SHIFT_AXES", "StepSpec", "TaskFile", "load_task", "parse_goal", "parse_pose",
+    "parse_scaling", "parse_shift",
 ]
 
 MAX_SEED = 2**32 - 1
@@ -62,11 +62,16 @@ class TaskFile:
     raw: bytes = field(default=b"", repr=False)
 
 
+# A motion slowed more than a thousandfold lasts hours for a radian, and the plan's /tf
+# samples and an execution's control cycles grow with it (1e-9 asked for terabytes): a typo.
+MIN_SCALING = 1e-3
+
+
 def parse_scaling(value: Any, where: str) -> float:
-    """Return a velocity or acceleration scaling factor, checked to lie in (0, 1]."""
+    """Return a velocity or acceleration scaling factor, checked to lie in [MIN_SCALING, 1]."""
     factor = number(value, where)
-    if not 0.0 < factor <= 1.0:
-        raise ConfigError(f"{where}: expected a scaling factor in (0, 1], got {value!r}")
+    if not MIN_SCALING <= factor <= 1.0:
+        raise ConfigError(f"{where}: expected a scaling factor in [{MIN_SCALING:g}, 1], got {value!r}")
     return factor
 
 

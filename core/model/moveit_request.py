@@ -34,7 +34,7 @@ import numpy as np
 from ..config.fields import check_keys, load_yaml, mapping, number
 from ..config.goals import JointGoal, PoseGoal
 from ..config.planners import PLANNERS
-from ..config.tasks import StepSpec
+from ..config.tasks import MIN_SCALING, StepSpec
 from ..errors import ConfigError, known
 from .moveit_messages import header_frame, point, pose, quaternion, robot_state, yaml_list
 from .poses import pose_matrix
@@ -178,6 +178,8 @@ def _scaling(top: dict[str, Any], key: str, source: str) -> float | None:
     if key not in top:
         return None
     factor = number(top[key], f"{source}: {key}")
+    if 0.0 < factor < MIN_SCALING:
+        raise ConfigError(f"{source}: {key}: {factor:g} is below moveplan's limit of {MIN_SCALING:g}")
     if 0.0 < factor <= 1.0:
         return factor
     if factor != 0.0:

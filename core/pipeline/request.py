@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TypeVar
 
 from ..config import JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom, StepSpec, TaskFile
+from ..config.tasks import MIN_SCALING
 from ..errors import UsageError
 from ..model.moveit_request import MotionPlanRequest, load_motion_plan_request
 
@@ -98,8 +99,8 @@ class PlanFlags:
             check_planning_time(self.planning_time)
         for name in ("velocity_scaling", "acceleration_scaling"):
             factor = getattr(self, name)
-            if factor is not None and not 0.0 < factor <= 1.0:
-                raise UsageError(f"{_flag(name)}: expected a factor in (0, 1], got {factor:g}")
+            if factor is not None and not MIN_SCALING <= factor <= 1.0:
+                raise UsageError(f"{_flag(name)}: expected a factor in [{MIN_SCALING:g}, 1], got {factor:g}")
 
     @property
     def start(self) -> Start:
