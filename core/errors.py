@@ -16,6 +16,8 @@ __all__ = [
     "FrameNotFound",
     "GoalInCollision",
     "GoalOutsideLimits",
+    "OutsideLimits",
+    "StartOutsideLimits",
     "GoalUnreachable",
     "InCollision",
     "InputError",
@@ -143,15 +145,29 @@ class GoalInCollision(InCollision):
         super().__init__(pair, "goal state")
 
 
-class GoalOutsideLimits(NoPlan):
-    """A goal joint value lies outside the joint's position limits."""
+class OutsideLimits(NoPlan):
+    """A joint value of a start or goal lies outside the joint's position limits."""
+
+    what = "value"
 
     def __init__(self, joint: str, value: float, lower: float, upper: float) -> None:
         self.joint, self.value, self.lower, self.upper = joint, value, lower, upper
         super().__init__(
-            f"goal for joint '{joint}' is {value:.6g} rad, outside its limits "
+            f"{self.what} for joint '{joint}' is {value:.6g} rad, outside its limits "
             f"[{lower:.6g}, {upper:.6g}]"
         )
+
+
+class GoalOutsideLimits(OutsideLimits):
+    """A goal joint value lies outside the joint's position limits."""
+
+    what = "goal"
+
+
+class StartOutsideLimits(OutsideLimits):
+    """A start joint value lies outside the joint's position limits."""
+
+    what = "start"
 
 
 class GoalUnreachable(NoPlan):

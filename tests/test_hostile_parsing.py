@@ -372,3 +372,11 @@ def test_an_update_rate_beyond_ten_kilohertz_is_an_input_error_naming_the_limit(
     run = cli("execute", plan, "--fake", "--controllers", controllers, "-o", out)
     assert run.exit_code == 3 and "1e+09 Hz is beyond moveplan's limit of 10000 Hz" in run.stderr
     assert not out.exists()
+
+
+def test_a_start_outside_the_limits_is_called_a_start(cli: Cli, tmp_path: Path) -> None:
+    out = tmp_path / "plan.mcap"
+    run = cli("plan", "--robot", "ur10e", "--start-joints", "elbow_joint=4", "--named", "home", "-o", out)
+    assert run.exit_code == 4
+    assert "start for joint 'elbow_joint' is 4 rad, outside its limits" in run.stderr and "goal" not in run.stderr
+    assert not out.exists()

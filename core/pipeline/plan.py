@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 from ..bag import write_plan
 from ..collision.motion import MotionChecker, exact_checks, scene_checks
 from ..config import JointGoal, RobotConfig, StartFrom, load_robot_config, load_task
-from ..errors import ConfigError, InputError, MoveplanError, StartInCollision, UnknownName
+from ..errors import ConfigError, InputError, MoveplanError, StartInCollision, StartOutsideLimits, UnknownName
 from ..model.moveit_messages import known_joints
 from ..model.robot import Robot
 from ..model.scene import Scene, empty_scene
@@ -116,7 +116,7 @@ def _start_values(
     if isinstance(start, StartFrom):
         start = _start_from(Path(start.plan), robot)
     source = str(request.task.source) if request.task else "--start-joints"
-    return base, joint_target(robot, start, neutral, source)
+    return base, joint_target(robot, start, neutral, source, StartOutsideLimits)
 
 
 def _start_from(path: Path, robot: Robot) -> JointGoal:

@@ -15,7 +15,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ..config.goals import JointGoal, NamedGoal, PoseGoal, ShiftGoal
-from ..errors import ConfigError, GoalOutsideLimits, UnknownName, UsageError
+from ..errors import ConfigError, GoalOutsideLimits, OutsideLimits, UnknownName, UsageError
 from ..model.poses import pose_matrix
 from ..model.robot import Robot
 from ..model.scene import Scene
@@ -35,12 +35,13 @@ def named_state(robot: Robot, name: str, start: NDArray[np.float64]) -> NDArray[
 
 
 def joint_target(
-    robot: Robot, goal: JointGoal | NamedGoal, start: NDArray[np.float64], source: str
+    robot: Robot, goal: JointGoal | NamedGoal, start: NDArray[np.float64], source: str,
+    outside: type[OutsideLimits] = GoalOutsideLimits,
 ) -> NDArray[np.float64]:
     """Return the group values a joints or named goal asks for, checked against the limits.
 
     `source` names where the goal came from: a flag ("--joints"; a malformed one is a
-    UsageError) or a file (a ConfigError).
+    UsageError) or a file (a ConfigError). A value outside its limits raises `outside`.
     """
     if isinstance(goal, NamedGoal):
         target = named_state(robot, goal.name, start)
@@ -55,17 +56,19 @@ def joint_target(
                 f"{robot.dof} joints: {', '.join(robot.joint_names)}"
             )
         target = np.array(goal.values, dtype=float)
-    check_limits(robot, target)
+    check_limits(robot, target, outside)
     return target
 
 
-def check_limits(robot: Robot, values: NDArray[np.float64]) -> None:
-    """Raise GoalOutsideLimits for the first joint outside its position limits."""
+def check_limits(
+    robot: Robot, values: NDArray[np.float64], outside: type[OutsideLimits] = GoalOutsideLimits
+) -> None:
+    """Raise `outside` for the first joint outside its position limits."""
     for i, joint in enumerate(robot.joint_names):
         if robot.continuous[i]:
             continue
         if not robot.lower[i] - _LIMIT_SLACK <= values[i] <= robot.upper[i] + _LIMIT_SLACK:
-            raise GoalOutsideLimits(joint, float(values[i]), float(robot.lower[i]), float(robot.upper[i]))
+            raise outside(joint, float(values[i]), float(robot.lower[i]), float(robot.upper[i]))
 
 
 def _apply(robot: Robot, values: dict[str, float], start: NDArray[np.float64], source: str) -> NDArray[np.float64]:
