@@ -26,7 +26,6 @@ from ..planning.goals import joint_target
 from ..planning.search import seed_planner
 from ..trajectory import sample
 from ..types import Plan, StepResult, TfSamples
-from .execute import read_valid_plan
 from .request import PlanFlags, PlanRequest, resolve_request
 from .step import plan_step
 
@@ -127,6 +126,9 @@ def _start_from(path: Path, robot: Robot) -> JointGoal:
             another robot, or moves none of the group's joints.
 
     """
+    # Imported here: execution's district (the controller simulation) is no part of planning.
+    from .execute import read_valid_plan
+
     plan = read_valid_plan(path)
     name = robot.config.name
     last = plan.steps[-1].trajectory
