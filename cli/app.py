@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from moveplan.cli.errors import GuardedGroup, check_outputs, exit_codes, handle_signals
+from moveplan.cli.errors import GuardedGroup, check_outputs, description_inputs, exit_codes, handle_signals
 from moveplan.cli.parsing import (
     MAX_SEED,
     parse_disturbance,
@@ -28,7 +28,7 @@ from moveplan.cli.parsing import (
 )
 
 if TYPE_CHECKING:  # each command imports the core it runs, so that `moveplan --help` stays fast
-    from moveplan.core.pipeline.request import PlanFlags
+    from moveplan.core.pipeline.request import PlanFlags, RobotSource
 
 __all__ = ["app", "main"]
 
@@ -49,6 +49,18 @@ app = typer.Typer(
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON document on stdout, nothing else.")]
 QuietOpt = Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")]
 VerboseOpt = Annotated[bool, typer.Option("--verbose", "-v", help="Log what happens to stderr.")]
+PackagePathOpt = Annotated[list[Path] | None, typer.Option(
+    help="Folder searched for $(find pkg) and package:// URIs; repeatable.")]
+XacroArgOpt = Annotated[list[str] | None, typer.Option(help="xacro argument name:=value; repeatable.")]
+UrdfOpt = Annotated[str | None, typer.Option(
+    "--urdf", metavar="FILE|package://PKG/PATH", help="URDF (or .xacro) to load, whatever the config names.")]
+SrdfOpt = Annotated[str | None, typer.Option(
+    "--srdf", metavar="FILE|package://PKG/PATH", help="SRDF (or .srdf.xacro) to load, whatever the config names.")]
+StrictLimitsOpt = Annotated[bool, typer.Option(
+    "--strict-limits", help="An acceleration limit missing in the config is an error instead of the documented "
+                            "default.")]
+_ROBOT_HELP = ("Robot config: a moveplan.yaml or its folder, a MoveIt config package, a URDF or SRDF file, "
+               "or a shipped name.")
 
 
 def _logging(verbose: bool, quiet: bool) -> None:
@@ -60,7 +72,7 @@ def _logging(verbose: bool, quiet: bool) -> None:
 def plan(
     task: Annotated[Path | None, typer.Argument(help="Task file (docs/formats.md).", show_default=False)] = None,
     output: Annotated[Path, typer.Option("--output", "-o", help="Plan file to write (.mcap).")] = Path("plan.mcap"),
-    robot: Annotated[Path | None, typer.Option(help="Robot config: a moveplan.yaml or a folder holding one.")] = None,
+    robot: Annotated[Path | None, typer.Option(help=_ROBOT_HELP)] = None,
     scene: Annotated[Path | None, typer.Option(
         help="Scene file: frames and collision objects, or a MoveIt PlanningScene YAML.")] = None,
     motion_request: Annotated[Path | None, typer.Option(
@@ -84,8 +96,11 @@ def plan(
     seed: Annotated[int | None, typer.Option(min=0, max=MAX_SEED, help="Random seed: same seed, same plan.")] = None,
     velocity_scaling: Annotated[str | None, typer.Option(help="Velocity limits' fraction, in [0.001, 1].")] = None,
     acceleration_scaling: Annotated[str | None, typer.Option(help="Acceleration limits' fraction, [0.001, 1].")] = None,
-    package_path: Annotated[list[Path] | None, typer.Option(help="Folder searched for package:// URIs.")] = None,
-    xacro_arg: Annotated[list[str] | None, typer.Option(help="xacro argument name:=value; repeatable.")] = None,
+    package_path: PackagePathOpt = None,
+    xacro_arg: XacroArgOpt = None,
+    urdf: UrdfOpt = None,
+    srdf: SrdfOpt = None,
+    strict_limits: StrictLimitsOpt = False,
     ros_distro: Annotated[str, typer.Option(help="Message layout to write: jazzy or humble.")] = "jazzy",
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
@@ -95,7 +110,7 @@ def plan(
     _logging(verbose, quiet)
     with exit_codes(as_json):
         check_outputs({"-o": output}, {"TASK": task, "--robot": robot, "--scene": scene, "--request": motion_request,
-                                       "--start-from": start_from})
+                                       "--start-from": start_from, **description_inputs(urdf, srdf)})
         flags = _plan_flags(locals())
         from moveplan.cli import render
         from moveplan.core.pipeline.plan import plan_to_file
@@ -122,7 +137,8 @@ def _plan_flags(args: dict[str, Any]) -> PlanFlags:
         linear=args["linear"], min_fraction=number("min_fraction"), planner=args["planner"],
         planning_time=number("planning_time"), seed=args["seed"], velocity_scaling=number("velocity_scaling"),
         acceleration_scaling=number("acceleration_scaling"), package_paths=tuple(args["package_path"] or ()),
-        xacro_args=parse_xacro_args(args["xacro_arg"] or ()),
+        xacro_args=parse_xacro_args(args["xacro_arg"] or ()), urdf=args["urdf"], srdf=args["srdf"],
+        strict_limits=args["strict_limits"],
     )
 
 
@@ -203,10 +219,12 @@ def check_tolerances(
 
 @app.command("robot")
 def robot_info(
-    config: Annotated[Path, typer.Argument(
-        help="Robot config: a moveplan.yaml or its folder, a MoveIt config package, or a shipped name.")],
-    package_path: Annotated[list[Path] | None, typer.Option(help="Folder searched for packages.")] = None,
-    xacro_arg: Annotated[list[str] | None, typer.Option(help="xacro argument name:=value; repeatable.")] = None,
+    config: Annotated[Path, typer.Argument(help=_ROBOT_HELP)],
+    package_path: PackagePathOpt = None,
+    xacro_arg: XacroArgOpt = None,
+    urdf: UrdfOpt = None,
+    srdf: SrdfOpt = None,
+    strict_limits: StrictLimitsOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
 ) -> None:
@@ -214,10 +232,8 @@ def robot_info(
     _logging(False, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render
-        from moveplan.core.config import load_robot_config
-        from moveplan.core.config.xacro import parse_xacro_args
 
-        loaded = load_robot_config(config, tuple(package_path or ()), parse_xacro_args(xacro_arg or ()))
+        loaded = _robot_source(config, package_path, xacro_arg, urdf, srdf, strict_limits).load()
         loaded.collision_meshes()  # a missing mesh is reported here too, not only when planning
     render.robot_summary(loaded, as_json, quiet)
 
@@ -242,7 +258,7 @@ def inspect(
 def benchmark(
     problems: Annotated[list[Path], typer.Argument(
         help="Folders of sceneNNNN.yaml/requestNNNN.yaml pairs (searched recursively), or task files.")],
-    robot: Annotated[Path, typer.Option(help="Robot config the problems are for.")],
+    robot: Annotated[Path, typer.Option(help="Robot config the problems are for (as plan's --robot).")],
     planner: Annotated[list[str] | None, typer.Option(
         help="OMPL planner; repeatable or comma-separated (default: the config's).")] = None,
     seeds: Annotated[str, typer.Option(help="Seeds: '0-4' or '0,3,7'.")] = "0",
@@ -251,6 +267,11 @@ def benchmark(
     jobs: Annotated[int, typer.Option(min=1, help="Planner/seed processes run at a time (1: cleanest times).")] = 1,
     csv: Annotated[Path | None, typer.Option(help="Write one CSV row per run here.")] = None,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG of the time distributions here.")] = None,
+    package_path: PackagePathOpt = None,
+    xacro_arg: XacroArgOpt = None,
+    urdf: UrdfOpt = None,
+    srdf: SrdfOpt = None,
+    strict_limits: StrictLimitsOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
 ) -> None:
@@ -258,23 +279,35 @@ def benchmark(
     _logging(False, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render
-        from moveplan.core.config import load_robot_config
         from moveplan.core.pipeline import benchmark as bench
         from moveplan.core.pipeline.request import check_planning_time
 
-        check_outputs({"--csv": csv, "--plot": plot}, {"PROBLEMS": problems, "--robot": robot})
+        check_outputs({"--csv": csv, "--plot": plot},
+                      {"PROBLEMS": problems, "--robot": robot, **description_inputs(urdf, srdf)})
         seed_list = parse_seeds(seeds)
         time_s = check_planning_time(parse_number(planning_time, "--planning-time"))
         found = bench.find_problems(problems, count)
-        config = load_robot_config(robot)
+        source = _robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits)
+        config = source.load()
         planners = [p.strip() for text in planner or [config.planning["planner"]] for p in text.split(",")]
         with render.benchmark_progress(len(found) * len(planners) * len(seed_list), quiet) as advance:
-            runs = bench.run_benchmark(config.root, found, planners, seed_list, time_s, jobs, advance)
+            runs = bench.run_benchmark(source, found, planners, seed_list, time_s, jobs, advance)
         if csv is not None:
             bench.write_csv(runs, csv)
         if plot is not None:
             bench.plot(runs, plot)
     render.benchmark_summary(runs, bench.summarize(runs), as_json, quiet)
+
+
+def _robot_source(
+    robot: Path, package_path: list[Path] | None, xacro_arg: list[str] | None, urdf: str | None, srdf: str | None,
+    strict_limits: bool,
+) -> RobotSource:
+    """Return what loads the robot config: --robot and the flags that complete it, as core's typed value."""
+    from moveplan.core.config.xacro import parse_xacro_args
+    from moveplan.core.pipeline.request import RobotSource
+
+    return RobotSource(robot, tuple(package_path or ()), parse_xacro_args(xacro_arg or ()), urdf, srdf, strict_limits)
 
 
 def main() -> None:

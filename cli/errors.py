@@ -24,7 +24,9 @@ from typer.core import TyperGroup
 
 from moveplan.core.errors import MoveplanError, UsageError
 
-__all__ = ["PIPE_CLOSED", "GuardedGroup", "Interrupted", "check_outputs", "exit_codes", "handle_signals"]
+__all__ = [
+    "PIPE_CLOSED", "GuardedGroup", "Interrupted", "check_outputs", "description_inputs", "exit_codes", "handle_signals",
+]
 
 logger = logging.getLogger("moveplan")
 
@@ -127,6 +129,12 @@ def check_outputs(outputs: Mapping[str, Path | None], inputs: Mapping[str, Path 
         if where in seen:
             raise UsageError(f"{flag} '{path}': is also {seen[where]}; name two different files")
         seen[where] = flag
+
+
+def description_inputs(urdf: str | None, srdf: str | None) -> dict[str, Path]:
+    """Return --urdf and --srdf as inputs for check_outputs: those naming a file (a package:// URI names none yet)."""
+    return {flag: Path(value) for flag, value in (("--urdf", urdf), ("--srdf", srdf))
+            if value is not None and "://" not in value}
 
 
 def _same_file(a: Path, b: Path) -> bool:

@@ -96,6 +96,7 @@ def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
             for n, c in config.controllers.items()
         },
         "initial_positions": config.initial_positions,
+        "initial_sources": config.initial_sources,
         "sources": {k: str(v) for k, v in config.sources.items()},
         "kinematics": config.kinematics,
         "xacro_args": config.xacro_args,
@@ -115,7 +116,7 @@ def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
     for name, lim in config.limits.items():
         joints.add_row(name, f"{lim.lower:.4g}", f"{lim.upper:.4g}", f"{lim.max_velocity:.4g}",
                        f"{lim.max_acceleration:.4g}", lim.source["position"], lim.source["velocity"],
-                       lim.source["acceleration"] or "[red]missing[/red]")
+                       lim.source["acceleration"])
     _console.print(joints)
     for group, states in document["named_states"].items():
         for name, values in states.items():
@@ -126,7 +127,11 @@ def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
     for setting, source in document["sources"].items():
         _console.print(f"{setting} from {source}")
     if document["missing_acceleration"]:
-        _console.print(f"[red]no acceleration limit[/red] for {', '.join(document['missing_acceleration'])}")
+        from moveplan.core.config.limits import DEFAULT_ACCELERATION
+
+        _console.print(f"[yellow]no acceleration limit in the config[/yellow] for "
+                       f"{', '.join(document['missing_acceleration'])}: plans use the default "
+                       f"{DEFAULT_ACCELERATION:g} rad/s^2 (m/s^2 for prismatic joints)")
 
 
 def inspect_summary(inspection: Inspection, as_json: bool, quiet: bool) -> None:

@@ -150,11 +150,12 @@ class OutsideLimits(NoPlan):
 
     what = "value"
 
-    def __init__(self, joint: str, value: float, lower: float, upper: float) -> None:
+    def __init__(self, joint: str, value: float, lower: float, upper: float, origin: str = "") -> None:
         self.joint, self.value, self.lower, self.upper = joint, value, lower, upper
+        where = f"; the value comes from {origin}" if origin else ""
         super().__init__(
             f"{self.what} for joint '{joint}' is {value:.6g} rad, outside its limits "
-            f"[{lower:.6g}, {upper:.6g}]"
+            f"[{lower:.6g}, {upper:.6g}]{where}"
         )
 
 

@@ -162,10 +162,10 @@ def test_kinematics_yaml_is_read_and_its_groups_checked(tmp_path: Path) -> None:
         load_robot_config(tmp_path)
 
 
-def test_missing_acceleration_limits_are_listed_by_joint(tmp_path: Path) -> None:
+def test_missing_acceleration_limits_are_listed_by_joint_and_take_the_default(tmp_path: Path) -> None:
     config = load_robot_config(plain(tmp_path))
     assert config.missing_acceleration_limits() == ("j1",)
-    assert config.limits["j1"].source["acceleration"] == ""
+    assert config.limits["j1"].source["acceleration"] == "default" and config.limits["j1"].max_acceleration == 1.0
 
 
 # --- packages ---------------------------------------------------------------------------------
@@ -276,7 +276,8 @@ def test_robot_command_shows_the_panda_by_name(cli: Cli) -> None:
     code, document = cli.json("robot", "panda")
     assert code == 0, document
     assert list(document["groups"]) == ["panda_arm", "hand", "panda_arm_hand"]
-    assert document["joints"]["panda_finger_joint1"]["max_acceleration"] is None
+    finger = document["joints"]["panda_finger_joint1"]
+    assert finger["max_acceleration"] == 1.0 and finger["source"]["acceleration"] == "default"
     assert document["named_states"]["panda_arm"]["ready"][3] == -2.356
 
 

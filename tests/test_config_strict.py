@@ -200,10 +200,10 @@ def test_real_world_controller_files_load(name: str) -> None:
     assert all(c.joints for c in controllers.values())
 
 
-def test_ur_driver_controllers_keep_the_tf_prefix_substitution_in_joint_names() -> None:
+def test_ur_driver_controllers_substitute_the_tf_prefix_in_joint_names() -> None:
     path = REALWORLD / "Universal_Robots_ROS2_Driver/ur_robot_driver/config/ur_controllers.yaml"
     controller = parse_controllers(path)["joint_trajectory_controller"]
-    assert controller.trajectory_tolerance["$(var tf_prefix)elbow_joint"] == 0.2
+    assert controller.trajectory_tolerance["elbow_joint"] == 0.2
 
 
 # --- YAML booleans --------------------------------------------------------------------------------

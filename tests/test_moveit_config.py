@@ -194,7 +194,7 @@ def test_a_xacro_error_through_the_cli_is_one_line_with_exit_3(cli: Cli, copied:
     assert result.stderr.count("\n") == 1 and "ur10e_macro.xacro" in result.stderr and "d7" in result.stderr
 
 
-def test_without_acceleration_limits_robot_shows_them_missing_and_plan_names_the_joints(
+def test_without_acceleration_limits_robot_shows_the_default_and_strict_limits_refuse(
     cli: Cli, copied: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     limits = copied / PACKAGE.name / "config" / "joint_limits.yaml"
@@ -202,10 +202,15 @@ def test_without_acceleration_limits_robot_shows_them_missing_and_plan_names_the
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(copied))
     code, document = cli.json("robot", copied / PACKAGE.name)
     assert code == 0
-    assert all(joint["max_acceleration"] is None for joint in document["joints"].values())
+    assert all(j["max_acceleration"] == 1.0 and j["source"]["acceleration"] == "default"
+               for j in document["joints"].values())
     result = cli("plan", "--robot", copied / PACKAGE.name, "--named", "home", "-o", copied / "o.mcap")
+    assert result.exit_code == 0, result.stderr
+    result = cli("plan", "--robot", copied / PACKAGE.name, "--named", "home", "--strict-limits",
+                 "-o", copied / "s.mcap")
     assert result.exit_code == 3, result.stderr
     assert "no acceleration limit for joints shoulder_pan_joint, shoulder_lift_joint, elbow_joint" in result.stderr
+    assert not (copied / "s.mcap").exists()
 
 
 def test_xacro_arg_flags_reach_the_robot_and_plan_commands(cli: Cli, tmp_path: Path) -> None:

@@ -363,7 +363,7 @@ def _start_with(names: list[str]) -> dict[str, Any]:
      "{file}: path_constraints: not supported"),
     (request_with(goal_constraint=[]), "{file}: unknown key 'goal_constraint'"),
     (request_with(start_state={"attached_collision_objects": [{"link_name": "panda_hand"}]}),
-     "{file}: start_state.attached_collision_objects: not supported in a request"),
+     "{file}: start_state.attached_collision_objects[0].object.id: expected an object name, got None"),
 ])
 def test_bad_motion_plan_request_exits_3_naming_file_and_key(
     cli: Cli, tmp_path: Path, content: Any, message: str

@@ -5,16 +5,22 @@ JointTrajectoryController's parameters, `constraints` and `gains` accept what so
 ROS 2 release of it declares, so a typo (`trajectroy`, read by ROS as an undeclared
 parameter and ignored) is an error rather than a tolerance of 0, "not checked". The
 other controllers of the file (broadcasters, grippers, ...) are not looked at.
+
+Both files may use ROS 2 launch substitutions, as ur_robot_driver's ur_controllers.yaml does
+(`$(var tf_prefix)shoulder_pan_joint`): they are made first, with the launch arguments given
+(substitutions.py), and errors name the file as the user wrote it.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from .fields import boolean, check_keys, load_yaml, mapping, number
+from .fields import boolean, check_keys, mapping, number
+from .substitutions import load_substituted_yaml
 
 __all__ = ["MAX_UPDATE_RATE_HZ", "ControllerConfig", "ExecutionConfig", "parse_controllers", "parse_execution"]
 
@@ -75,14 +81,19 @@ class ExecutionConfig:
     execution_duration_monitoring: bool = True
 
 
-def parse_controllers(path: Path) -> dict[str, ControllerConfig]:
+def parse_controllers(path: Path, launch_args: Mapping[str, str] | None = None) -> dict[str, ControllerConfig]:
     """Return the JointTrajectoryControllers configured in a ros2_controllers.yaml, by name.
+
+    Args:
+        path: The file.
+        launch_args: Values of its `$(var NAME)` substitutions (the xacro args in force).
 
     Raises:
         ConfigError: A malformed value, or an unknown key in a JointTrajectoryController's
-            parameters, `constraints` or `gains`; names the file and the key path.
+            parameters, `constraints` or `gains`; names the file and the key path. An
+            unsupported or malformed substitution; names the file, line and substitution.
     """
-    top = mapping(load_yaml(path), str(path))
+    top = mapping(load_substituted_yaml(path, launch_args), str(path))
     manager = _ros_parameters(top, "controller_manager", path)
     where = f"{path}: controller_manager.ros__parameters.update_rate"
     rate = number(manager.get("update_rate", 100), where, positive=True)
@@ -99,9 +110,12 @@ def parse_controllers(path: Path) -> dict[str, ControllerConfig]:
     return controllers
 
 
-def parse_execution(path: Path) -> ExecutionConfig:
-    """Return moveit_controllers.yaml's trajectory_execution settings, MoveIt's defaults where absent."""
-    top = mapping(load_yaml(path), str(path))
+def parse_execution(path: Path, launch_args: Mapping[str, str] | None = None) -> ExecutionConfig:
+    """Return moveit_controllers.yaml's trajectory_execution settings, MoveIt's defaults where absent.
+
+    `launch_args` are the values of its `$(var NAME)` substitutions, as for parse_controllers.
+    """
+    top = mapping(load_substituted_yaml(path, launch_args), str(path))
     section = mapping(top.get("trajectory_execution"), f"{path}: trajectory_execution")
     defaults = ExecutionConfig()
     where = f"{path}: trajectory_execution"

@@ -10,22 +10,19 @@ from ..errors import ConfigError, UsageError, known
 from .fields import mapping
 from .xacro import PackagePath, process_xacro
 
-__all__ = ["check_xacro_args", "expand", "resolve_xacro_args"]
+__all__ = ["check_xacro_args", "expand", "file_xacro_args"]
 
 
-def resolve_xacro_args(
-    manifest: Path | None, top: dict[str, Any], flags: Mapping[str, str]
-) -> tuple[dict[str, str], frozenset[str]]:
-    """Return the xacro args in force (flag > moveplan.yaml) and the names set by flag."""
+def file_xacro_args(source: Path, values: Any) -> dict[str, str]:
+    """Return a file's `xacro_args` mapping (moveplan.yaml) as name -> text, booleans as xacro writes them."""
     args: dict[str, str] = {}
-    for key, value in mapping(top.get("xacro_args"), f"{manifest}: xacro_args").items():
+    for key, value in mapping(values, f"{source}: xacro_args").items():
         if isinstance(value, bool):
             value = "true" if value else "false"
         if not isinstance(value, str | int | float):
-            raise ConfigError(f"{manifest}: xacro_args.{key}: expected a string or number, got {value!r}")
+            raise ConfigError(f"{source}: xacro_args.{key}: expected a string or number, got {value!r}")
         args[key] = str(value)
-    args.update(flags)
-    return args, frozenset(flags)
+    return args
 
 
 def expand(
@@ -43,9 +40,13 @@ def expand(
 
 
 def check_xacro_args(
-    args: Mapping[str, str], flags: frozenset[str], declared: frozenset[str], urdf: Path, manifest: Path | None
+    args: Mapping[str, str], flags: frozenset[str], declared: frozenset[str], urdf: Path, source: Path | None
 ) -> None:
-    """Raise for a xacro arg no xacro file declares (a typo must not pass silently)."""
+    """Raise for a xacro arg no xacro file declares (a typo must not pass silently).
+
+    An arg set by flag is a UsageError; one from a file (`source`: moveplan.yaml or
+    .setup_assistant) a ConfigError naming that file.
+    """
     for name in args:
         if name in declared:
             continue
@@ -54,4 +55,4 @@ def check_xacro_args(
             what = f"xacro arg '{name}' given, but {urdf} is not a .xacro file"
         if name in flags:
             raise UsageError(f"--xacro-arg {name}: {what}")
-        raise ConfigError(f"{manifest}: xacro_args: {what}")
+        raise ConfigError(f"{source}: xacro_args: {what}")

@@ -33,7 +33,9 @@ def embedded_files(
         written = {k: str(top[k]) for k in embed}
         if all("://" not in v and (root / v).resolve().is_relative_to(root.resolve()) for v in written.values()):
             files = {CONFIG_FILE: manifest.read_bytes()}
-            files.update({written[k]: paths[k].read_bytes() for k in embed})
+            # Controller files go in substituted (texts); the rest as they are.
+            files.update({written[k]: texts[k].encode("utf-8") if k in texts and k not in ("urdf", "srdf")
+                          else paths[k].read_bytes() for k in embed})
             return files
     files = {}
     generated: dict[str, Any] = {"name": name}

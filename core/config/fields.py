@@ -5,6 +5,7 @@ Shared by every parser of a configuration file: robot config, scene, task and Mo
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from collections.abc import Mapping
@@ -15,9 +16,14 @@ import yaml
 
 from ..errors import ConfigError, known
 
+try:
+    from yaml.cyaml import CParser as _CParser  # libyaml's parser, where PyYAML has it
+except ImportError:  # a PyYAML built without libyaml
+    _CParser = None
+
 __all__ = [
-    "MAX_ALIAS_EXPANSION", "MAX_MAGNITUDE", "boolean", "check_keys", "coordinate", "load_yaml", "mapping", "number",
-    "string_list",
+    "MAX_ALIAS_EXPANSION", "MAX_MAGNITUDE", "MAX_YAML_BYTES", "MAX_YAML_EVENTS", "boolean", "check_keys", "coordinate",
+    "load_yaml", "mapping", "number", "parse_yaml", "string_list",
 ]
 
 
@@ -28,6 +34,14 @@ radians, a thousand kilometres, eleven days. Beyond it, a typo (1e308) must not 
 MAX_ALIAS_EXPANSION = 100_000
 """Values YAML aliases may add to a file once expanded: ROS files reuse a joint list or a block of
 gains a few times; a "billion laughs" file adds billions (docs/formats.md, Limits)."""
+
+MAX_YAML_BYTES = 64 * 1024 * 1024
+"""Size of a YAML file moveplan reads: a MotionBenchMaker scene is ~10 kB, a 10,000-shape scene ~2 MB."""
+
+MAX_YAML_EVENTS = 3_000_000
+"""Parse events a YAML file may hold (one per value, two per list or mapping): a 10,000-shape scene
+has ~350,000, a 100,000-triangle inline mesh ~1,300,000. Counted before the file is built into Python
+values, which costs ~50 times more: a 200,000-shape scene is refused in a second, not in a minute."""
 
 # ROS 2 reads a parameter as a double when strtod accepts it, and yaml-cpp (MoveIt's scenes and requests)
 # likewise: `1.0e9`, `1e9` and `1e-3` are numbers there, strings to YAML 1.1's float pattern.
@@ -47,24 +61,46 @@ _Loader.add_implicit_resolver("tag:yaml.org,2002:float", _ROS_FLOAT, list("-+012
 def load_yaml(path: Path) -> Any:
     """Return the parsed content of a YAML file; ConfigError names the file and line.
 
-    Aliases may add at most MAX_ALIAS_EXPANSION values to the document (and may not contain
-    themselves), so that no reader of the result walks a billion shared copies.
+    A file larger than MAX_YAML_BYTES, or with more than MAX_YAML_EVENTS parse events, is refused
+    before its values are built. Aliases may add at most MAX_ALIAS_EXPANSION values to the
+    document (and may not contain themselves), so that no reader of the result walks a billion
+    shared copies.
     """
     try:
+        size = path.stat().st_size
+        if size > MAX_YAML_BYTES:
+            raise ConfigError(f"{path}: {size:,} bytes; moveplan reads YAML files of at most {MAX_YAML_BYTES:,} bytes")
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ConfigError(f"{path}: file not found") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(f"{path}: cannot read: {exc}") from None
+    return parse_yaml(text, path)
+
+
+def parse_yaml(text: str, path: Path, after: str = "") -> Any:
+    """Return YAML `text` parsed under load_yaml's limits; ConfigError names `path`, the line and `after`."""
     try:
+        events = _count_events(text)
+        if events > MAX_YAML_EVENTS:
+            raise ConfigError(f"{path}: more than {MAX_YAML_EVENTS:,} YAML values (lists and mappings count twice); "
+                              "moveplan reads at most that many per file (a 10,000-shape scene has ~350,000)")
         content = yaml.load(text, Loader=_Loader)  # noqa: S506 - a safe loader
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" line {mark.line + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise ConfigError(f"{path}:{where} malformed YAML: {problem}") from None
+        raise ConfigError(f"{path}:{where} malformed YAML{after}: {problem}") from None
     _check_aliases(content, path)
     return content
+
+
+def _count_events(text: str) -> int:
+    """Return the parse events of `text`, building no value (without libyaml, counted up to MAX_YAML_EVENTS + 1)."""
+    if _CParser is not None:
+        # libyaml counts the events in C, creating no Python object: ~40 MB/s.
+        return int(_CParser(text).raw_parse())
+    return sum(1 for _ in itertools.islice(yaml.parse(text, Loader=_Loader), MAX_YAML_EVENTS + 1))
 
 
 def _check_aliases(content: Any, path: Path) -> None:

@@ -2,16 +2,30 @@
 
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ..errors import ConfigError, UnknownName
+from ..errors import ConfigError
 from .fields import boolean, check_keys, load_yaml, mapping, number
 from .urdf import MOVABLE_JOINT_TYPES, UrdfJoint
 
-__all__ = ["JointLimit", "merge_limits", "parse_joint_limits"]
+__all__ = ["DEFAULT_ACCELERATION", "DEFAULT_SOURCE", "JointLimit", "merge_limits", "parse_joint_limits"]
+
+logger = logging.getLogger(__name__)
+
+DEFAULT_ACCELERATION = 1.0
+"""Acceleration limit in [rad]/[s]^2 (or [m]/[s]^2) of a joint the config gives none.
+
+MoveIt 1's (IterativeParabolicTimeParameterization's DEFAULT_ACCEL_MAX): conservative, as arms
+publish a few [rad]/[s]^2 (the Panda 1.9 to 5, UR's MoveIt configs 5 to 10). MoveIt 2 Jazzy
+refuses to time such a joint; so does merge_limits with `strict`.
+"""
+
+DEFAULT_SOURCE = "default"
+"""JointLimit.source value of a limit no file gives (DEFAULT_ACCELERATION)."""
 
 # ros2_control joint_limits_rosparam.hpp's keys, and MoveIt's angle_wraparound.
 _LIMIT_KEYS = {
@@ -27,7 +41,11 @@ _DEFAULT_SCALING = 0.1  # MoveIt's default_{velocity,acceleration}_scaling_facto
 
 @dataclass(frozen=True)
 class JointLimit:
-    """Merged limits of one joint in [rad] (or [m]), [rad]/[s], [rad]/[s]^2, with their sources."""
+    """Merged limits of one joint in [rad] (or [m]), [rad]/[s], [rad]/[s]^2, with their sources.
+
+    `source` maps position, velocity and acceleration to the name of the file the limit comes
+    from, or DEFAULT_SOURCE for an acceleration limit no file gives.
+    """
 
     lower: float
     upper: float
@@ -67,36 +85,57 @@ def merge_limits(
     joints: dict[str, UrdfJoint],
     limits_path: Path | None,
     overrides: dict[str, dict[str, Any]],
+    strict: bool = False,
 ) -> dict[str, JointLimit]:
-    """Return the limits of every movable URDF joint: the URDF's, overridden where joint_limits.yaml says so."""
+    """Return the limits of every movable URDF joint: the URDF's, overridden where joint_limits.yaml says so.
+
+    As MoveIt, joint_limits.yaml is read for the URDF's joints only: an entry for another joint
+    (a file shared by several robots) is ignored, logged at debug level. A joint without an
+    acceleration limit (`has_acceleration_limits: false`, the Setup Assistant's default, or no
+    entry) gets DEFAULT_ACCELERATION, its source DEFAULT_SOURCE; planning warns about the ones it
+    times (pipeline/plan.py).
+
+    Raises:
+        ConfigError: A malformed entry or lower limit above upper; with `strict`, a joint
+            without an acceleration limit, mimic joints aside (names the joints and the file).
+    """
     for joint in overrides:
         if joint not in joints:
-            raise UnknownName("joint", joint, f"{limits_path}: joint_limits", joints)
-    limits: dict[str, JointLimit] = {}
-    for joint in joints.values():
-        if joint.type not in MOVABLE_JOINT_TYPES:
-            continue
-        continuous = joint.type == "continuous"
-        lower, upper = (-math.pi, math.pi) if continuous else (joint.lower, joint.upper)
-        velocity, acceleration = joint.velocity, math.nan
-        urdf_name, file_name = urdf_path.name, limits_path.name if limits_path else ""
-        source = {"position": urdf_name, "velocity": urdf_name, "acceleration": ""}
-        entry = overrides.get(joint.name, {})
-        where = f"{limits_path}: joint_limits.{joint.name}"
-        if _flag(entry, "has_position_limits", where) and not continuous:
-            lower = number(entry.get("min_position", lower), f"{where}.min_position")
-            upper = number(entry.get("max_position", upper), f"{where}.max_position")
-            source["position"] = file_name
-        if _flag(entry, "has_velocity_limits", where):
-            velocity = number(entry.get("max_velocity"), f"{where}.max_velocity", positive=True)
-            source["velocity"] = file_name
-        if _flag(entry, "has_acceleration_limits", where):
-            acceleration = number(entry.get("max_acceleration"), f"{where}.max_acceleration", positive=True)
-            source["acceleration"] = file_name
-        if not lower <= upper:
-            raise ConfigError(f"{urdf_path}: joint '{joint.name}': lower limit {lower} above upper {upper}")
-        limits[joint.name] = JointLimit(lower, upper, velocity, acceleration, continuous, source)
+            logger.debug("%s: joint_limits.%s: no such joint in %s; ignored", limits_path, joint, urdf_path.name)
+    limits = {
+        joint.name: _merged(joint, urdf_path, limits_path, overrides.get(joint.name, {}))
+        for joint in joints.values() if joint.type in MOVABLE_JOINT_TYPES
+    }
+    # A mimic joint follows its leader: MoveIt times only the leader, so only the leader needs a limit.
+    defaulted = [j for j, lim in limits.items() if lim.source["acceleration"] == DEFAULT_SOURCE and not joints[j].mimic]
+    if strict and defaulted:
+        raise ConfigError(f"{limits_path or urdf_path}: no acceleration limit for joints {', '.join(defaulted)} "
+                          "(joint_limits.yaml: has_acceleration_limits: true, max_acceleration); without "
+                          f"--strict-limits they plan with the default {DEFAULT_ACCELERATION:g} rad/s^2")
     return limits
+
+
+def _merged(joint: UrdfJoint, urdf_path: Path, limits_path: Path | None, entry: dict[str, Any]) -> JointLimit:
+    """Return one joint's limits: the URDF's, overridden by its joint_limits.yaml `entry`."""
+    continuous = joint.type == "continuous"
+    lower, upper = (-math.pi, math.pi) if continuous else (joint.lower, joint.upper)
+    velocity, acceleration = joint.velocity, DEFAULT_ACCELERATION
+    urdf_name, file_name = urdf_path.name, limits_path.name if limits_path else ""
+    source = {"position": urdf_name, "velocity": urdf_name, "acceleration": DEFAULT_SOURCE}
+    where = f"{limits_path}: joint_limits.{joint.name}"
+    if _flag(entry, "has_position_limits", where) and not continuous:
+        lower = number(entry.get("min_position", lower), f"{where}.min_position")
+        upper = number(entry.get("max_position", upper), f"{where}.max_position")
+        source["position"] = file_name
+    if _flag(entry, "has_velocity_limits", where):
+        velocity = number(entry.get("max_velocity"), f"{where}.max_velocity", positive=True)
+        source["velocity"] = file_name
+    if _flag(entry, "has_acceleration_limits", where):
+        acceleration = number(entry.get("max_acceleration"), f"{where}.max_acceleration", positive=True)
+        source["acceleration"] = file_name
+    if not lower <= upper:
+        raise ConfigError(f"{urdf_path}: joint '{joint.name}': lower limit {lower} above upper {upper}")
+    return JointLimit(lower, upper, velocity, acceleration, continuous, source)
 
 
 def _flag(entry: dict[str, Any], key: str, where: str) -> bool:

@@ -9,7 +9,6 @@ a plan embeds (embed.py). Every error names the file and key path.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,12 +16,23 @@ from typing import Any
 
 from ..errors import UnknownName
 from .controllers import ControllerConfig, ExecutionConfig, parse_controllers, parse_execution
-from .descriptions import check_xacro_args, expand, resolve_xacro_args
+from .descriptions import check_xacro_args, expand, file_xacro_args
 from .embed import embedded_files
-from .limits import JointLimit, merge_limits, parse_joint_limits
-from .settings import parse_initial_positions, parse_kinematics, planning_defaults
-from .sources import discover, manifest_files, read_manifest, resolve_config_path, search_path
+from .initial_state import initial_state
+from .limits import DEFAULT_SOURCE, JointLimit, merge_limits, parse_joint_limits
+from .settings import parse_kinematics, planning_defaults
+from .sources import (
+    discover,
+    discover_beside,
+    flag_file,
+    manifest_files,
+    read_manifest,
+    resolve_config_path,
+    robot_file_kind,
+    search_path,
+)
 from .srdf import Group, Srdf, parse_srdf
+from .substitutions import read_substituted
 from .urdf import CollisionMesh, UrdfJoint, parse_urdf, resolve_collision_meshes
 from .xacro import PackagePath
 
@@ -39,11 +49,14 @@ class RobotConfig:
         urdf_path: URDF file; `urdf` its text.
         urdf_joints: URDF joints by name, in file order.
         srdf: Parsed SRDF; `srdf_path` its file.
-        limits: Merged limits of every movable URDF joint.
+        limits: Merged limits of every movable URDF joint; an acceleration limit the config
+            does not give is limits.DEFAULT_ACCELERATION, its source limits.DEFAULT_SOURCE.
         default_velocity_scaling, default_acceleration_scaling: From joint_limits.yaml (MoveIt: 0.1).
         controllers: JointTrajectoryControllers from ros2_controllers.yaml.
         execution: MoveIt's trajectory_execution settings.
-        initial_positions: Where the fake hardware starts (joint -> value).
+        initial_positions: Where every movable joint starts when no start is given (joint ->
+            value): the URDF's <ros2_control> initial values (where mock hardware starts), else
+            initial_positions.yaml, else MoveIt's default state (initial_state.py).
         planning: moveplan.yaml `planning` defaults: group, planner, planning_time, and
             collision (`exact`: the URDF's meshes; `convex`: their convex hulls).
         files: File name -> bytes of every config file, to embed in plan files; laid out in
@@ -55,6 +68,7 @@ class RobotConfig:
         urdf_includes: Every file the URDF was made of (the .urdf, or the xacro and its includes).
         kinematics: kinematics.yaml's settings per group (reported; moveplan solves IK itself).
         xacro_args: The xacro args the URDF and SRDF were expanded with.
+        initial_sources: Joint -> where its initial position comes from (initial_state.py).
     """
 
     name: str
@@ -77,6 +91,7 @@ class RobotConfig:
     urdf_includes: tuple[Path, ...] = ()
     kinematics: dict[str, dict[str, Any]] = field(default_factory=dict)
     xacro_args: dict[str, str] = field(default_factory=dict)
+    initial_sources: dict[str, str] = field(default_factory=dict)
 
     def group(self, name: str | None = None) -> Group:
         """Return the named planning group, or the config's default one."""
@@ -86,8 +101,12 @@ class RobotConfig:
         return self.srdf.groups[name]
 
     def missing_acceleration_limits(self, group: str | None = None) -> tuple[str, ...]:
-        """Return the group's joints without an acceleration limit (planning needs one for each)."""
-        return tuple(j for j in self.group(group).joints if math.isnan(self.limits[j].max_acceleration))
+        """Return the group's joints the config gives no acceleration limit (they plan with the default).
+
+        Mimic joints are left out: MoveIt times the joint they follow.
+        """
+        return tuple(j for j in self.group(group).joints
+                     if self.limits[j].source["acceleration"] == DEFAULT_SOURCE and not self.urdf_joints[j].mimic)
 
     def collision_meshes(self) -> tuple[CollisionMesh, ...]:
         """Return every collision mesh of the URDF with the file it resolves to.
@@ -112,6 +131,8 @@ class _Located:
     top: dict[str, Any]
     packages: PackagePath
     paths: dict[str, Path]
+    xacro_args: dict[str, str] = field(default_factory=dict)  # from moveplan.yaml or .setup_assistant
+    xacro_source: Path | None = None  # the file that gave them
 
 
 @dataclass(frozen=True)
@@ -130,34 +151,48 @@ def load_robot_config(
     robot: str | Path,
     package_paths: Sequence[Path] = (),
     xacro_args: Mapping[str, str] | None = None,
+    urdf: str | None = None,
+    srdf: str | None = None,
+    strict_limits: bool = False,
 ) -> RobotConfig:
     """Return the parsed robot config at `robot`.
 
     Args:
         robot: A moveplan.yaml, a folder holding one, a MoveIt config package folder, a plain
-            folder with a URDF and an SRDF, or the name of a shipped config.
+            folder with a URDF and an SRDF, a URDF or SRDF file (the other one found beside
+            it), or the name of a shipped config (core/config/sources.py has the rules).
         package_paths: --package-path folders, searched for `$(find pkg)` and `package://`
-            after the config folder and before ROS_PACKAGE_PATH.
-        xacro_args: --xacro-arg values; they override moveplan.yaml's `xacro_args`.
+            after the config folder and before the enclosing workspace and ROS_PACKAGE_PATH.
+        xacro_args: --xacro-arg values; they override moveplan.yaml's or .setup_assistant's `xacro_args`.
+        urdf: --urdf, a file or `package://pkg/path`: the URDF, whatever the config names.
+        srdf: --srdf, likewise the SRDF.
+        strict_limits: --strict-limits: a joint without an acceleration limit is an error
+            instead of planning with the documented default.
 
     Raises:
-        ConfigError: A file is missing or malformed; the message names file and key.
+        ConfigError: A file is missing or malformed, or the files are ambiguous; the message
+            names file and key, or the files and the flag that settles it.
         UsageError: A --xacro-arg the xacro files do not declare.
     """
-    found = _locate(robot, package_paths)
+    found = _locate(robot, package_paths, urdf, srdf)
     paths = found.paths
     model = _read_model(found, xacro_args or {})
     limit_overrides, v_scale, a_scale = parse_joint_limits(paths.get("joint_limits"))
-    limits = merge_limits(paths["urdf"], model.urdf_joints, paths.get("joint_limits"), limit_overrides)
-    controllers = parse_controllers(paths["controllers"]) if "controllers" in paths else {}
-    execution = parse_execution(paths["moveit_controllers"]) if "moveit_controllers" in paths else ExecutionConfig()
-    initial = parse_initial_positions(paths["initial_positions"], limits) if "initial_positions" in paths else {}
+    limits = merge_limits(paths["urdf"], model.urdf_joints, paths.get("joint_limits"), limit_overrides,
+                          strict=strict_limits)
+    controllers = parse_controllers(paths["controllers"], model.xacro_args) if "controllers" in paths else {}
+    execution = (parse_execution(paths["moveit_controllers"], model.xacro_args)
+                 if "moveit_controllers" in paths else ExecutionConfig())
+    initial = initial_state(model.urdf_text, paths["urdf"], model.urdf_joints, limits, paths.get("initial_positions"))
     kinematics = parse_kinematics(paths["kinematics"], model.srdf) if "kinematics" in paths else {}
     planning, planning_source = planning_defaults(
         found.manifest, found.top, paths.get("ompl_planning"), model.srdf, paths["srdf"]
     )
     name = str(found.top.get("name") or model.srdf.name)
     texts = {"urdf": model.urdf_text, "srdf": model.srdf_text}
+    # A plan carries controller files with their launch substitutions made: execute reads them without args.
+    texts.update({key: read_substituted(paths[key], model.xacro_args) for key in ("controllers", "moveit_controllers")
+                  if key in paths and b"$(" in paths[key].read_bytes()})
     config = RobotConfig(
         name=name,
         root=found.root,
@@ -171,7 +206,7 @@ def load_robot_config(
         default_acceleration_scaling=a_scale,
         controllers=controllers,
         execution=execution,
-        initial_positions=initial,
+        initial_positions=initial.positions,
         planning=planning,
         files=embedded_files(found.manifest, found.top, found.root, paths, texts, name, planning),
         package_paths=found.packages.folders,
@@ -179,32 +214,42 @@ def load_robot_config(
         urdf_includes=model.urdf_includes,
         kinematics=kinematics,
         xacro_args=model.xacro_args,
+        initial_sources=initial.sources,
     )
     config.group()  # an unknown default group is a config error, found at load time
     return config
 
 
-def _locate(robot: str | Path, package_paths: Sequence[Path]) -> _Located:
-    """Return where the config's files are: named by its moveplan.yaml, or found in its folder."""
-    path = resolve_config_path(robot)
-    manifest = path if path.is_file() else None
-    root = path.parent if manifest else path
+def _locate(robot: str | Path, package_paths: Sequence[Path], urdf: str | None, srdf: str | None) -> _Located:
+    """Return where the config's files are: named by its moveplan.yaml, or found in its folder or beside a file."""
+    path = resolve_config_path(robot, srdf_given=srdf is not None)
+    manifest = path if robot_file_kind(path) == "moveplan" else None
+    root = path if path.is_dir() else path.parent
     top: dict[str, Any] = {}
     extra: tuple[Path, ...] = ()
     if manifest is not None:
         top, extra = read_manifest(manifest)
     packages = PackagePath(search_path(root, tuple(package_paths), extra))
-    paths = manifest_files(manifest, top, packages) if manifest else discover(root)
-    return _Located(manifest, root, top, packages, paths)
+    given = {key: flag_file(value, key, packages) for key, value in (("urdf", urdf), ("srdf", srdf)) if value}
+    if manifest is not None:
+        paths = manifest_files(manifest, top, packages, given)
+        # A flag's file replaces moveplan.yaml's, named by URI: a plan then embeds the files as loaded.
+        top = {**top, **{key: file.resolve().as_uri() for key, file in given.items()}}
+        return _Located(manifest, root, top, packages, paths, file_xacro_args(manifest, top.get("xacro_args")),
+                        manifest)
+    found = discover(root, packages, given) if path.is_dir() else discover_beside(path, given)
+    if found.root != root:
+        packages = PackagePath(search_path(found.root, tuple(package_paths)))
+    return _Located(None, found.root, top, packages, found.paths, found.xacro_args, found.xacro_source)
 
 
 def _read_model(found: _Located, flags: Mapping[str, str]) -> _Model:
-    """Return the URDF and SRDF read (through xacro, with flag > moveplan.yaml args) and parsed."""
-    args, flag_args = resolve_xacro_args(found.manifest, found.top, flags)
+    """Return the URDF and SRDF read (through xacro, with flag > moveplan.yaml or .setup_assistant args) and parsed."""
+    args = {**found.xacro_args, **flags}
     urdf_path, srdf_path = found.paths["urdf"], found.paths["srdf"]
     urdf_text, urdf_includes, declared = expand(urdf_path, found.root, args, found.packages)
     srdf_text, _, srdf_declared = expand(srdf_path, found.root, args, found.packages)
-    check_xacro_args(args, flag_args, declared | srdf_declared, urdf_path, found.manifest)
+    check_xacro_args(args, frozenset(flags), declared | srdf_declared, urdf_path, found.xacro_source)
     urdf_joints = parse_urdf(urdf_text, urdf_path)
     srdf = parse_srdf(srdf_text, srdf_path, urdf_joints)
     return _Model(urdf_text, urdf_includes, urdf_joints, srdf_text, srdf, dict(args))

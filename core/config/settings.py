@@ -1,4 +1,4 @@
-"""The settings beside the robot model: planning defaults, kinematics.yaml and initial_positions.yaml."""
+"""The settings beside the robot model: planning defaults and kinematics.yaml."""
 
 from __future__ import annotations
 
@@ -7,10 +7,9 @@ from typing import Any
 
 from ..errors import ConfigError, UnknownName
 from .fields import check_keys, load_yaml, mapping, number
-from .limits import JointLimit
 from .srdf import Srdf
 
-__all__ = ["COLLISION_MODES", "parse_initial_positions", "parse_kinematics", "planning_defaults"]
+__all__ = ["COLLISION_MODES", "parse_kinematics", "planning_defaults"]
 
 COLLISION_MODES = ("exact", "convex")  # robot meshes as triangle BVHs, or as their convex hulls
 _PLANNING_KEYS = {"group", "planner", "planning_time", "collision"}
@@ -80,14 +79,3 @@ def parse_kinematics(path: Path, srdf: Srdf) -> dict[str, dict[str, Any]]:
         result[group] = mapping(entry, f"{path}: {group}")
     return result
 
-
-def parse_initial_positions(path: Path, limits: dict[str, JointLimit]) -> dict[str, float]:
-    """Return initial_positions.yaml's joint -> value, for joints that have limits (the movable ones)."""
-    top = mapping(load_yaml(path), str(path))
-    values = mapping(top.get("initial_positions", top), f"{path}: initial_positions")
-    result = {}
-    for joint, value in values.items():
-        if joint not in limits:
-            raise UnknownName("joint", joint, f"{path}: initial_positions", limits)
-        result[joint] = number(value, f"{path}: initial_positions.{joint}")
-    return result

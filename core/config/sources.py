@@ -1,35 +1,47 @@
-"""Where a robot config's files come from: a --robot argument, a moveplan.yaml, or a folder without one.
+"""Where a robot config's files come from: a --robot argument, a moveplan.yaml, a MoveIt config package, a lone file.
 
 - A moveplan.yaml names them (relative to itself, or `package://pkg/...`); a URDF or
   SRDF ending in .xacro is expanded with its `xacro_args`, overridden by --xacro-arg.
-- A folder without moveplan.yaml is a MoveIt config package (or a plain folder): the
-  SRDF is the one *.srdf(.xacro) in the first of config/, srdf/, the folder that has
-  any; the URDF the one *.urdf(.xacro) in the first of config/, urdf/, the folder
-  (several: the one named like the SRDF); joint_limits.yaml, kinematics.yaml,
-  ros2_controllers.yaml, moveit_controllers.yaml, initial_positions.yaml and
-  ompl_planning.yaml by name, in config/ before the folder. More than one candidate
-  is an error that asks for a moveplan.yaml.
-- `$(find pkg)` and `package://pkg` search, in order: the config folder,
-  moveplan.yaml `package_paths`, --package-path, ROS_PACKAGE_PATH, AMENT_PREFIX_PATH
-  shares, and Python-installed (cmeel) package shares (core/config/xacro.py finds them).
+- A folder without moveplan.yaml is a MoveIt config package (or a plain folder). Its URDF
+  and SRDF are the ones MoveItConfigsBuilder would load (core/config/setup_assistant.py:
+  `config/<robot name>.urdf.xacro`, `.setup_assistant`, `config/<robot name>.srdf`), else
+  the one *.srdf(.xacro) in the first of config/, srdf/, the folder that has any, and the one
+  URDF in the first of config/, urdf/, robots/, the folder (*.urdf(.xacro); in urdf/ and
+  robots/ also *.xacro). Among several candidates, `*_macro*` files and files another
+  candidate includes are not robots; of the rest, the one named like the SRDF or the robot
+  wins. joint_limits.yaml, kinematics.yaml, ros2_controllers.yaml, moveit_controllers.yaml,
+  initial_positions.yaml and ompl_planning.yaml are found by name, in config/ before the folder.
+- A lone URDF (*.urdf, *.urdf.xacro, *.xacro) or SRDF (*.srdf, *.srdf.xacro) goes with the
+  other file of the pair found beside it: the one of the same name, or the only one, in its
+  folder, then ../config and ../srdf (an SRDF) or ../urdf, ../robots and ../config (a URDF).
+- --urdf and --srdf (a file, or `package://pkg/path`) replace what any of these supply.
+- Ambiguity or absence is an error naming the files and the flag that settles it.
+- `$(find pkg)` and `package://pkg` search, in order: the config folder, moveplan.yaml
+  `package_paths`, --package-path, the colcon workspace the config lies in (the nearest
+  ancestor folder named `src`), ROS_PACKAGE_PATH, AMENT_PREFIX_PATH shares, and
+  Python-installed (cmeel) package shares (core/config/xacro.py and workspace.py find them).
 """
 
 from __future__ import annotations
 
 import os
+import re
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from ..errors import ConfigError, known
+from ..errors import ConfigError, UsageError, known
 from .fields import check_keys, load_yaml, mapping, string_list
+from .setup_assistant import SETUP_ASSISTANT_FILE, builder_srdf, builder_urdf, read_setup_assistant, robot_names
+from .workspace import workspace_src
 from .xacro import PackagePath
 
 __all__ = [
-    "CONFIG_FILE", "FILE_KEYS", "discover", "manifest_files", "read_manifest", "resolve_config_path",
-    "search_path", "shipped_configs", "stem",
+    "CONFIG_FILE", "FILE_KEYS", "Discovered", "discover", "discover_beside", "flag_file", "manifest_files",
+    "read_manifest", "resolve_config_path", "robot_file_kind", "search_path", "shipped_configs", "stem",
 ]
 
 CONFIG_FILE = "moveplan.yaml"
@@ -46,15 +58,41 @@ _PACKAGE_FILES = {
     "ompl_planning": "ompl_planning.yaml",
 }
 _SRDF_FOLDERS = ("config", "srdf", ".")
-_URDF_FOLDERS = ("config", "urdf", ".")
+_URDF_FOLDERS = ("config", "urdf", "robots", ".")
+_SRDF_SUFFIXES = (".srdf", ".srdf.xacro")
+_URDF_SUFFIXES = (".urdf", ".urdf.xacro")
+# Description packages keep top-level xacros as robot.xacro in these; elsewhere a bare .xacro is a fragment.
+_XACRO_URDF_FOLDERS = ("urdf", "robots")
+_FLAGS = {"urdf": "--urdf", "srdf": "--srdf"}
+_INCLUDE = re.compile(r"<xacro:include\s[^>]*?filename\s*=\s*[\"']([^\"']+)[\"']")
+_ACCEPTED = ("a moveplan.yaml or a folder holding one, a MoveIt config package folder, a URDF (.urdf, "
+             ".urdf.xacro, .xacro) or SRDF (.srdf, .srdf.xacro) file")
 
 
-def resolve_config_path(robot: str | Path) -> Path:
-    """Return what a --robot argument names: a moveplan.yaml, or a folder to read without one.
+@dataclass(frozen=True)
+class Discovered:
+    """A config's files found without a moveplan.yaml.
+
+    Attributes:
+        root: The config folder (for a lone file: the package it lies in, else its folder).
+        paths: Setting -> file (urdf, srdf, joint_limits, ...).
+        xacro_args: Default xacro args from `.setup_assistant` (--xacro-arg overrides them).
+        xacro_source: The file they came from, None without any.
+    """
+
+    root: Path
+    paths: dict[str, Path]
+    xacro_args: dict[str, str] = field(default_factory=dict)
+    xacro_source: Path | None = None
+
+
+def resolve_config_path(robot: str | Path, srdf_given: bool = False) -> Path:
+    """Return what a --robot argument names: a moveplan.yaml, a URDF or SRDF file, or a folder to read without one.
 
     A bare name such as `ur10e` names a config shipped with moveplan. A folder holding a
     moveplan.yaml means that file; a folder without one is read as a MoveIt config package
-    (or a plain folder holding a URDF and an SRDF) if it holds an SRDF.
+    (or a plain folder holding a URDF and an SRDF) if it holds an SRDF or a .setup_assistant,
+    or if `srdf_given` (--srdf names the SRDF).
     """
     path = Path(robot)
     shipped = Path(str(resources.files("moveplan.configs"))) / str(robot)
@@ -63,14 +101,30 @@ def resolve_config_path(robot: str | Path) -> Path:
     if path.is_dir():
         if (path / CONFIG_FILE).is_file():
             return path / CONFIG_FILE
-        if any(_candidates(path / sub, (".srdf", ".srdf.xacro")) for sub in _SRDF_FOLDERS):
+        if srdf_given or (path / SETUP_ASSISTANT_FILE).is_file() or any(
+                _candidates(path / sub, _SRDF_SUFFIXES) for sub in _SRDF_FOLDERS):
             return path
         raise ConfigError(f"{robot}: no robot config: no {CONFIG_FILE}, and no *.srdf in config/, srdf/ "
-                          "or the folder itself (a MoveIt config package)")
+                          "or the folder itself (a MoveIt config package); pass --srdf FILE to name one")
     if not path.is_file():
-        raise ConfigError(f"{robot}: robot config not found (expected a {CONFIG_FILE}, a folder holding one, "
-                          f"a MoveIt config package, or a shipped config: {known(shipped_configs())})")
+        raise ConfigError(f"{robot}: robot config not found (expected {_ACCEPTED}, or a shipped config: "
+                          f"{known(shipped_configs())})")
+    if robot_file_kind(path) is None:
+        raise ConfigError(f"{robot}: not a robot config; expected {_ACCEPTED}, or a shipped config: "
+                          f"{known(shipped_configs())}")
     return path
+
+
+def robot_file_kind(path: Path) -> str | None:
+    """Return "moveplan", "urdf" or "srdf" for a file --robot may name, by its name; None for any other file."""
+    name = path.name.lower()
+    if name.endswith((".yaml", ".yml")):
+        return "moveplan"
+    if name.endswith(_SRDF_SUFFIXES):
+        return "srdf"
+    if name.endswith((*_URDF_SUFFIXES, ".xacro")):
+        return "urdf"
+    return None
 
 
 def shipped_configs() -> list[str]:
@@ -82,16 +136,19 @@ def shipped_configs() -> list[str]:
 def search_path(root: Path, package_paths: Sequence[Path] = (), extra: Sequence[Path] = ()) -> tuple[Path, ...]:
     """Return the folders searched for ROS packages, in order (first match wins).
 
-    The config folder, moveplan.yaml's `package_paths` (`extra`), --package-path, then
+    The config folder, moveplan.yaml's `package_paths` (`extra`), --package-path, the
+    colcon workspace the config folder lies in (its nearest ancestor named `src`), then
     ROS_PACKAGE_PATH, then the `share` folder of each AMENT_PREFIX_PATH entry (a sourced
     ROS 2 workspace), then the share folders of Python-installed (cmeel) packages such as
     example-robot-data.
     """
+    workspace = workspace_src(root)
     env = [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
     ament = [Path(p) / "share" for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
     cmeel = [Path(p) / "cmeel.prefix" / "share" for p in sys.path if p]
     cmeel = [p for p in cmeel if p.is_dir()]
-    return tuple(dict.fromkeys((root, *extra, *package_paths, *env, *ament, *cmeel)))
+    found = (root, *extra, *package_paths, *([workspace] if workspace else []), *env, *ament, *cmeel)
+    return tuple(dict.fromkeys(found))
 
 
 def read_manifest(manifest: Path) -> tuple[dict[str, Any], tuple[Path, ...]]:
@@ -102,14 +159,18 @@ def read_manifest(manifest: Path) -> tuple[dict[str, Any], tuple[Path, ...]]:
     return top, tuple(manifest.parent / p for p in folders)
 
 
-def manifest_files(manifest: Path, top: dict[str, Any], packages: PackagePath) -> dict[str, Path]:
-    """Return setting -> file for the files moveplan.yaml names (relative to it, or package://)."""
+def manifest_files(
+    manifest: Path, top: dict[str, Any], packages: PackagePath, given: Mapping[str, Path] | None = None
+) -> dict[str, Path]:
+    """Return setting -> file for the files moveplan.yaml names (relative to it, or package://); `given` wins."""
     root = manifest.parent
-    paths: dict[str, Path] = {}
+    paths: dict[str, Path] = dict(given or {})
     for key in FILE_KEYS:
+        if key in paths:
+            continue
         if key not in top:
             if key in ("urdf", "srdf"):
-                raise ConfigError(f"{manifest}: missing key '{key}'")
+                raise ConfigError(f"{manifest}: missing key '{key}' (or pass {_FLAGS[key]} FILE)")
             continue
         value = top[key]
         if not isinstance(value, str):
@@ -121,16 +182,50 @@ def manifest_files(manifest: Path, top: dict[str, Any], packages: PackagePath) -
     return paths
 
 
-def discover(root: Path) -> dict[str, Path]:
-    """Return setting -> file for a folder without moveplan.yaml (see the module's loading rules)."""
-    paths = {"srdf": _one(root, _SRDF_FOLDERS, (".srdf", ".srdf.xacro"), "SRDF")}
-    paths["urdf"] = _one(root, _URDF_FOLDERS, (".urdf", ".urdf.xacro"), "URDF", prefer=stem(paths["srdf"]))
-    for setting, name in _PACKAGE_FILES.items():
-        for sub in ("config", "."):
-            if (root / sub / name).is_file():
-                paths[setting] = root / sub / name
-                break
-    return paths
+def flag_file(value: str, key: str, packages: PackagePath) -> Path:
+    """Return the file --urdf or --srdf (`key`) names: a path, or a `package://` or `file://` URI."""
+    flag = _FLAGS[key]
+    other = "srdf" if key == "urdf" else "urdf"
+    if robot_file_kind(Path(value)) == other:
+        article = "an SRDF" if other == "srdf" else "a URDF"
+        raise UsageError(f"{flag} {value}: {article} file; pass it with {_FLAGS[other]}")
+    path = packages.resolve_uri(value, Path.cwd(), f"{flag} {value}")[0] if "://" in value else Path(value)
+    if not path.is_file():
+        where = f" ({path})" if str(path) != value else ""
+        raise ConfigError(f"{flag} {value}: file not found{where}")
+    return path
+
+
+def discover(root: Path, packages: PackagePath, given: Mapping[str, Path]) -> Discovered:
+    """Return the files of a folder without moveplan.yaml (see the module's rules); `given` (flags) wins."""
+    names = robot_names(root)
+    assistant = read_setup_assistant(root)
+    srdf = given.get("srdf") or builder_srdf(root, names, assistant) or _pick(
+        [root / sub for sub in _SRDF_FOLDERS], "srdf", names, f"{root}: no SRDF file", _where(_SRDF_FOLDERS))
+    names = tuple(dict.fromkeys((*names, stem(srdf))))
+    urdf = given.get("urdf") or builder_urdf(root, names, assistant, packages) or _pick(
+        [root / sub for sub in _URDF_FOLDERS], "urdf", (stem(srdf), *names), f"{root}: no URDF file",
+        _where(_URDF_FOLDERS) + f", and no {SETUP_ASSISTANT_FILE} naming one")
+    paths = {"srdf": srdf, "urdf": urdf, **_settings((root / "config", root))}
+    if "urdf" in given or assistant is None or not assistant.xacro_args:
+        return Discovered(root, paths)
+    return Discovered(root, paths, dict(assistant.xacro_args), assistant.path)
+
+
+def discover_beside(file: Path, given: Mapping[str, Path]) -> Discovered:
+    """Return the files of a lone URDF or SRDF: the other one of the pair found beside it, or `given`."""
+    folder = file.parent
+    kind = "srdf" if robot_file_kind(file) == "srdf" else "urdf"
+    paths = {kind: given.get(kind, file)}
+    other = "urdf" if kind == "srdf" else "srdf"
+    subs = ("../urdf", "../robots", "../config") if other == "urdf" else ("../config", "../srdf")
+    folders = [folder, *(folder.parent / sub.removeprefix("../") for sub in subs)]
+    paths[other] = given.get(other) or _pick(
+        folders, other, (stem(file),), f"{file}: no {other.upper()} beside it",
+        f"of the same name or the only one, in {folder}, {', '.join(subs)}")
+    root = next((p for p in (folder, folder.parent, folder.parent.parent) if (p / "package.xml").is_file()), folder)
+    paths.update(_settings((paths["srdf"].parent, root / "config", root)))
+    return Discovered(root, paths)
 
 
 def stem(path: Path) -> str:
@@ -139,23 +234,71 @@ def stem(path: Path) -> str:
     return name.rsplit(".", 1)[0]
 
 
+def _settings(folders: Sequence[Path]) -> dict[str, Path]:
+    """Return setting -> file for joint_limits.yaml and the others, from the first of `folders` holding each."""
+    found: dict[str, Path] = {}
+    for setting, name in _PACKAGE_FILES.items():
+        for folder in dict.fromkeys(folders):
+            if (folder / name).is_file():
+                found[setting] = folder / name
+                break
+    return found
+
+
+def _where(subs: Sequence[str]) -> str:
+    return "in " + ", ".join(f"{s}/" for s in subs if s != ".") + " or the folder itself"
+
+
 def _candidates(folder: Path, suffixes: tuple[str, ...]) -> list[Path]:
     if not folder.is_dir():
         return []
     return sorted(p for p in folder.iterdir() if p.is_file() and p.name.endswith(suffixes))
 
 
-def _one(root: Path, folders: tuple[str, ...], suffixes: tuple[str, str], kind: str, prefer: str = "") -> Path:
-    """Return the one `kind` file in the first of `folders` that has any; `prefer` breaks ties by stem."""
-    for sub in folders:
-        found = _candidates(root / sub, suffixes)
-        if len(found) > 1:
-            found = [p for p in found if stem(p) == prefer] or found
-        if len(found) == 1:
-            return found[0]
-        if found:
-            raise ConfigError(f"{root / sub}: several {kind} files ({', '.join(p.name for p in found)}); "
-                              f"write a {CONFIG_FILE} that names one")
-    where = ", ".join(f"{s}/" for s in folders if s != ".")
-    raise ConfigError(f"{root}: no {kind} file (*{suffixes[0]} or *{suffixes[1]}) in {where} or the folder "
-                      f"itself; write a {CONFIG_FILE} that names one (urdf: package://pkg/urdf/robot.urdf.xacro)")
+def _files(folder: Path, kind: str) -> list[Path]:
+    """Return the files in `folder` that may be a `kind` (urdf, srdf) by their names."""
+    if kind == "srdf":
+        return _candidates(folder, _SRDF_SUFFIXES)
+    suffixes = (*_URDF_SUFFIXES, ".xacro") if folder.name in _XACRO_URDF_FOLDERS else _URDF_SUFFIXES
+    return [p for p in _candidates(folder, suffixes) if not p.name.endswith(_SRDF_SUFFIXES)]
+
+
+def _pick(folders: Sequence[Path], kind: str, prefer: Sequence[str], missing: str, where: str) -> Path:
+    """Return the one `kind` file in the first of `folders` that has any (see _narrow); else raise naming the flag."""
+    flag = _FLAGS[kind]
+    for folder in folders:
+        found = _files(folder, kind)
+        if not found:
+            continue
+        chosen = _narrow(found, prefer)
+        if len(chosen) == 1:
+            return chosen[0]
+        raise ConfigError(f"{folder}: several {kind.upper()} files ({', '.join(p.name for p in chosen)}); "
+                          f"write a {CONFIG_FILE} that names one, or pass {flag} FILE")
+    example = "package://pkg/urdf/robot.urdf.xacro" if kind == "urdf" else "package://pkg/config/robot.srdf"
+    raise ConfigError(f"{missing} ({where}); pass {flag} FILE or {flag} {example}, "
+                      f"or write a {CONFIG_FILE} that names it")
+
+
+def _narrow(found: list[Path], prefer: Sequence[str]) -> list[Path]:
+    """Return the candidates that are robots: not `*_macro*`, not included by another; named like `prefer` if any is."""
+    kept = [p for p in found if "_macro" not in p.name] or found
+    included = {name for p in kept for name in _included(p)}
+    kept = [p for p in kept if p.name not in included] or kept
+    if len(kept) > 1:
+        for name in prefer:
+            named = [p for p in kept if stem(p) == name]
+            if named:
+                return named
+    return kept
+
+
+def _included(path: Path) -> set[str]:
+    """Return the file names a xacro file includes (`xacro:include filename=...`)."""
+    if not path.name.endswith(".xacro"):
+        return set()
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return set()
+    return {Path(name).name for name in _INCLUDE.findall(text)}

@@ -31,6 +31,8 @@ class UrdfJoint:
     upper: float = math.nan
     velocity: float = math.nan
     mimic: str = ""  # the joint this one follows (<mimic joint="..."/>), "" for none
+    mimic_multiplier: float = 1.0  # value = multiplier * leader's value + offset
+    mimic_offset: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -84,9 +86,13 @@ def parse_urdf(text: str, path: Path) -> dict[str, UrdfJoint]:
             upper = float_attr(limit, "upper", path, 0.0)
             velocity = float_attr(limit, "velocity", path)
         mimic = element.find("mimic")
+        leader, multiplier, offset = "", 1.0, 0.0
+        if mimic is not None:
+            leader = mimic.get("joint", "")
+            multiplier, offset = float_attr(mimic, "multiplier", path, 1.0), float_attr(mimic, "offset", path, 0.0)
         joints[name] = UrdfJoint(
             name, element.get("type", ""), parent.get("link", ""), child.get("link", ""),
-            lower, upper, velocity, "" if mimic is None else mimic.get("joint", ""),
+            lower, upper, velocity, leader, multiplier, offset,
         )
     for joint in joints.values():
         if joint.mimic and joint.mimic not in joints:

@@ -1,9 +1,10 @@
 """ROS resources without ROS: finding packages on a package path, and xacro to URDF/SRDF.
 
 A package is found as ROS finds it on ROS_PACKAGE_PATH: in the first folder of the
-search path that is the package, holds a folder of that name, or holds (up to three
-levels down) a folder whose package.xml names it. The same lookup resolves
-`$(find pkg)` in xacro files and `package://pkg/...` URIs of meshes.
+search path that is the package, holds a folder of that name, or holds (below it, as
+colcon finds packages in a workspace: core/config/workspace.py) a folder whose
+package.xml names it. The same lookup resolves `$(find pkg)` in xacro files and
+`package://pkg/...` URIs of meshes.
 
 xacro itself resolves `$(find pkg)` through ament_index_python, which needs a sourced
 ROS 2 install; here the PyPI `xacro` package runs with that one function replaced by
@@ -17,7 +18,6 @@ import io
 import logging
 import re
 import xml.dom.minidom
-import xml.etree.ElementTree as ET
 import xml.parsers.expat
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -28,43 +28,13 @@ import xacro as _xacro  # type: ignore[import-untyped]  # the PyPI package ships
 from xacro import substitution_args as _substitution_args
 
 from ..errors import ConfigError, UsageError
+from .workspace import package_name, packages_under
 
 __all__ = ["PackagePath", "XacroResult", "parse_xacro_args", "process_xacro"]
 
 _log = logging.getLogger(__name__)
 
-_CRAWL_DEPTH = 3
 _BANNER_LINES = 4  # the comments xacro.process_file puts before the document
-_IGNORE_MARKERS = ("COLCON_IGNORE", "CATKIN_IGNORE", "AMENT_IGNORE")
-
-
-def _package_name(folder: Path) -> str | None:
-    """Return the name a folder's package.xml gives, or None (no or unreadable package.xml)."""
-    manifest = folder / "package.xml"
-    if not manifest.is_file():
-        return None
-    try:
-        name = ET.parse(manifest).getroot().findtext("name")
-    except (ET.ParseError, OSError):
-        return None
-    return name.strip() if name else None
-
-
-def _crawl(folder: Path, depth: int) -> Iterator[Path]:
-    """Yield package folders (holding a package.xml) below `folder`, in sorted order."""
-    if depth == 0:
-        return
-    try:
-        children = sorted(p for p in folder.iterdir() if p.is_dir() and not p.name.startswith("."))
-    except OSError:
-        return
-    for child in children:
-        if any((child / marker).exists() for marker in _IGNORE_MARKERS):
-            continue
-        if (child / "package.xml").is_file():
-            yield child  # a package: its subfolders are its own, not other packages
-        else:
-            yield from _crawl(child, depth - 1)
 
 
 @dataclass(frozen=True)
@@ -101,14 +71,11 @@ class PackagePath:
     def _in(folder: Path, package: str) -> Path | None:
         if not folder.is_dir():
             return None
-        if _package_name(folder) == package or folder.name == package:
+        if package_name(folder) == package or folder.name == package:
             return folder
         if (folder / package).is_dir():
             return folder / package
-        for candidate in _crawl(folder, _CRAWL_DEPTH):
-            if _package_name(candidate) == package:
-                return candidate
-        return None
+        return packages_under(folder).get(package)
 
     def resolve_uri(self, uri: str, base: Path, source: str) -> tuple[Path, str]:
         """Return the file a URDF resource URI names, and the package it came from ('' if none).
@@ -231,6 +198,9 @@ def process_xacro(path: Path, args: Mapping[str, str], packages: PackagePath, sh
             message = "a macro expands itself without end"
         elif len(message) > 300:
             message = message[:297] + "..."
+        undefined = re.match(r"Undefined substitution argument (\S+)", message)
+        if undefined:  # an arg without default: only the user can say its value, as launch files do
+            message += f" (an xacro arg without default: pass --xacro-arg {undefined.group(1)}:=VALUE)"
         raise ConfigError(f"{where}: xacro error: {message or type(exc).__name__}") from None
     finally:
         for line in captured.getvalue().splitlines():

@@ -88,7 +88,8 @@ def solve_ik(
         seed: Seed of the random restarts.
         max_attempts: Local solves at most, the one from `start` included.
         position_tolerance: Largest accepted position error in [m].
-        orientation_tolerance: Largest accepted orientation error in [rad].
+        orientation_tolerance: Largest accepted orientation error in [rad]; `math.inf` leaves
+            the orientation free (a position goal: only the link origin is placed).
         colliding_pair: Names a colliding pair in a full configuration, for the error message
             (e.g. `CollisionChecker.colliding_pair`).
         exhaustive: Run all `max_attempts` and return the nearest valid solution of them all
@@ -109,7 +110,8 @@ def solve_ik(
     if outcome.best is not None:
         best = outcome.best
         return IkSolution(best.values, best.position_m, best.angle_rad, outcome.attempts)
-    raise _unreachable(robot, solver, outcome, link, root_T_target, reference, base, colliding_pair)
+    raise _unreachable(robot, solver, outcome, link, root_T_target, reference, base, colliding_pair,
+                       orientation_tolerance)
 
 
 def _checked_inputs(
@@ -180,9 +182,12 @@ def _search(
 def _unreachable(
     robot: Robot, solver: _Solver, outcome: _Outcome, link: str, root_T_target: pin.SE3,
     reference: NDArray[np.float64], base: NDArray[np.float64],
-    colliding_pair: Callable[[NDArray[np.float64]], tuple[str, str] | None] | None,
+    colliding_pair: Callable[[NDArray[np.float64]], tuple[str, str] | None] | None, orientation_tolerance: float,
 ) -> GoalUnreachable:
-    """Return the error for a search with no valid solution: the closest pose error, or what the solutions hit."""
+    """Return the error for a search with no valid solution: the closest pose error, or what the solutions hit.
+
+    With an infinite `orientation_tolerance` [rad] the orientation is free: the message gives distance only.
+    """
     x, y, z = root_T_target.translation
     where = f"no IK solution for link '{link}' at [{x:.3f} {y:.3f} {z:.3f}]"
     attempts, colliding, closest = outcome.attempts, outcome.colliding, outcome.closest
@@ -197,8 +202,8 @@ def _unreachable(
             text += f" (nearest the start: {pair[0]} touches {pair[1]})" if pair else ""
         return GoalUnreachable(f"{text} {tries}")
     assert closest is not None  # no attempt converged, so every one was a candidate
-    return GoalUnreachable(f"{where}: closest reached {closest.position_m * 1e3:.1f} mm, "
-                           f"{closest.angle_rad:.3g} rad away {tries}")
+    angle = "" if math.isinf(orientation_tolerance) else f", {closest.angle_rad:.3g} rad"
+    return GoalUnreachable(f"{where}: closest reached {closest.position_m * 1e3:.1f} mm{angle} away {tries}")
 
 
 @dataclass(frozen=True)
@@ -263,9 +268,14 @@ class _Solver:
         target: pin.SE3,
         tolerances: tuple[float, float],
     ) -> _Attempt:
-        """Return where damped least squares on the local SE3 log error ends, from `guess`."""
+        """Return where damped least squares on the local SE3 log error ends, from `guess`.
+
+        With an infinite orientation tolerance, only the position error and the Jacobian's
+        linear rows count: the orientation is free.
+        """
         model, data = self.model, self.data
         position_tolerance2, angle_tolerance2 = tolerances[0] ** 2, tolerances[1] ** 2
+        position_only = math.isinf(tolerances[1])
         lower, upper = self.clamp_lower, self.clamp_upper
         normal, diagonal, cholesky = self.normal, self.diagonal, self.cholesky
         values = guess.copy()
@@ -286,6 +296,9 @@ class _Solver:
             angle2 = error[3:].dot(error[3:])
             if position2 <= position_tolerance2 and angle2 <= angle_tolerance2:
                 break
+            if position_only:
+                # LOCAL: the linear rows move the origin in the link's frame, the frame of `translation`.
+                error, jacobian = translation, jacobian[:3]
             residual = error.dot(error)
             if residual < 0.98 * best_residual:
                 best_residual, best_iteration = residual, iteration
@@ -305,7 +318,7 @@ class _Solver:
             np.maximum(values, lower, out=values)
         position, angle = math.sqrt(position2), math.sqrt(angle2)
         converged = position <= tolerances[0] and angle <= tolerances[1]
-        return _Attempt(values, position, angle, math.sqrt(position2 + angle2), converged)
+        return _Attempt(values, position, angle, math.sqrt(position2 + (0.0 if position_only else angle2)), converged)
 
     def random_guess(
         self, rng: np.random.Generator, start: NDArray[np.float64]

@@ -3,10 +3,11 @@
 Read as move_group reads one, with these choices:
 
 - `goal_constraints` are alternatives; moveplan plans to the first (a warning says so when
-  there are more). A goal is either joint constraints (a joint goal) or one position and
-  one orientation constraint on one link (a pose goal of that link: the constraint region's
-  first pose, moved back by `target_point_offset` along the orientation). Tolerances and
-  weights are ignored: moveplan reaches the goal itself.
+  there are more). A goal is joint constraints (a joint goal), one position and one
+  orientation constraint on one link (a pose goal of that link: the constraint region's
+  first pose, moved back by `target_point_offset` along the orientation), or a position
+  constraint alone (a position goal, orientation free: what MoveGroupInterface's
+  setPositionTarget sends). Tolerances and weights are ignored: moveplan reaches the goal itself.
 - `planner_id`: "geometric::" is dropped, then a MoveIt planner config name maps to the
   longest OMPL planner name that begins it (RRTConnectkConfigDefault -> RRTConnect), with
   BKPIECE, LBKPIECE and KPIECE meaning BKPIECE1, LBKPIECE1 and KPIECE1. Empty: the robot
@@ -16,10 +17,14 @@ Read as move_group reads one, with these choices:
   parameterisation reads them, a value in (0, 1] is used and anything else (0 included,
   MoveIt's "not set") means 1.0, the full limits; values other than 0 log a warning.
   A factor left out of the file is not set: the task's or robot config's default applies.
+- `start_state.attached_collision_objects` are attached to the scene as MoveIt attaches them
+  (core/model/planning_scene.py `attach_request_objects`).
 - Ignored: `num_planning_attempts` (one search per step), `workspace_parameters` (the
   joint limits bound the search), `pipeline_id`, `reference_trajectories` and Cartesian
-  speed limits (warnings where set). Path and trajectory constraints, visibility
-  constraints and attached objects in the start state are errors.
+  speed limits (warnings where set). Path and trajectory constraints and visibility
+  constraints are errors.
+- Every number is finite and within MAX_MAGNITUDE, as on the command line; attempts are an
+  int32 at least 0, planning time at least 0.
 """
 
 from __future__ import annotations
@@ -30,16 +35,17 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
-from ..config.fields import check_keys, load_yaml, mapping, number
+from ..config.fields import MAX_MAGNITUDE, check_keys, coordinate, load_yaml, mapping, number
 from ..config.goals import JointGoal, PoseGoal
 from ..config.planners import PLANNERS
 from ..config.tasks import MIN_SCALING, StepSpec
 from ..errors import ConfigError, known
-from .moveit_messages import header_frame, point, pose, quaternion, robot_state, yaml_list
+from .moveit_messages import attached_object, header_frame, point, pose, quaternion, robot_state, yaml_list
 from .poses import pose_matrix
 
-__all__ = ["MotionPlanRequest", "load_motion_plan_request", "planner_name"]
+__all__ = ["MAX_ATTEMPTS", "MotionPlanRequest", "PositionGoal", "load_motion_plan_request", "planner_name"]
 
 logger = logging.getLogger(__name__)
 
@@ -48,6 +54,7 @@ _REQUEST_KEYS = {
     "reference_trajectories", "pipeline_id", "planner_id", "group_name", "num_planning_attempts",
     "allowed_planning_time", "max_velocity_scaling_factor", "max_acceleration_scaling_factor",
     "cartesian_speed_limited_link", "max_cartesian_speed",
+    "cartesian_speed_end_effector_link",  # Humble's name of cartesian_speed_limited_link
 }
 _CONSTRAINTS_KEYS = {
     "name", "joint_constraints", "position_constraints", "orientation_constraints", "visibility_constraints",
@@ -55,6 +62,7 @@ _CONSTRAINTS_KEYS = {
 _JOINT_KEYS = {"joint_name", "position", "tolerance_above", "tolerance_below", "weight"}
 _POSITION_KEYS = {"header", "link_name", "target_point_offset", "constraint_region", "weight"}
 _REGION_KEYS = {"primitives", "primitive_poses", "meshes", "mesh_poses"}
+_WORKSPACE_KEYS = {"header", "min_corner", "max_corner"}
 _ORIENTATION_KEYS = {
     "header", "orientation", "link_name", "absolute_x_axis_tolerance", "absolute_y_axis_tolerance",
     "absolute_z_axis_tolerance", "parameterization", "weight",
@@ -68,6 +76,23 @@ _UNAVAILABLE = (
     "LazyPRMstar", "SPARS", "SPARStwo", "EST", "BiEST", "ProjEST", "SBL", "pSBL", "STRIDE", "PDST",
     "AITstar", "ABITstar", "EITstar", "CForest", "STRRTstar", "SST",
 )
+
+MAX_ATTEMPTS = 2**31 - 1
+"""Largest num_planning_attempts: the field is an int32."""
+
+
+@dataclass(frozen=True)
+class PositionGoal(PoseGoal):
+    """A position of a link with its orientation left free (a position constraint alone, as setPositionTarget sends).
+
+    `xyz` is where the link's origin goes, in `frame`; `rpy` and `quat` stay None.
+    """
+
+    def describe(self) -> dict[str, Any]:
+        """Return the goal as the plan JSON reports it: {"pose": {..., "orientation": "free"}}."""
+        described = super().describe()
+        described["pose"]["orientation"] = "free"
+        return described
 
 
 @dataclass(frozen=True)
@@ -85,6 +110,8 @@ class MotionPlanRequest:
         velocity_scaling: Fraction of the velocity limits, in (0, 1].
         acceleration_scaling: Fraction of the acceleration limits, in (0, 1].
         raw: The file's bytes, embedded in plan files.
+        attached: start_state.attached_collision_objects as written (each with a link name
+            and an object id); attached to the scene with the robot at the start.
     """
 
     source: Path
@@ -96,6 +123,7 @@ class MotionPlanRequest:
     velocity_scaling: float | None
     acceleration_scaling: float | None
     raw: bytes = b""
+    attached: tuple[Any, ...] = ()
 
 
 def load_motion_plan_request(path: Path) -> MotionPlanRequest:
@@ -106,9 +134,8 @@ def load_motion_plan_request(path: Path) -> MotionPlanRequest:
     _check_unsupported(top, source)
 
     joints, attached = robot_state(top.get("start_state"), f"{source}: start_state")
-    if attached:
-        raise ConfigError(f"{source}: start_state.attached_collision_objects: not supported in a request; "
-                          "attach objects in the scene (robot_state.attached_collision_objects)")
+    for k, entry in enumerate(attached):
+        attached_object(entry, f"{source}: start_state.attached_collision_objects[{k}]")
     alternatives = yaml_list(top.get("goal_constraints"), f"{source}: goal_constraints")
     if len(alternatives) > 1:
         logger.warning("%s: goal_constraints has %d alternatives; moveplan plans to the first",
@@ -123,9 +150,13 @@ def load_motion_plan_request(path: Path) -> MotionPlanRequest:
     planner_id = top.get("planner_id", "")
     if not isinstance(planner_id, str):
         raise ConfigError(f"{source}: planner_id: expected a planner name, got {planner_id!r}")
-    planning_time = number(top.get("allowed_planning_time", 0.0), f"{source}: allowed_planning_time")
+    planning_time = coordinate(top.get("allowed_planning_time", 0.0), f"{source}: allowed_planning_time")
     if planning_time < 0:
         raise ConfigError(f"{source}: allowed_planning_time: expected seconds >= 0, got {planning_time!r}")
+    attempts = top.get("num_planning_attempts", 0)
+    if isinstance(attempts, bool) or not isinstance(attempts, int) or not 0 <= attempts <= MAX_ATTEMPTS:
+        raise ConfigError(f"{source}: num_planning_attempts: expected an integer in 0..{MAX_ATTEMPTS}, "
+                          f"got {str(attempts)[:40]}")
     return MotionPlanRequest(
         source=path,
         group_name=group or None,
@@ -136,6 +167,7 @@ def load_motion_plan_request(path: Path) -> MotionPlanRequest:
         velocity_scaling=_scaling(top, "max_velocity_scaling_factor", source),
         acceleration_scaling=_scaling(top, "max_acceleration_scaling_factor", source),
         raw=path.read_bytes(),
+        attached=tuple(attached),
     )
 
 
@@ -168,16 +200,21 @@ def _check_unsupported(top: dict[str, Any], source: str) -> None:
         logger.warning("%s: reference_trajectories are ignored", source)
     pipeline = top.get("pipeline_id", "")
     if pipeline not in ("", "ompl"):
-        logger.warning("%s: pipeline_id '%s' is ignored; moveplan plans with OMPL", source, pipeline)
-    if number(top.get("max_cartesian_speed", 0.0), f"{source}: max_cartesian_speed") > 0:
+        logger.warning("%s: pipeline_id '%s' is ignored; moveplan plans with OMPL", source, str(pipeline)[:80])
+    if coordinate(top.get("max_cartesian_speed", 0.0), f"{source}: max_cartesian_speed") > 0:
         logger.warning("%s: max_cartesian_speed is ignored; the joint limits bound the motion", source)
+    workspace = mapping(top.get("workspace_parameters"), f"{source}: workspace_parameters")
+    check_keys(workspace, _WORKSPACE_KEYS, f"{source}: workspace_parameters")
+    header_frame(workspace, f"{source}: workspace_parameters", "")
+    for corner in ("min_corner", "max_corner"):
+        point(workspace.get(corner, [0.0, 0.0, 0.0]), f"{source}: workspace_parameters.{corner}")
 
 
 def _scaling(top: dict[str, Any], key: str, source: str) -> float | None:
     """Return a scaling factor as MoveIt's time parameterisation reads it: outside (0, 1] is 1.0."""
     if key not in top:
         return None
-    factor = number(top[key], f"{source}: {key}")
+    factor = coordinate(top[key], f"{source}: {key}")
     if 0.0 < factor < MIN_SCALING:
         raise ConfigError(f"{source}: {key}: {factor:g} is below moveplan's limit of {MIN_SCALING:g}")
     if 0.0 < factor <= 1.0:
@@ -188,7 +225,7 @@ def _scaling(top: dict[str, Any], key: str, source: str) -> float | None:
 
 
 def _goal(value: Any, where: str) -> JointGoal | PoseGoal:
-    """Return the step goal of one moveit_msgs/Constraints: a joint goal or a pose goal."""
+    """Return the step goal of one moveit_msgs/Constraints: a joint, pose or position goal."""
     entry = mapping(value, where)
     check_keys(entry, _CONSTRAINTS_KEYS, where)
     joints = yaml_list(entry.get("joint_constraints"), f"{where}.joint_constraints")
@@ -199,53 +236,86 @@ def _goal(value: Any, where: str) -> JointGoal | PoseGoal:
     if joints and (positions or orientations):
         raise ConfigError(f"{where}: give joint constraints or position and orientation constraints, not both")
     if joints:
-        goal: dict[str, float] = {}
-        for k, item in enumerate(joints):
-            at = f"{where}.joint_constraints[{k}]"
-            constraint = mapping(item, at)
-            check_keys(constraint, _JOINT_KEYS, at)
-            name = constraint.get("joint_name")
-            if not isinstance(name, str) or not name:
-                raise ConfigError(f"{at}.joint_name: expected a joint name, got {name!r}")
-            if name in goal:
-                raise ConfigError(f"{at}.joint_name: joint '{name}' is constrained twice")
-            goal[name] = number(constraint.get("position"), f"{at}.position")
-        return JointGoal.by_name(goal)
-    if len(positions) != 1 or len(orientations) != 1:
-        raise ConfigError(f"{where}: a goal needs joint constraints, or one position and one orientation "
-                          f"constraint (got {len(positions)} and {len(orientations)})")
-    return _pose_goal(positions[0], orientations[0], where)
+        return _joint_goal(joints, where)
+    if len(positions) != 1 or len(orientations) > 1:
+        raise ConfigError(f"{where}: a goal needs joint constraints, or one position constraint and at most one "
+                          f"orientation constraint (got {len(positions)} and {len(orientations)})")
+    return _pose_goal(positions[0], orientations[0] if orientations else None, where)
+
+
+def _joint_goal(constraints: list[Any], where: str) -> JointGoal:
+    """Return the joint goal of moveit_msgs/JointConstraint entries (tolerances checked, then ignored)."""
+    goal: dict[str, float] = {}
+    for k, item in enumerate(constraints):
+        at = f"{where}.joint_constraints[{k}]"
+        constraint = mapping(item, at)
+        check_keys(constraint, _JOINT_KEYS, at)
+        name = constraint.get("joint_name")
+        if not isinstance(name, str) or not name:
+            raise ConfigError(f"{at}.joint_name: expected a joint name, got {name!r}")
+        if name in goal:
+            raise ConfigError(f"{at}.joint_name: joint '{name}' is constrained twice")
+        goal[name] = coordinate(constraint.get("position"), f"{at}.position")
+        _check_numbers(constraint, ("tolerance_above", "tolerance_below", "weight"), at)
+    return JointGoal.by_name(goal)
 
 
 def _pose_goal(position_value: Any, orientation_value: Any, where: str) -> PoseGoal:
-    """Return the pose goal of a link from a position and an orientation constraint on it."""
+    """Return the pose goal of a link from a position and an orientation constraint on it (None: orientation free)."""
     at_p, at_o = f"{where}.position_constraints[0]", f"{where}.orientation_constraints[0]"
     position = mapping(position_value, at_p)
     check_keys(position, _POSITION_KEYS, at_p)
+    _check_numbers(position, ("weight",), at_p)
+    centre = _region_centre(position.get("constraint_region"), f"{at_p}.constraint_region")
+    offset = np.array(point(position.get("target_point_offset", [0.0, 0.0, 0.0]), f"{at_p}.target_point_offset"))
+    link = position.get("link_name")
+    if not isinstance(link, str) or not link:
+        raise ConfigError(f"{at_p}.link_name: expected a link name, got {link!r}")
+    frame = header_frame(position, at_p, "")
+    if orientation_value is None:
+        if offset.any():
+            raise ConfigError(f"{at_p}.target_point_offset: not supported in a goal without an orientation "
+                              "constraint (where the point is depends on the orientation); give the link origin")
+        x, y, z = (float(v) for v in centre)
+        return PositionGoal(xyz=(x, y, z), frame=frame or None, link=link)
     orientation = mapping(orientation_value, at_o)
     check_keys(orientation, _ORIENTATION_KEYS, at_o)
-    links = [c.get("link_name") for c in (position, orientation)]
-    if not all(isinstance(link, str) and link for link in links):
-        raise ConfigError(f"{where}: position and orientation constraints need a link_name, got {links}")
-    if links[0] != links[1]:
-        raise ConfigError(f"{at_o}.link_name: '{links[1]}' is not the position constraint's link '{links[0]}'")
-    frames = [header_frame(c, at, "") for c, at in ((position, at_p), (orientation, at_o))]
-    if frames[0] != frames[1]:
-        raise ConfigError(f"{at_o}.header.frame_id: '{frames[1]}' is not the position constraint's frame "
-                          f"'{frames[0]}'; give both in one frame")
-    region = mapping(position.get("constraint_region"), f"{at_p}.constraint_region")
-    check_keys(region, _REGION_KEYS, f"{at_p}.constraint_region")
-    poses = (yaml_list(region.get("primitive_poses"), f"{at_p}.constraint_region.primitive_poses")
-             or yaml_list(region.get("mesh_poses"), f"{at_p}.constraint_region.mesh_poses"))
-    if not poses:
-        raise ConfigError(f"{at_p}.constraint_region.primitive_poses: the region needs a pose, its centre is the goal")
-    centre = pose(poses[0], f"{at_p}.constraint_region.primitive_poses[0]")[:3, 3]
+    _check_numbers(orientation, ("absolute_x_axis_tolerance", "absolute_y_axis_tolerance",
+                                 "absolute_z_axis_tolerance", "weight"), at_o)
+    if orientation.get("link_name") != link:
+        raise ConfigError(f"{at_o}.link_name: {orientation.get('link_name')!r} is not the position constraint's "
+                          f"link '{link}'")
+    if header_frame(orientation, at_o, "") != frame:
+        raise ConfigError(f"{at_o}.header.frame_id: '{header_frame(orientation, at_o, '')}' is not the position "
+                          f"constraint's frame '{frame}'; give both in one frame")
     quat = quaternion(orientation.get("orientation"), f"{at_o}.orientation") or [0.0, 0.0, 0.0, 1.0]
     rotation = pose_matrix(None, None, quat, f"{at_o}.orientation")[:3, :3]
-    offset = np.array(point(position.get("target_point_offset", [0.0, 0.0, 0.0]), f"{at_p}.target_point_offset"))
     # The offset point, fixed in the link, must reach the centre: the link origin sits back from it.
     origin = centre - rotation @ offset
     norm = float(np.linalg.norm(quat))
     x, y, z = (float(v) for v in origin)
     qx, qy, qz, qw = (v / norm for v in quat)
-    return PoseGoal(xyz=(x, y, z), quat=(qx, qy, qz, qw), frame=frames[0] or None, link=links[0])
+    return PoseGoal(xyz=(x, y, z), quat=(qx, qy, qz, qw), frame=frame or None, link=link)
+
+
+def _region_centre(value: Any, where: str) -> NDArray[np.float64]:
+    """Return the centre of a constraint region (moveit_msgs/BoundingVolume): its first primitive's or mesh's pose."""
+    region = mapping(value, where)
+    check_keys(region, _REGION_KEYS, where)
+    for k, primitive in enumerate(yaml_list(region.get("primitives"), f"{where}.primitives")):
+        at = f"{where}.primitives[{k}]"
+        entry = mapping(primitive, at)
+        for i, size in enumerate(yaml_list(entry.get("dimensions"), f"{at}.dimensions")):
+            number(size, f"{at}.dimensions[{i}]", bound=MAX_MAGNITUDE)
+    poses = (yaml_list(region.get("primitive_poses"), f"{where}.primitive_poses")
+             or yaml_list(region.get("mesh_poses"), f"{where}.mesh_poses"))
+    if not poses:
+        raise ConfigError(f"{where}.primitive_poses: the region needs a pose, its centre is the goal")
+    return pose(poses[0], f"{where}.primitive_poses[0]")[:3, 3]
+
+
+def _check_numbers(entry: dict[str, Any], keys: tuple[str, ...], where: str) -> None:
+    """Raise ConfigError unless each of `keys` present in `entry` is a finite number within MAX_MAGNITUDE."""
+    for key in keys:
+        if key in entry:
+            number(entry[key], f"{where}.{key}", bound=MAX_MAGNITUDE)

@@ -5,14 +5,27 @@ Read as MoveIt's PlanningScene::setPlanningSceneMsg reads it, with these choices
 - A collision object's shapes (primitives, then meshes) become one moveplan object each,
   named `id/0`, `id/1`, ... (just `id` for a lone shape); allowed-collision entries naming
   the id apply to every part. Object and shape poses compose as in MoveIt, including its
-  rule that a lone shape's pose is the object's pose when the object has none.
+  rule that a lone shape's pose is the object's pose when the object has none. Meshes are
+  inline (triangles, vertices) or, as robowflex and MotionBenchMaker write them, a
+  `resource` file (a path relative to the scene file, or a package:// URI) scaled by `dimensions`.
 - Primitive types are names in any case or SolidPrimitive numbers (1 box, 2 sphere,
   3 cylinder, 4 cone). A cone is checked as the cylinder enclosing it (conservative);
   prisms and planes are errors. Only the ADD operation describes an object in a scene.
 - Frames: an empty `header.frame_id` is the planning frame (for attached objects: their
   link); objects are placed with the robot in the scene's own robot state, as MoveIt
-  does. `fixed_frame_transforms` become scene frames; one for the planning frame itself
-  must be the identity and is skipped. Subframes become frames named `id/subframe`.
+  does. `fixed_frame_transforms` are read as MoveIt's Transforms::copyTransforms writes them:
+  `child_frame_id` is the planning frame and `header.frame_id` the fixed frame, whose pose in
+  the planning frame is the transform. The planning frame is the URDF root link, or the frame
+  the SRDF's virtual joint hangs from (MoveIt's model frame), or any frame the file gives
+  relative to itself (MoveIt writes its planning frame so); frames that name it must be the
+  identity. A transform to another child frame is read as tf reads it: the child frame's pose
+  in the header frame. Subframes become frames named `id/subframe`.
+- Attached objects (robot_state.attached_collision_objects, after the world's objects, and a
+  MotionPlanRequest's start state through `attach_request_objects`) are attached as
+  processAttachedCollisionObjectMsg attaches them: one given by id alone takes the world object
+  of that id, where it is, and any world object of that id leaves the world; an object attached
+  again replaces the first. (MoveIt applies a whole scene's robot state before its world, so
+  there an object attached by id must already be in the world.)
 - The allowed collision matrix is read as MoveIt reads it (upper triangle, then default
   entries for pairs it does not list); its allowed pairs come on top of the SRDF's disabled
   pairs, so a `false` entry does not re-enable a pair the SRDF disables. Unknown names are
@@ -26,7 +39,7 @@ Read as MoveIt's PlanningScene::setPlanningSceneMsg reads it, with these choices
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -34,48 +47,61 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..config.fields import check_keys, mapping, number
+from ..config.xacro import PackagePath
 from ..errors import ConfigError, UnknownName
-from ..types import CollisionObject, Frame, Shape
+from ..types import CollisionObject, Frame
 from .moveit_messages import (
+    ObjectMessage,
+    attached_object,
+    collision_object,
     header_frame,
-    is_empty_pose,
     known_joints,
-    point,
-    pose,
     robot_state,
     string_list,
     transform,
     yaml_list,
 )
+from .moveit_request import MotionPlanRequest
 from .robot import Robot
-from .scene import PLANNING_SCENE_KEYS, Scene, check_shape_count, first_repeated, resolve_frames
+from .scene import (
+    PLANNING_SCENE_KEYS,
+    Scene,
+    check_shape_count,
+    empty_scene,
+    first_repeated,
+    planning_frame_names,
+    resolve_frames,
+)
 
-__all__ = ["planning_scene"]
+__all__ = ["attach_request_objects", "planning_scene"]
 
 logger = logging.getLogger(__name__)
 
 _WORLD_KEYS = {"collision_objects", "octomap"}
-_OBJECT_KEYS = {
-    "header", "pose", "id", "type", "primitives", "primitive_poses", "meshes", "mesh_poses", "planes",
-    "plane_poses", "subframe_names", "subframe_poses", "operation",
-}
-_ATTACHED_KEYS = {"link_name", "object", "touch_links", "detach_posture", "weight"}
 _ACM_KEYS = {"entry_names", "entry_values", "default_entry_names", "default_entry_values"}
-_PRIMITIVES = {1: "box", 2: "sphere", 3: "cylinder", 4: "cone"}  # SolidPrimitive type constants
-_DIMENSIONS = {"box": "x, y, z (full sizes)", "sphere": "radius", "cylinder": "height, radius",
-               "cone": "height, radius"}
-_ADD = (0, "add", "ADD", "\x00", b"\x00")  # CollisionObject.ADD as numbers, names or a byte
 
 
-@dataclass(frozen=True)
-class _Object:
-    """A CollisionObject message, parsed: shapes placed in the object frame, the object in its header frame."""
+@dataclass
+class _Objects:
+    """The objects of a scene being built, by message id, in the order they came (world, then attached)."""
 
-    id: str
-    frame: str
-    header_T_object: NDArray[np.float64]
-    parts: tuple[tuple[str, Shape, NDArray[np.float64]], ...]  # (name, shape, object_T_shape)
-    subframes: dict[str, NDArray[np.float64]]  # name -> object_T_subframe
+    world: dict[str, tuple[list[CollisionObject], list[Frame]]] = field(default_factory=dict)
+    attached: dict[str, tuple[list[CollisionObject], list[Frame]]] = field(default_factory=dict)
+
+    def scene(self, base: Scene, frames: list[Frame], robot: Robot) -> Scene:
+        """Return `base` with these objects, `frames` and the objects' subframes, frames resolved."""
+        groups = [*self.world.items(), *self.attached.items()]
+        objects = [obj for _, (parts, _) in groups for obj in parts]
+        check_shape_count(len(objects), base.source)
+        if (twice := first_repeated(o.name for o in objects)) is not None:
+            raise ConfigError(f"{base.source}: collision object '{twice}' is defined twice")
+        frames = [*frames, *(frame for _, (_, subframes) in groups for frame in subframes)]
+        if (twice := first_repeated(f.name for f in frames)) is not None:
+            raise ConfigError(f"{base.source}: frame '{twice}' is defined twice")
+        return replace(base, frames=tuple(frames), objects=tuple(objects),
+                       anchors=resolve_frames(frames, robot, base.source),
+                       parts={i: tuple(o.name for o in parts) for i, (parts, _) in groups},
+                       subframes={i: tuple(f.name for f in subs) for i, (_, subs) in groups})
 
 
 def planning_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
@@ -90,67 +116,112 @@ def planning_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
         q = robot.set_joint(q, joint, value)
 
     frames = _fixed_frames(top.get("fixed_frame_transforms"), source, robot)
-    anchors = resolve_frames(frames, robot, source)
+    fixed = Scene(source, tuple(frames), (), resolve_frames(frames, robot, source), robot_state=state)
     world = mapping(top.get("world"), f"{source}: world")
     check_keys(world, _WORLD_KEYS, f"{source}: world")
     _check_octomap(world.get("octomap"), f"{source}: world.octomap")
     check_shape_count(_shape_count(world.get("collision_objects"), attached), source)
-    placed = [
-        _place(value, f"{source}: world.collision_objects[{k}]", "", robot, anchors, q)
-        for k, value in enumerate(yaml_list(world.get("collision_objects"), f"{source}: world.collision_objects"))
-    ]
-    for k, value in enumerate(attached):
-        where = f"{source}: robot_state.attached_collision_objects[{k}]"
-        entry = mapping(value, where)
-        check_keys(entry, _ATTACHED_KEYS, where)
-        link = entry.get("link_name")
-        if not isinstance(link, str) or link not in robot.link_names:
-            raise UnknownName("link", str(link), f"{where}.link_name", robot.link_names)
-        touch = tuple(string_list(entry.get("touch_links"), f"{where}.touch_links"))
-        placed.append(_place(entry.get("object"), f"{where}.object", link, robot, anchors, q, touch))
-
-    objects = [obj for group in placed for obj in group[1]]
-    if (twice := first_repeated(o.name for o in objects)) is not None:
-        raise ConfigError(f"{source}: collision object '{twice}' is defined twice")
-    frames.extend(frame for group in placed for frame in group[2])
-    if (twice := first_repeated(f.name for f in frames)) is not None:
-        raise ConfigError(f"{source}: frame '{twice}' is defined twice")
-    parts_of = {object_id: [o.name for o in parts] for object_id, parts, _ in placed}
+    packages = PackagePath(tuple(robot.config.package_paths))
+    objects = _Objects()
+    for k, value in enumerate(yaml_list(world.get("collision_objects"), f"{source}: world.collision_objects")):
+        where = f"{source}: world.collision_objects[{k}]"
+        message = collision_object(value, where, path.parent, packages)
+        if not message.parts:
+            raise ConfigError(f"{where}: object '{message.id}' has no primitives or meshes")
+        if message.id in objects.world:
+            raise ConfigError(f"{source}: collision object '{message.id}' is defined twice")
+        objects.world[message.id] = _place(message, where, "", robot, fixed, q)
+    _attach(objects, attached, f"{source}: robot_state.attached_collision_objects", robot, fixed, q,
+            path.parent, packages)
+    scene = objects.scene(fixed, frames, robot)
     pairs = _allowed_pairs(top.get("allowed_collision_matrix"), f"{source}: allowed_collision_matrix",
-                           [*robot.link_names, *parts_of])
+                           [*robot.link_names, *scene.parts])
     # Entries naming an object apply to each of its parts.
     allowed: set[frozenset[str]] = set()
     for first, second in map(tuple, pairs):
-        for a in parts_of.get(first, [first]):
-            allowed.update(frozenset((a, b)) for b in parts_of.get(second, [second]) if a != b)
-    return Scene(source, tuple(frames), tuple(objects), resolve_frames(frames, robot, source), frozenset(allowed),
-                 state)
+        for a in scene.parts.get(first, (first,)):
+            allowed.update(frozenset((a, b)) for b in scene.parts.get(second, (second,)) if a != b)
+    return replace(scene, allowed=frozenset(allowed))
+
+
+def attach_request_objects(
+    scene: Scene, request: MotionPlanRequest, robot: Robot, q: NDArray[np.float64]
+) -> Scene:
+    """Return `scene` with a request's start_state.attached_collision_objects attached, the robot at `q`.
+
+    As MoveIt applies a request's start state to the planning scene: an object given by id
+    alone takes the world object of that id, where it is; a world object of an attached id
+    leaves the world; an object attached again replaces the first.
+    """
+    if not request.attached:
+        return scene
+    objects = _Objects()
+    id_of = {name: object_id for object_id, names in scene.parts.items() for name in names}
+    frames = {f.name: f for f in scene.frames}
+    for obj in scene.objects:
+        object_id = id_of.get(obj.name, obj.name)  # a moveplan scene's objects are their own ids
+        side = objects.attached if obj.link else objects.world
+        side.setdefault(object_id, ([], [frames[name] for name in scene.subframes.get(object_id, ())]))[0].append(obj)
+    packages = PackagePath(tuple(robot.config.package_paths))
+    _attach(objects, list(request.attached), f"{request.source}: start_state.attached_collision_objects", robot,
+            scene, q, request.source.parent, packages)
+    subframes = {name for names in scene.subframes.values() for name in names}
+    source = str(request.source) if scene.source == empty_scene().source else scene.source
+    return objects.scene(replace(scene, source=source), [f for f in scene.frames if f.name not in subframes], robot)
+
+
+def _attach(
+    objects: _Objects, entries: list[Any], where: str, robot: Robot, fixed: Scene, q: NDArray[np.float64],
+    folder: Path, packages: PackagePath,
+) -> None:
+    """Attach moveit_msgs/AttachedCollisionObject entries to `objects`, as MoveIt attaches them."""
+    for k, value in enumerate(entries):
+        at = f"{where}[{k}]"
+        link, written, touch = attached_object(value, at)
+        if link not in robot.link_names:
+            raise UnknownName("link", link, f"{at}.link_name", robot.link_names)
+        message = collision_object(written, f"{at}.object", folder, packages)
+        world = objects.world.pop(message.id, None)
+        objects.attached.pop(message.id, None)
+        if message.parts:
+            objects.attached[message.id] = _place(message, f"{at}.object", link, robot, fixed, q, touch)
+        elif world is not None:
+            objects.attached[message.id] = _carried(world, link, robot, q, touch)
+        else:
+            raise ConfigError(f"{at}.object: object '{message.id}' has no primitives or meshes, and no world "
+                              f"object has that id to attach (world objects: {', '.join(objects.world) or 'none'})")
 
 
 def _place(
-    value: Any,
-    where: str,
-    link: str,
-    robot: Robot,
-    anchors: dict[str, tuple[str, NDArray[np.float64]]],
-    q: NDArray[np.float64],
+    message: ObjectMessage, where: str, link: str, robot: Robot, fixed: Scene, q: NDArray[np.float64],
     touch_links: tuple[str, ...] = (),
-) -> tuple[str, list[CollisionObject], list[Frame]]:
-    """Return a CollisionObject message's id, parts and subframes, placed with the robot at `q`.
+) -> tuple[list[CollisionObject], list[Frame]]:
+    """Return a CollisionObject message's parts and subframes, placed with the robot at `q`.
 
     `link` is "" for a world object (placed in the planning frame), else the link it is attached to.
     """
-    parsed = _collision_object(value, where, link or robot.root_link)
-    frame_link, link_T_frame = _anchor(parsed.frame, anchors, robot, f"{where}.header.frame_id")
+    frame = message.frame or link or robot.root_link
+    frame_link, link_T_frame = Scene(f"{where}.header.frame_id", (), (), fixed.anchors).anchor(frame, robot)
     root_T_header = robot.frame_pose(q, frame_link) @ link_T_frame
     # MoveIt fixes an attached object to its link where the scene's robot state puts it.
     parent_T_header = np.linalg.inv(robot.frame_pose(q, link)) @ root_T_header if link else root_T_header
-    parent_T_object = parent_T_header @ parsed.header_T_object
+    parent_T_object = parent_T_header @ message.header_T_object
     parts = [CollisionObject(name, shape, parent_T_object @ object_T_shape, link, touch_links)
-             for name, shape, object_T_shape in parsed.parts]
-    subframes = [Frame(f"{parsed.id}/{sub}", link or robot.root_link, parent_T_object @ object_T_sub)
-                 for sub, object_T_sub in parsed.subframes.items()]
-    return parsed.id, parts, subframes
+             for name, shape, object_T_shape in message.parts]
+    subframes = [Frame(f"{message.id}/{sub}", link or robot.root_link, parent_T_object @ object_T_sub)
+                 for sub, object_T_sub in message.subframes.items()]
+    return parts, subframes
+
+
+def _carried(
+    world: tuple[list[CollisionObject], list[Frame]], link: str, robot: Robot, q: NDArray[np.float64],
+    touch_links: tuple[str, ...],
+) -> tuple[list[CollisionObject], list[Frame]]:
+    """Return a world object's parts and subframes fixed to `link` where they are, the robot at `q`."""
+    link_T_root = np.linalg.inv(robot.frame_pose(q, link))
+    parts, subframes = world
+    return ([replace(o, transform=link_T_root @ o.transform, link=link, touch_links=touch_links) for o in parts],
+            [Frame(f.name, link, link_T_root @ f.transform) for f in subframes])
 
 
 def _shape_count(collision_objects: Any, attached: list[Any]) -> int:
@@ -159,13 +230,6 @@ def _shape_count(collision_objects: Any, attached: list[Any]) -> int:
                *(a.get("object") for a in attached if isinstance(a, dict))]
     return sum(len(e.get(key) or ()) if isinstance(e, dict) and isinstance(e.get(key), list) else 0
                for e in entries for key in ("primitives", "meshes"))
-
-
-def _anchor(
-    frame: str, anchors: dict[str, tuple[str, NDArray[np.float64]]], robot: Robot, where: str
-) -> tuple[str, NDArray[np.float64]]:
-    """Return (robot link, `link_T_frame`) of a scene frame or robot link; FrameNotFound names `where`."""
-    return Scene(where, (), (), anchors).anchor(frame, robot)
 
 
 def _warn_ignored(top: dict[str, Any], source: str, robot: Robot) -> None:
@@ -194,8 +258,13 @@ def _check_octomap(value: Any, where: str) -> None:
 
 
 def _fixed_frames(value: Any, source: str, robot: Robot) -> list[Frame]:
-    """Return scene frames from `fixed_frame_transforms` (geometry_msgs/TransformStamped entries)."""
-    frames = []
+    """Return scene frames from `fixed_frame_transforms` (geometry_msgs/TransformStamped entries).
+
+    MoveIt writes each fixed frame F as {header.frame_id: F, child_frame_id: planning frame,
+    transform: planning_T_F}, its planning frame P as {header.frame_id: P, child_frame_id: P}.
+    Names of the planning frame that are no robot link (`world`) are kept as identity frames.
+    """
+    entries = []
     for k, item in enumerate(yaml_list(value, f"{source}: fixed_frame_transforms")):
         where = f"{source}: fixed_frame_transforms[{k}]"
         entry = mapping(item, where)
@@ -203,106 +272,28 @@ def _fixed_frames(value: Any, source: str, robot: Robot) -> list[Frame]:
         child = entry.get("child_frame_id")
         if not isinstance(child, str) or not child.strip("/"):
             raise ConfigError(f"{where}.child_frame_id: expected a frame name, got {child!r}")
-        child = child.lstrip("/")
-        parent = header_frame(entry, where, robot.root_link)
-        parent_T_child = transform(entry.get("transform"), f"{where}.transform")
-        if child == robot.root_link:
-            # MoveIt writes its planning frame among these; it adds nothing if it is the identity.
-            if parent != robot.root_link or not np.allclose(parent_T_child, np.eye(4), atol=1e-9):
-                raise ConfigError(f"{where}: frame '{child}' is the planning frame; "
-                                  "it can only be the identity relative to itself")
-            continue
-        frames.append(Frame(child, parent, parent_T_child))
-    return frames
-
-
-def _collision_object(value: Any, where: str, default_frame: str) -> _Object:
-    """Return a moveit_msgs/CollisionObject's shapes, poses and subframes."""
-    entry = mapping(value, where)
-    check_keys(entry, _OBJECT_KEYS, where)
-    name = entry.get("id")
-    if not isinstance(name, str) or not name:
-        raise ConfigError(f"{where}.id: expected an object name, got {name!r}")
-    operation = entry.get("operation", 0)
-    if isinstance(operation, bool) or operation not in _ADD:
-        raise ConfigError(f"{where}.operation: only ADD (0) describes an object in a scene, got {operation!r} "
-                          "(APPEND 1, REMOVE 2 and MOVE 3 edit a running scene)")
-    if yaml_list(entry.get("planes"), f"{where}.planes"):
-        raise ConfigError(f"{where}.planes: planes are not supported; use a thin box")
-    shapes: list[Shape] = []
-    shape_poses: list[NDArray[np.float64]] = []
-    for key, poses_key, read in (("primitives", "primitive_poses", _primitive), ("meshes", "mesh_poses", _mesh)):
-        items = yaml_list(entry.get(key), f"{where}.{key}")
-        poses = yaml_list(entry.get(poses_key), f"{where}.{poses_key}")
-        if len(poses) != len(items):
-            # MoveIt refuses such an object ("Number of primitive shapes does not match number of poses").
-            raise ConfigError(f"{where}.{poses_key}: object '{name}' has {len(items)} {key} and {len(poses)} "
-                              f"{poses_key}; give one pose per shape")
-        shapes.extend(read(item, f"{where}.{key}[{i}]") for i, item in enumerate(items))
-        shape_poses.extend(pose(p, f"{where}.{poses_key}[{i}]") for i, p in enumerate(poses))
-    if not shapes:
-        raise ConfigError(f"{where}: object '{name}' has no primitives or meshes")
-    header_T_object = pose(entry.get("pose"), f"{where}.pose")
-    if len(shapes) == 1 and is_empty_pose(entry.get("pose"), f"{where}.pose"):
-        # MoveIt: an object with one shape and no pose takes the shape's pose as its own.
-        header_T_object, shape_poses[0] = shape_poses[0], header_T_object
-    parts = tuple((name if len(shapes) == 1 else f"{name}/{i}", shape, shape_T)
-                  for i, (shape, shape_T) in enumerate(zip(shapes, shape_poses, strict=True)))
-    sub_names = string_list(entry.get("subframe_names"), f"{where}.subframe_names")
-    sub_poses = yaml_list(entry.get("subframe_poses"), f"{where}.subframe_poses")
-    if len(sub_names) != len(sub_poses):
-        raise ConfigError(f"{where}.subframe_poses: {len(sub_poses)} poses for {len(sub_names)} subframe_names")
-    subframes = {sub: pose(p, f"{where}.subframe_poses[{i}]")
-                 for i, (sub, p) in enumerate(zip(sub_names, sub_poses, strict=True))}
-    return _Object(name, header_frame(entry, where, default_frame), header_T_object, parts, subframes)
-
-
-def _primitive(value: Any, where: str) -> Shape:
-    """Return the shape of a shape_msgs/SolidPrimitive."""
-    entry = mapping(value, where)
-    check_keys(entry, {"type", "dimensions", "polygon"}, where)
-    kind_value = entry.get("type")
-    kind = _PRIMITIVES.get(kind_value) if isinstance(kind_value, int) and not isinstance(kind_value, bool) else (
-        kind_value.lower() if isinstance(kind_value, str) else None)
-    if kind not in _DIMENSIONS:
-        raise ConfigError(f"{where}.type: unknown primitive type {kind_value!r}; expected box (1), sphere (2), "
-                          "cylinder (3) or cone (4)")
-    dims = entry.get("dimensions")
-    size = len(_DIMENSIONS[kind].split(","))
-    if not isinstance(dims, list) or len(dims) != size:
-        raise ConfigError(f"{where}.dimensions: a {kind} takes {size} number{'s' * (size > 1)} "
-                          f"[{_DIMENSIONS[kind]}], got {dims!r}")
-    values = [number(v, f"{where}.dimensions[{i}]", positive=True) for i, v in enumerate(dims)]
-    if kind == "box":
-        return Shape("box", tuple(values))
-    if kind == "sphere":
-        return Shape("sphere", (values[0],))
-    height, radius = values
-    if kind == "cone":
-        logger.warning("%s: a cone is checked as the cylinder that encloses it", where)
-    return Shape("cylinder", (radius, height))
-
-
-def _mesh(value: Any, where: str) -> Shape:
-    """Return the inline mesh of a shape_msgs/Mesh."""
-    entry = mapping(value, where)
-    check_keys(entry, {"triangles", "vertices"}, where)
-    vertices = [point(v, f"{where}.vertices[{i}]")
-                for i, v in enumerate(yaml_list(entry.get("vertices"), f"{where}.vertices"))]
-    triangles = []
-    for i, item in enumerate(yaml_list(entry.get("triangles"), f"{where}.triangles")):
-        at = f"{where}.triangles[{i}]"
-        if isinstance(item, dict):
-            triangle = mapping(item, at)
-            check_keys(triangle, {"vertex_indices"}, at)
-            item, at = triangle.get("vertex_indices"), f"{at}.vertex_indices"
-        if not (isinstance(item, list) and len(item) == 3
-                and all(isinstance(n, int) and not isinstance(n, bool) and 0 <= n < len(vertices) for n in item)):
-            raise ConfigError(f"{at}: expected 3 indices into vertices (0 to {len(vertices) - 1}), got {item!r}")
-        triangles.append(item)
-    if not triangles:
-        raise ConfigError(f"{where}: a mesh needs vertices and triangles")
-    return Shape("mesh", vertices=np.array(vertices), triangles=np.array(triangles))
+        entries.append((header_frame(entry, where, ""), child.lstrip("/"),
+                        transform(entry.get("transform"), f"{where}.transform"), where))
+    # A frame given relative to itself is MoveIt's planning frame; robowflex leaves that header out.
+    planning = set(planning_frame_names(robot)) | {
+        child for header, child, parent_T_child, _ in entries
+        if header in ("", child) and np.allclose(parent_T_child, np.eye(4), atol=1e-9)}
+    aliases: dict[str, Frame] = {}
+    frames = []
+    for header, child, parent_T_child, where in entries:
+        if child in planning and header in planning | {""}:
+            if not np.allclose(parent_T_child, np.eye(4), atol=1e-9):
+                raise ConfigError(f"{where}: '{header or child}' and '{child}' both name the planning frame; "
+                                  "the transform between them can only be the identity")
+            for name in {header, child} - {"", *robot.link_names}:
+                aliases.setdefault(name, Frame(name, robot.root_link, np.eye(4)))
+        elif child in planning:
+            frames.append(Frame(header, robot.root_link, parent_T_child))
+        elif header == child:
+            raise ConfigError(f"{where}: frame '{child}' relative to itself can only be the identity")
+        else:
+            frames.append(Frame(child, header or robot.root_link, parent_T_child))
+    return [*aliases.values(), *frames]
 
 
 def _allowed_pairs(value: Any, where: str, names: list[str]) -> set[frozenset[str]]:

@@ -26,6 +26,7 @@ class Robot:
     def __init__(self, config: RobotConfig, group: str | None = None) -> None:
         self.config = config
         self.group: Group = config.group(group)
+        config.srdf.plannable(self.group.name, config.srdf_path)  # a floating or planar base: refused
         try:
             self.model = pin.buildModelFromXML(config.urdf)
         except (RuntimeError, ValueError) as exc:
@@ -75,7 +76,7 @@ class Robot:
         return out
 
     def neutral(self) -> NDArray[np.float64]:
-        """Return the configuration where the fake hardware starts (initial_positions, else zero)."""
+        """Return the configuration where the robot starts when no start is given (RobotConfig.initial_positions)."""
         q = np.array(pin.neutral(self.model))
         for joint, value in self.config.initial_positions.items():
             q = self.set_joint(q, joint, value)

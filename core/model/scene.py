@@ -28,7 +28,7 @@ from .robot import Robot
 
 __all__ = [
     "MAX_SCENE_FRAMES", "MAX_SCENE_SHAPES", "PLANNING_SCENE_KEYS", "Scene", "check_shape_count", "empty_scene",
-    "first_repeated", "moveplan_scene", "resolve_frames",
+    "first_repeated", "moveplan_scene", "planning_frame_names", "resolve_frames",
 ]
 
 MAX_SCENE_SHAPES = 10_000
@@ -61,6 +61,8 @@ class Scene:
             collision matrix; the SRDF's disabled pairs come on top).
         robot_state: Joint name -> position in [rad] or [m], the robot state a PlanningScene
             carries (empty for moveplan scenes).
+        parts: PlanningScene object id -> the names of the objects it became (one per shape).
+        subframes: PlanningScene object id -> the names of the frames its subframes became.
     """
 
     source: str
@@ -69,14 +71,33 @@ class Scene:
     anchors: dict[str, tuple[str, NDArray[np.float64]]]
     allowed: frozenset[frozenset[str]] = frozenset()
     robot_state: dict[str, float] = field(default_factory=dict)
+    parts: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    subframes: dict[str, tuple[str, ...]] = field(default_factory=dict)
 
     def anchor(self, frame: str, robot: Robot) -> tuple[str, NDArray[np.float64]]:
-        """Return (robot link, `link_T_frame`) for a scene frame or robot link."""
+        """Return (robot link, `link_T_frame`) for a scene frame, a robot link or a name of the planning frame."""
         if frame in self.anchors:
             return self.anchors[frame]
         if frame in robot.link_names:
             return frame, np.eye(4)
-        raise FrameNotFound(frame, self.source, [*self.anchors, *robot.link_names])
+        planning = planning_frame_names(robot)
+        if frame in planning:
+            return robot.root_link, np.eye(4)
+        raise FrameNotFound(frame, self.source, [*self.anchors, *robot.link_names, *planning])
+
+
+def planning_frame_names(robot: Robot) -> frozenset[str]:
+    """Return the names of the planning frame: the URDF root link, and the frame its SRDF virtual joint hangs from.
+
+    MoveIt's planning frame is that parent frame (`world`) for a floating or planar virtual
+    joint; moveplan plans with the robot at the identity of its virtual joint, so both name it.
+    """
+    names = {robot.root_link}
+    for joint in robot.config.srdf.virtual_joints.values():
+        parent = joint.parent_frame.lstrip("/")
+        if joint.child_link == robot.root_link and parent and parent not in robot.link_names:
+            names.add(parent)
+    return frozenset(names)
 
 
 def empty_scene() -> Scene:

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..bag.bag_writer import atomic_file
 from ..errors import ConfigError, InputError, MoveplanError, NoPlan, UsageError
+from .request import RobotSource
 
 __all__ = ["STAGES", "Problem", "Run", "find_problems", "plot", "run_benchmark", "summarize", "write_csv"]
 
@@ -110,7 +111,7 @@ RunProblem = Callable[[Problem], Run]
 
 
 def run_benchmark(
-    robot: Path,
+    robot: Path | RobotSource,
     problems: Sequence[Problem],
     planners: Sequence[str],
     seeds: Sequence[int],
@@ -167,14 +168,14 @@ def _rebuild(payload: dict[str, Any]) -> Exception:
     return RuntimeError(f"benchmark worker failed: {payload['message']}\n{payload['traceback']}")
 
 
-def _worker(robot: Path, problems: tuple[Problem, ...], planner: str, seed: int, planning_time: float,
+def _worker(robot: Path | RobotSource, problems: tuple[Problem, ...], planner: str, seed: int, planning_time: float,
             results: Any) -> None:
     """Run every problem with one planner and seed, and put each run on `results`."""
     key = (planner, seed)
     try:
         from ..config.robot_config import load_robot_config
 
-        config = load_robot_config(robot)
+        config = robot.load() if isinstance(robot, RobotSource) else load_robot_config(robot)
         for problem in problems:
             results.put(("run", key, asdict(_solve(problem, config, planner, seed, planning_time))))
     except Exception as exc:  # noqa: BLE001 - reported to the parent, which raises it there

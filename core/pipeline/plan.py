@@ -8,6 +8,8 @@ planned in named stages (step.py).
 
 from __future__ import annotations
 
+import json
+import logging
 from importlib.metadata import version
 from pathlib import Path
 
@@ -16,13 +18,15 @@ from numpy.typing import NDArray
 
 from ..bag import write_plan
 from ..collision.motion import MotionChecker, exact_checks, scene_checks
-from ..config import JointGoal, RobotConfig, StartFrom, load_robot_config, load_task
-from ..errors import ConfigError, InputError, MoveplanError, StartInCollision, StartOutsideLimits, UnknownName
+from ..config import JointGoal, NamedGoal, RobotConfig, StartFrom, load_robot_config, load_task
+from ..config.limits import DEFAULT_ACCELERATION
+from ..errors import InputError, MoveplanError, StartInCollision, StartOutsideLimits, UnknownName
 from ..model.moveit_messages import known_joints
+from ..model.planning_scene import attach_request_objects
 from ..model.robot import Robot
 from ..model.scene import Scene, empty_scene
 from ..model.scene_file import load_scene
-from ..planning.goals import joint_target
+from ..planning.goals import check_limits, joint_target
 from ..planning.search import seed_planner
 from ..trajectory import sample
 from ..types import Plan, StepResult, TfSamples
@@ -30,6 +34,8 @@ from .request import PlanFlags, PlanRequest, resolve_request
 from .step import plan_step
 
 __all__ = ["PlanFlags", "PlanRequest", "plan", "plan_to_file", "resolve_request"]
+
+logger = logging.getLogger(__name__)
 
 _TF_RATE_HZ = 30.0
 
@@ -46,19 +52,26 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
     """Return the timed, collision-free plan for every step of `request`, in order.
 
     `config` is the loaded `request.robot` when the caller has it (a benchmark plans many
-    problems with one robot). With `exact_check`, each step's `stats["exact_valid"]` says
-    whether its trajectory is free under the URDF's exact meshes, checked independently of
-    the planner's geometry (1.0 or 0.0).
+    problems with one robot); a config loaded here also warns about the group's joints that
+    plan with the default acceleration limit (limits.DEFAULT_ACCELERATION). With `exact_check`,
+    each step's `stats["exact_valid"]` says whether its trajectory is free under the URDF's
+    exact meshes, checked independently of the planner's geometry (1.0 or 0.0).
 
     Raises:
         MoveplanError: Any error while planning a step carries the step's name (`step`).
     """
     seed_planner(request.seed)
+    loaded_here = config is None
     if config is None:
-        config = load_robot_config(request.robot, request.package_paths, request.xacro_args)
+        config = load_robot_config(request.robot, request.package_paths, request.xacro_args, urdf=request.urdf,
+                                   srdf=request.srdf, strict_limits=request.strict_limits)
     robot = _robot(request, config)
+    if loaded_here:
+        _warn_default_accelerations(config, robot)
     scene = load_scene(request.scene, robot) if request.scene else empty_scene()
     base, current = _start_values(request, robot, scene)
+    if request.motion_request is not None:  # objects the request's start state carries
+        scene = attach_request_objects(scene, request.motion_request, robot, robot.configuration(current, base))
     checks = scene_checks(robot, scene, config.planning["collision"], base)
     pair = checks.colliding_pair(current)
     if pair:
@@ -84,11 +97,17 @@ def _robot(request: PlanRequest, config: RobotConfig) -> Robot:
             if joint not in robot.joint_names:
                 raise UnknownName("joint", joint, f"{motion.source}: goal_constraints[0].joint_constraints "
                                   f"(group '{robot.group.name}')", robot.joint_names)
-    missing = config.missing_acceleration_limits(robot.group.name)
-    if missing:
-        raise ConfigError(f"{config.root}: no acceleration limit for joints {', '.join(missing)} "
-                          "(joint_limits.yaml: has_acceleration_limits, max_acceleration)")
     return robot
+
+
+def _warn_default_accelerations(config: RobotConfig, robot: Robot) -> None:
+    """Log a warning naming the group's joints the config gives no acceleration limit, and the file."""
+    defaulted = config.missing_acceleration_limits(robot.group.name)
+    if defaulted:
+        where = config.sources.get("joint_limits", config.urdf_path)
+        logger.warning("%s: no acceleration limit for joints %s; planning with the default %g rad/s^2 (m/s^2 for "
+                       "a prismatic joint), as MoveIt 1 did (--strict-limits makes this an error)",
+                       where, ", ".join(defaulted), DEFAULT_ACCELERATION)
 
 
 def _start_values(
@@ -96,26 +115,58 @@ def _start_values(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Return the start configuration (all joints) and the group's start values.
 
-    Every joint starts at the initial positions, overridden by the scene's robot state, then
-    by the MoveIt request's start state (MoveIt applies a request's start state on top of the
-    scene's). The group's joints then take a start flag or the task's start, if given.
+    Every joint starts at the initial positions (RobotConfig.initial_positions), overridden by
+    the scene's robot state, then by the MoveIt request's start state (MoveIt applies a request's
+    start state on top of the scene's). The group's joints then take a start flag or the task's
+    start, if given. The group's start is checked against the limits before anything else.
+
+    Raises:
+        StartOutsideLimits: A group joint starts outside its limits; names the joint and where
+            its value came from.
     """
     base = robot.neutral()
-    states = [scene.robot_state]
+    origins = dict(robot.config.initial_sources)
+    layers = [(scene.robot_state, f"{scene.source}: robot_state")]
     if request.motion_request is not None:
         motion = request.motion_request
-        states.append(known_joints(motion.start, robot, f"{motion.source}: start_state.joint_state.name"))
-    for state in states:
+        state = known_joints(motion.start, robot, f"{motion.source}: start_state.joint_state.name")
+        layers.append((state, f"{motion.source}: start_state"))
+    for state, origin in layers:
         for joint, value in state.items():
             base = robot.set_joint(base, joint, value)
-    start = request.start
-    neutral = robot.values(base)
-    if start is None:
-        return base, neutral
+            origins[joint] = origin
+    values = robot.values(base)
+    start, origin = request.start, _start_origin(request)
     if isinstance(start, StartFrom):
         start = _start_from(Path(start.plan), robot)
-    source = str(request.task.source) if request.task else "--start-joints"
-    return base, joint_target(robot, start, neutral, source, StartOutsideLimits)
+    try:
+        if start is None:
+            check_limits(robot, values, StartOutsideLimits)
+            return base, values
+        return base, joint_target(robot, start, values, origin, StartOutsideLimits)
+    except StartOutsideLimits as exc:
+        # A joint the start leaves out keeps its value from the initial positions, scene or request.
+        given = _joints_set_by(robot, start) if start is not None else set()
+        where = origin if exc.joint in given else origins.get(exc.joint, "the initial positions")
+        raise StartOutsideLimits(exc.joint, exc.value, exc.lower, exc.upper, where) from None
+
+
+def _start_origin(request: PlanRequest) -> str:
+    """Return where the request's start comes from, as messages name it: the task file, or a start flag."""
+    start = request.start
+    if request.task is not None and start is request.task.start:
+        return f"{request.task.source}: start"
+    if isinstance(start, StartFrom):
+        return f"--start-from {start.plan}"
+    return f"--start-named {start.name}" if isinstance(start, NamedGoal) else "--start-joints"
+
+
+def _joints_set_by(robot: Robot, start: JointGoal | NamedGoal) -> set[str]:
+    """Return the group joints a start gives a value (the others keep theirs)."""
+    if isinstance(start, NamedGoal):
+        return set(robot.config.srdf.group_states.get(robot.group.name, {}).get(start.name, {}))
+    return set(robot.joint_names if start.named_values is None else start.named_values)
+
 
 
 def _start_from(path: Path, robot: Robot) -> JointGoal:
@@ -178,7 +229,8 @@ def _assemble(
                 for i, j in enumerate(robot.joint_names)},
         attachments=_attachments(config, request),
         metadata={"seed": str(request.seed), "moveplan_version": version("moveplan"),
-                  "planners": ",".join(s.planner for s in steps)},
+                  "planners": ",".join(s.planner for s in steps),
+                  "limit_sources": json.dumps({j: config.limits[j].source for j in robot.joint_names}, sort_keys=True)},
     )
 
 

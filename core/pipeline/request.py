@@ -12,12 +12,23 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TypeVar
 
-from ..config import JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom, StepSpec, TaskFile
+from ..config import (
+    JointGoal,
+    NamedGoal,
+    PoseGoal,
+    RobotConfig,
+    ShiftGoal,
+    Start,
+    StartFrom,
+    StepSpec,
+    TaskFile,
+    load_robot_config,
+)
 from ..config.tasks import MIN_SCALING
 from ..errors import UsageError
 from ..model.moveit_request import MotionPlanRequest, load_motion_plan_request
 
-__all__ = ["PlanFlags", "PlanRequest", "check_planning_time", "resolve_request"]
+__all__ = ["PlanFlags", "PlanRequest", "RobotSource", "check_planning_time", "resolve_request"]
 
 _T = TypeVar("_T")
 
@@ -27,6 +38,33 @@ def check_planning_time(seconds: float, flag: str = "--planning-time") -> float:
     if seconds <= 0:
         raise UsageError(f"{flag}: expected a positive number of seconds, got {seconds:g}")
     return seconds
+
+
+@dataclass(frozen=True)
+class RobotSource:
+    """What loads a robot config: --robot and the flags that complete it, as load_robot_config takes them.
+
+    Picklable, so that a benchmark's worker processes load the same robot.
+
+    Attributes:
+        robot: A shipped name, a moveplan.yaml or its folder, a MoveIt config package, a URDF or SRDF.
+        package_paths: --package-path folders.
+        xacro_args: --xacro-arg values, name -> value.
+        urdf, srdf: --urdf and --srdf: a file or `package://pkg/path`, replacing the config's.
+        strict_limits: --strict-limits: a missing acceleration limit is an error.
+    """
+
+    robot: str | Path
+    package_paths: tuple[Path, ...] = ()
+    xacro_args: Mapping[str, str] = field(default_factory=dict)
+    urdf: str | None = None
+    srdf: str | None = None
+    strict_limits: bool = False
+
+    def load(self) -> RobotConfig:
+        """Return the robot config these arguments name."""
+        return load_robot_config(self.robot, self.package_paths, self.xacro_args, urdf=self.urdf, srdf=self.srdf,
+                                 strict_limits=self.strict_limits)
 
 
 @dataclass(frozen=True)
@@ -56,6 +94,8 @@ class PlanFlags:
         velocity_scaling, acceleration_scaling: Fractions of the limits, in (0, 1].
         package_paths: Folders searched for package:// URIs.
         xacro_args: xacro arguments, name -> value.
+        urdf, srdf: The URDF and SRDF (a file or `package://pkg/path`), replacing the config's.
+        strict_limits: A missing acceleration limit is an error instead of the default.
     """
 
     robot: Path | None = None
@@ -81,6 +121,9 @@ class PlanFlags:
     acceleration_scaling: float | None = None
     package_paths: tuple[Path, ...] = ()
     xacro_args: Mapping[str, str] = field(default_factory=dict)
+    urdf: str | None = None
+    srdf: str | None = None
+    strict_limits: bool = False
 
     def __post_init__(self) -> None:
         starts = [k for k in ("start_joints", "start_named", "start_from") if getattr(self, k) is not None]
@@ -147,6 +190,9 @@ class PlanRequest:
     xacro_args: Mapping[str, str] = field(default_factory=dict)
     task: TaskFile | None = None
     motion_request: MotionPlanRequest | None = None
+    urdf: str | None = None
+    srdf: str | None = None
+    strict_limits: bool = False
 
 
 def resolve_request(task: TaskFile | None, flags: PlanFlags) -> PlanRequest:
@@ -177,6 +223,7 @@ def resolve_request(task: TaskFile | None, flags: PlanFlags) -> PlanRequest:
         seed=_first(flags.seed, task and task.seed) or 0,
         min_fraction=1.0 if flags.min_fraction is None else flags.min_fraction,
         package_paths=flags.package_paths, xacro_args=dict(flags.xacro_args), task=task, motion_request=motion,
+        urdf=flags.urdf, srdf=flags.srdf, strict_limits=flags.strict_limits,
     )
 
 

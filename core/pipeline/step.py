@@ -23,7 +23,7 @@ from ..model.kinematics import solve_ik
 from ..model.robot import Robot
 from ..model.scene import Scene
 from ..planning.cartesian import straight_line
-from ..planning.goals import check_limits, joint_target, pose_error, tip_target
+from ..planning.goals import check_limits, joint_target, orientation_tolerance, pose_error, tip_target
 from ..planning.search import PathResult, Validity, plan_path, repair_path
 from ..timing import rest_to_rest, time_parameterize
 from ..types import JointTrajectory, StepResult
@@ -134,7 +134,8 @@ def _target(
         return _Target(None, link, pose)
     # Exhaustive: the first valid solution from a far start is not always the nearest one.
     solution = solve_ik(robot, pose, link, start, base=base, seed=request.seed, exhaustive=True,
-                        is_free=checks.state_free, colliding_pair=checks.checker.colliding_pair)
+                        orientation_tolerance=orientation_tolerance(goal), is_free=checks.state_free,
+                        colliding_pair=checks.checker.colliding_pair)
     return _Target(solution.values, link, pose)
 
 

@@ -5,10 +5,14 @@ partial (joint: value; the others keep their start values). Named goals are
 SRDF group_states. Every target is checked against the joint limits.
 
 Pose and shift goals become a pose of the tip link in the planning frame,
-evaluated with the robot where the step starts (frames on moving links move).
+evaluated with the robot where the step starts (frames on moving links move). A
+position goal (a MoveIt request's position constraint alone) leaves the orientation
+free: it takes the orientation of the inverse-kinematics solution nearest the start.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 import pinocchio as pin
@@ -16,11 +20,18 @@ from numpy.typing import NDArray
 
 from ..config.goals import JointGoal, NamedGoal, PoseGoal, ShiftGoal
 from ..errors import ConfigError, GoalOutsideLimits, OutsideLimits, UnknownName, UsageError
+from ..model.kinematics import solve_ik
+from ..model.moveit_request import PositionGoal
 from ..model.poses import pose_matrix
 from ..model.robot import Robot
 from ..model.scene import Scene
 
-__all__ = ["check_limits", "joint_target", "named_state", "pose_error", "tip_target"]
+__all__ = [
+    "check_limits", "joint_target", "named_state", "orientation_tolerance", "pose_error", "tip_target",
+]
+
+# [rad]: solve_ik's default, for goals that fix the orientation.
+_ORIENTATION_TOLERANCE = 1e-3
 
 # Goals written at a limit by hand ("3.14" for pi) must not fail on rounding.
 _LIMIT_SLACK = 1e-6
@@ -83,7 +94,11 @@ def _apply(robot: Robot, values: dict[str, float], start: NDArray[np.float64], s
 def tip_target(
     robot: Robot, scene: Scene, goal: PoseGoal | ShiftGoal, q: NDArray[np.float64], source: str
 ) -> tuple[str, NDArray[np.float64]]:
-    """Return (link, `root_T_link`) that a pose or shift goal asks for, from configuration `q`."""
+    """Return (link, `root_T_link`) that a pose or shift goal asks for, from configuration `q`.
+
+    A position goal's orientation is the one where inverse kinematics from `q`, with the
+    orientation free, puts the link (GoalUnreachable when no configuration reaches the position).
+    """
     if isinstance(goal, ShiftGoal):
         return robot.group.tip, _shifted(robot, scene, goal, q)
     link = goal.link or robot.group.tip
@@ -91,7 +106,17 @@ def tip_target(
     anchor, anchor_T_frame = scene.anchor(frame, robot)
     root_T_frame = robot.frame_pose(q, anchor) @ anchor_T_frame
     # What the pose leaves out is the frame's own: no offset, no rotation.
-    return link, root_T_frame @ pose_matrix(goal.xyz, goal.rpy, goal.quat, source)
+    target = root_T_frame @ pose_matrix(goal.xyz, goal.rpy, goal.quat, source)
+    if isinstance(goal, PositionGoal):
+        solution = solve_ik(robot, target, link, robot.values(q), base=q, orientation_tolerance=math.inf)
+        reached = robot.frame_pose(robot.configuration(solution.values, q), link)
+        target[:3, :3] = reached[:3, :3]
+    return link, target
+
+
+def orientation_tolerance(goal: PoseGoal | ShiftGoal) -> float:
+    """Return the orientation error in [rad] inverse kinematics may leave for a goal: inf for a position goal."""
+    return math.inf if isinstance(goal, PositionGoal) else _ORIENTATION_TOLERANCE
 
 
 def _shifted(robot: Robot, scene: Scene, shift: ShiftGoal, q: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -1,0 +1,363 @@
+"""MoveIt config packages loaded as they are: the workspace's packages, .setup_assistant, --urdf/--srdf, lone files."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+import yaml
+from conftest import ROOT, UR10E, Cli
+
+from moveplan.core import bag as recording
+from moveplan.core.config.robot_config import load_robot_config
+from moveplan.core.config.setup_assistant import read_setup_assistant
+from moveplan.core.config.sources import discover, search_path
+from moveplan.core.config.workspace import packages_under, workspace_src
+from moveplan.core.config.xacro import PackagePath
+from moveplan.core.errors import ConfigError, UsageError
+
+WORKSPACE = Path(__file__).resolve().parents[2] / "shared" / "realworld" / "src"
+FANUC = "moveit_resources/fanuc_moveit_config"
+PANDA = "moveit_resources/panda_moveit_config"
+GEN3_LITE = "ros2_kortex/kortex_moveit_config/kinova_gen3_lite_moveit_config"
+GEN3 = "ros2_kortex/kortex_moveit_config/kinova_gen3_7dof_robotiq_2f_85_moveit_config"
+ABB = "abb_ros2/robot_specific_config/abb_irb1200_5_90_moveit_config"
+UR = "Universal_Robots_ROS2_Driver/ur_moveit_config"
+UR_ARGS = ("--urdf", "package://ur_description/urdf/ur.urdf.xacro", "--xacro-arg", "ur_type:=ur5e",
+           "--xacro-arg", "name:=ur")
+MBM = ROOT / "tests" / "data" / "mbm"
+
+URDF = """<?xml version="1.0"?>
+<robot name="arm">
+  <link name="base"/><link name="tip"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="tip"/>
+    <limit lower="-1" upper="1" velocity="2" effort="1"/></joint>
+</robot>
+"""
+SRDF = '<?xml version="1.0"?>\n<robot name="arm"><group name="arm"><joint name="j1"/></group></robot>\n'
+XACRO_SRDF = ('<?xml version="1.0"?>\n<robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+              '<xacro:include filename="{include}"/><group name="arm"><joint name="j1"/></group></robot>\n')
+LIMITS = "joint_limits:\n  j1: {has_acceleration_limits: true, max_acceleration: 3.0}\n"
+
+
+def real(package: str) -> Path:
+    """Return a package folder of the real workspace; the test fails (not skips) without it."""
+    assert WORKSPACE.is_dir(), f"the real MoveIt config workspace is missing: {WORKSPACE}"
+    return WORKSPACE / package
+
+
+def write(folder: Path, files: dict[str, str]) -> Path:
+    for name, text in files.items():
+        (folder / name).parent.mkdir(parents=True, exist_ok=True)
+        (folder / name).write_text(text)
+    return folder
+
+
+@pytest.fixture(autouse=True)
+def no_ros_environment(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    monkeypatch.delenv("AMENT_PREFIX_PATH", raising=False)
+
+
+# --- the real workspace, no environment variables -------------------------------------------------
+
+
+def test_fanuc_config_finds_its_description_package_in_the_workspace(cli: Cli) -> None:
+    code, document = cli.json("robot", real(FANUC))
+    assert code == 0, document
+    assert document["sources"]["urdf"] == str(real(FANUC) / "config" / "fanuc.urdf.xacro")
+    assert document["sources"]["srdf"] == str(real(FANUC) / "config" / "fanuc.srdf")
+    assert list(document["groups"]) == ["manipulator"]
+
+
+def test_panda_config_with_three_srdfs_loads_the_one_setup_assistant_names(cli: Cli) -> None:
+    code, document = cli.json("robot", real(PANDA))
+    assert code == 0, document
+    assert document["sources"]["srdf"] == str(real(PANDA) / "config" / "panda_arm_hand.srdf.xacro")
+    # MoveItConfigsBuilder prefers the package's config/<robot name>.urdf.xacro (the folder names the robot).
+    assert document["sources"]["urdf"] == str(real(PANDA) / "config" / "panda.urdf.xacro")
+    assert list(document["groups"]) == ["panda_arm", "hand", "panda_arm_hand"]
+
+
+def test_gen3_urdf_comes_from_kortex_description_with_the_setup_assistant_xacro_args(cli: Cli) -> None:
+    code, document = cli.json("robot", real(GEN3))
+    assert code == 0, document
+    assert document["sources"]["urdf"] == str(real("ros2_kortex/kortex_description/robots/gen3.xacro"))
+    assert document["xacro_args"] == {"gripper": "robotiq_2f_85", "dof": "7"}
+    assert document["groups"]["manipulator"]["joints"] == [f"joint_{i}" for i in range(1, 8)]
+
+
+def test_a_xacro_arg_flag_overrides_one_setup_assistant_arg_and_keeps_the_others() -> None:
+    config = load_robot_config(real(GEN3), xacro_args={"robot_ip": "10.0.0.2"})
+    assert config.xacro_args == {"gripper": "robotiq_2f_85", "dof": "7", "robot_ip": "10.0.0.2"}
+
+
+def test_gen3_lite_loads_the_urdf_named_like_its_srdf(cli: Cli) -> None:
+    code, document = cli.json("robot", real(GEN3_LITE))
+    assert code == 0, document
+    assert document["sources"]["urdf"] == str(real(GEN3_LITE) / "config" / "gen3_lite.urdf.xacro")
+    assert list(document["groups"]) == ["arm", "gripper"]
+
+
+def test_abb_srdf_the_setup_assistant_names_without_xacro_is_found_with_it() -> None:
+    root = real(ABB)
+    found = discover(root, PackagePath(search_path(root)), {})
+    assert found.paths["srdf"] == root / "config" / "abb_irb1200_5_90.srdf.xacro"
+    assert found.paths["urdf"] == real("abb_ros2/robot_specific_config/abb_irb1200_support/urdf/irb1200_5_90.xacro")
+
+
+def test_ur_config_without_urdf_says_to_pass_urdf(cli: Cli) -> None:
+    result = cli("robot", real(UR))
+    assert result.exit_code == 3, result.stderr
+    assert result.stderr.count("\n") == 1
+    assert f"{real(UR)}: no URDF file" in result.stderr and "pass --urdf FILE" in result.stderr
+
+
+def test_ur_config_with_urdf_from_its_description_package_picks_the_top_srdf_and_plans(
+    cli: Cli, tmp_path: Path
+) -> None:
+    code, document = cli.json("robot", real(UR), *UR_ARGS)
+    assert code == 0, document
+    assert document["sources"]["srdf"] == str(real(UR) / "srdf" / "ur.srdf.xacro")  # not ur_macro.srdf.xacro
+    assert document["sources"]["urdf"] == str(real("Universal_Robots_ROS2_Description/urdf/ur.urdf.xacro"))
+    out = tmp_path / "up.mcap"
+    code, document = cli.json("plan", "--robot", real(UR), *UR_ARGS, "--named", "up", "-o", out)
+    assert code == 0, document
+    assert document["group"] == "ur_manipulator" and out.is_file()
+
+
+def test_a_xacro_arg_without_default_names_the_flag_to_pass(cli: Cli) -> None:
+    result = cli("robot", real(UR), "--urdf", "package://ur_description/urdf/ur.urdf.xacro")
+    assert result.exit_code == 3
+    assert "Undefined substitution argument name" in result.stderr
+    assert "pass --xacro-arg name:=VALUE" in result.stderr
+
+
+def test_a_lone_urdf_without_an_srdf_beside_it_says_to_pass_srdf(cli: Cli) -> None:
+    urdf = real("moveit_resources/panda_description/urdf/panda.urdf")
+    result = cli("robot", urdf)
+    assert result.exit_code == 3, result.stderr
+    assert result.stderr.count("\n") == 1
+    assert f"{urdf}: no SRDF beside it" in result.stderr and "pass --srdf FILE" in result.stderr
+
+
+def test_a_lone_urdf_with_srdf_by_package_uri_loads(cli: Cli) -> None:
+    urdf = real("moveit_resources/panda_description/urdf/panda.urdf")
+    code, document = cli.json("robot", urdf, "--srdf", "package://moveit_resources_panda_moveit_config/config/panda.srdf")
+    assert code == 0, document
+    assert document["sources"]["srdf"] == str(real(PANDA) / "config" / "panda.srdf")
+    assert "panda_arm" in document["groups"]
+
+
+def test_a_lone_srdf_goes_with_the_urdf_of_the_same_name(cli: Cli) -> None:
+    code, document = cli.json("robot", real(FANUC) / "config" / "fanuc.srdf")
+    assert code == 0, document
+    assert document["sources"]["urdf"] == str(real(FANUC) / "config" / "fanuc.urdf.xacro")
+    assert document["sources"]["joint_limits"] == str(real(FANUC) / "config" / "joint_limits.yaml")
+
+
+def test_a_file_that_is_no_robot_config_says_what_robot_takes(cli: Cli) -> None:
+    result = cli("robot", real(FANUC) / "package.xml")
+    assert result.exit_code == 3
+    assert "package.xml: not a robot config; expected a moveplan.yaml" in result.stderr
+    assert "URDF (.urdf, .urdf.xacro, .xacro) or SRDF (.srdf, .srdf.xacro) file" in result.stderr
+    assert "malformed YAML" not in result.stderr
+
+
+def test_urdf_flag_naming_an_srdf_is_a_usage_error(cli: Cli) -> None:
+    result = cli("robot", real(UR), "--urdf", real(UR) / "srdf" / "ur.srdf.xacro")
+    assert result.exit_code == 2
+    assert "an SRDF file; pass it with --srdf" in result.stderr
+
+
+# --- --urdf, --srdf, --strict-limits on every command that loads a robot ---------------------------
+
+
+def test_urdf_flag_wins_over_moveplan_yaml_and_the_plan_embeds_that_urdf(cli: Cli, tmp_path: Path) -> None:
+    urdf = tmp_path / "slow.urdf"
+    text = (UR10E / "ur10e.urdf").read_text()
+    assert 'velocity="2.094"' in text
+    urdf.write_text(text.replace('velocity="2.094"', 'velocity="1.5"'))
+    code, document = cli.json("robot", UR10E, "--urdf", urdf)
+    assert code == 0, document
+    assert document["sources"]["urdf"] == str(urdf)
+    out = tmp_path / "home.mcap"
+    result = cli("plan", "--robot", UR10E, "--urdf", urdf, "--named", "home", "-o", out)
+    assert result.exit_code == 0, result.stderr
+    attachments = recording.read_plan(out).attachments
+    embedded = yaml.safe_load(attachments["moveplan.yaml"])
+    assert 'velocity="1.5"' in attachments[embedded["urdf"]].decode()
+
+
+def test_urdf_and_srdf_flags_are_inputs_an_output_may_not_replace(cli: Cli, tmp_path: Path) -> None:
+    urdf = tmp_path / "arm.urdf"
+    shutil.copy(UR10E / "ur10e.urdf", urdf)
+    result = cli("plan", "--robot", UR10E, "--urdf", urdf, "--named", "home", "-o", urdf)
+    assert result.exit_code == 2
+    assert "is also --urdf" in result.stderr
+    assert urdf.read_text() == (UR10E / "ur10e.urdf").read_text()
+
+
+def test_a_missing_urdf_flag_file_exits_3_naming_it(cli: Cli, tmp_path: Path) -> None:
+    result = cli("robot", UR10E, "--srdf", tmp_path / "nowhere.srdf")
+    assert result.exit_code == 3
+    assert f"--srdf {tmp_path / 'nowhere.srdf'}: file not found" in result.stderr
+
+
+def test_strict_limits_makes_a_missing_acceleration_limit_an_error(cli: Cli, tmp_path: Path) -> None:
+    folder = write(tmp_path, {"arm.urdf": URDF, "arm.srdf": SRDF})
+    assert cli("robot", folder).exit_code == 0
+    result = cli("robot", folder, "--strict-limits")
+    assert result.exit_code == 3, result.stderr
+    assert "no acceleration limit for joints j1" in result.stderr
+    plan = cli("plan", "--robot", folder, "--strict-limits", "--joints", "0.5", "-o", tmp_path / "p.mcap")
+    assert plan.exit_code == 3 and not (tmp_path / "p.mcap").exists()
+
+
+def test_benchmark_loads_the_robot_with_the_flags_in_its_workers(cli: Cli, tmp_path: Path) -> None:
+    robot = MBM / "panda_robot"
+    for name in ("panda.srdf", "joint_limits.yaml"):
+        shutil.copy(robot / name, tmp_path / name)
+    # A lone SRDF without a URDF beside it: a worker loading --robot alone would fail.
+    code, document = cli.json("benchmark", MBM / "problems" / "table_pick_panda", "--robot", tmp_path / "panda.srdf",
+                              "--urdf", robot / "panda.urdf", "--package-path", robot, "--count", 1, "--quiet")
+    assert code == 0, document
+    assert document["runs"][0]["ok"]
+    result = cli("benchmark", MBM / "problems", "--robot", robot, "--srdf", tmp_path / "none.srdf", "--count", 1)
+    assert result.exit_code == 3 and "--srdf" in result.stderr
+
+
+# --- folders without moveplan.yaml: the candidates ------------------------------------------------
+
+
+def test_macro_and_included_srdfs_are_parts_not_robots(tmp_path: Path) -> None:
+    write(tmp_path, {"arm.urdf": URDF, "srdf/robot.srdf.xacro": XACRO_SRDF.format(include="parts.srdf.xacro"),
+                     "srdf/parts.srdf.xacro": '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"/>\n',
+                     "srdf/robot_macro.srdf.xacro": '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"/>\n'})
+    assert load_robot_config(tmp_path).sources["srdf"] == tmp_path / "srdf" / "robot.srdf.xacro"
+
+
+def test_several_srdfs_name_the_files_and_the_flag(tmp_path: Path) -> None:
+    write(tmp_path, {"arm.urdf": URDF, "config/a.srdf": SRDF, "config/b.srdf": SRDF})
+    with pytest.raises(ConfigError, match=r"config: several SRDF files \(a.srdf, b.srdf\); .* or pass --srdf FILE"):
+        load_robot_config(tmp_path)
+    assert load_robot_config(tmp_path, srdf=str(tmp_path / "config" / "b.srdf")).srdf_path.name == "b.srdf"
+
+
+def test_a_urdf_in_robots_is_found_and_its_macro_ignored(tmp_path: Path) -> None:
+    write(tmp_path, {"robots/arm.xacro": URDF, "robots/arm_macro.xacro": "<robot/>", "config/arm.srdf": SRDF})
+    assert load_robot_config(tmp_path).sources["urdf"] == tmp_path / "robots" / "arm.xacro"
+
+
+def test_a_folder_with_only_a_urdf_loads_with_srdf_flag(tmp_path: Path) -> None:
+    write(tmp_path, {"cfg/arm.urdf": URDF, "elsewhere/semantic.srdf": SRDF})
+    config = load_robot_config(tmp_path / "cfg", srdf=str(tmp_path / "elsewhere" / "semantic.srdf"))
+    assert config.sources["urdf"] == tmp_path / "cfg" / "arm.urdf"
+
+
+# --- .setup_assistant ---------------------------------------------------------------------------
+
+
+def setup_package(folder: Path, assistant: str) -> Path:
+    """Write a description package and a config package naming its URDF in .setup_assistant, in a src/ folder."""
+    urdf = URDF.replace('<robot name="arm">', '<robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                        '<xacro:arg name="tool" default="none"/><xacro:arg name="mount" default="0"/>')
+    write(folder / "src", {
+        "arm_description/package.xml": "<package><name>acme_arm_description</name></package>",
+        "arm_description/urdf/arm.urdf.xacro": urdf,
+        "arm_moveit_config/package.xml": "<package><name>arm_moveit_config</name></package>",
+        "arm_moveit_config/config/semantic.srdf.xacro": SRDF,
+        "arm_moveit_config/config/joint_limits.yaml": LIMITS,
+        "arm_moveit_config/.setup_assistant": assistant,
+    })
+    return folder / "src" / "arm_moveit_config"
+
+
+ASSISTANT = """moveit_setup_assistant_config:
+  URDF:
+    package: acme_arm_description
+    relative_path: urdf/arm.urdf.xacro
+    xacro_args:
+      tool:=gripper
+      mount:=1
+  SRDF:
+    relative_path: config/semantic.srdf
+  CONFIG:
+    author_name: someone
+"""
+
+
+def test_setup_assistant_xacro_args_folded_over_lines_are_read_as_moveit_reads_them(tmp_path: Path) -> None:
+    package = setup_package(tmp_path, ASSISTANT)
+    assistant = read_setup_assistant(package)
+    assert assistant is not None
+    assert (assistant.urdf_package, assistant.urdf_path) == ("acme_arm_description", "urdf/arm.urdf.xacro")
+    assert assistant.xacro_args == {"tool": "gripper", "mount": "1"}
+    config = load_robot_config(package, xacro_args={"mount": "2"})
+    assert config.sources["urdf"] == (tmp_path / "src/arm_description/urdf/arm.urdf.xacro").resolve()
+    assert config.sources["srdf"] == package / "config" / "semantic.srdf.xacro"  # named without .xacro
+    assert config.xacro_args == {"tool": "gripper", "mount": "2"}
+
+
+def test_a_setup_assistant_arg_no_xacro_declares_names_the_setup_assistant(tmp_path: Path) -> None:
+    package = setup_package(tmp_path, ASSISTANT.replace("mount:=1", "mounting:=1"))
+    with pytest.raises(ConfigError, match=r"\.setup_assistant: xacro_args: xacro arg 'mounting' is not declared"):
+        load_robot_config(package)
+    urdf = tmp_path / "src" / "arm_description" / "urdf" / "arm.urdf.xacro"
+    assert load_robot_config(package, urdf=str(urdf)).xacro_args == {}  # its args are for its own URDF
+
+
+def test_a_malformed_setup_assistant_arg_is_a_config_error_naming_the_file(tmp_path: Path) -> None:
+    package = setup_package(tmp_path, ASSISTANT.replace("tool:=gripper", "tool=gripper"))
+    with pytest.raises(ConfigError, match=r"\.setup_assistant: moveit_setup_assistant_config.urdf.xacro_args: "
+                                          r"'tool=gripper': expected name:=value"):
+        load_robot_config(package)
+
+
+def test_a_setup_assistant_package_not_found_names_the_file_and_the_search_path(tmp_path: Path) -> None:
+    package = setup_package(tmp_path, ASSISTANT.replace("package: acme_arm_description", "package: acme_arm"))
+    with pytest.raises(ConfigError, match=r"\.setup_assistant: moveit_setup_assistant_config.urdf.package: "
+                                          r"package 'acme_arm' not found; searched in order: "):
+        load_robot_config(package)
+
+
+# --- packages: the workspace around the config --------------------------------------------------
+
+
+def test_a_config_outside_a_src_folder_does_not_search_beside_itself(tmp_path: Path) -> None:
+    package = setup_package(tmp_path, ASSISTANT)
+    shutil.move(tmp_path / "src", tmp_path / "source")
+    with pytest.raises(ConfigError, match=r"package 'acme_arm_description' not found"):
+        load_robot_config(tmp_path / "source" / package.name)
+
+
+def test_the_workspace_comes_after_package_path_flags_and_before_ros_package_path(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "env"))
+    config = tmp_path / "ws" / "src" / "repo" / "cfg"
+    config.mkdir(parents=True)
+    folders = search_path(config, (tmp_path / "flag",), (tmp_path / "yaml",))
+    assert folders[:5] == (config, tmp_path / "yaml", tmp_path / "flag", (tmp_path / "ws" / "src").resolve(),
+                           tmp_path / "env")
+    assert workspace_src(tmp_path / "ws") is None
+
+
+def test_packages_are_found_as_colcon_finds_them(tmp_path: Path) -> None:
+    def package(path: str, name: str) -> dict[str, str]:
+        return {f"{path}/package.xml": f"<package><name>{name}</name></package>"}
+
+    write(tmp_path / "src", {
+        **package("a/b/c/deep", "deep_pkg"), **package("outer", "outer_pkg"), **package("outer/inner", "inner_pkg"),
+        **package("build/built", "built_pkg"), **package(".hidden/pkg", "hidden_pkg"),
+        **package("ignored/pkg", "ignored_pkg"), "ignored/COLCON_IGNORE": "",
+    })
+    found = packages_under(tmp_path / "src")
+    assert dict(found) == {"deep_pkg": tmp_path / "src/a/b/c/deep", "outer_pkg": tmp_path / "src/outer"}
+
+
+def test_usage_error_for_urdf_flag_names_the_flag(tmp_path: Path) -> None:
+    write(tmp_path, {"arm.urdf": URDF, "arm.srdf": SRDF})
+    with pytest.raises(UsageError, match=r"--srdf .*arm.urdf: a URDF file; pass it with --urdf"):
+        load_robot_config(tmp_path, srdf=str(tmp_path / "arm.urdf"))
