@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import re
+import shutil
+from pathlib import Path
+
 import numpy as np
 import pytest
-from conftest import ROOT, TABLE_SCENE
+from conftest import ROOT, TABLE_SCENE, Cli
 
 from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.config.robot_config import load_robot_config
@@ -54,3 +58,14 @@ def test_a_hull_sinking_a_fraction_of_a_millimetre_into_a_box_collides_as_its_me
         checker = CollisionChecker(robot, scene.objects, scene.source, geometry=geometry, allowed=scene.allowed)
         assert not checker.free_batch(q[:, None])[0], geometry
         assert checker.colliding_pair(q) == ("panda_hand", "Object4")
+
+
+def test_a_robot_without_collision_geometry_plans(cli: Cli, tmp_path: Path) -> None:
+    """A bare kinematic model (no <collision> anywhere) has nothing to collide: MoveIt plans it."""
+    source = Path(__file__).parent / "data" / "controller_substitutions" / "prefixed_arm"
+    shutil.copytree(source, tmp_path / "arm")
+    urdf = tmp_path / "arm" / "arm.urdf.xacro"
+    urdf.write_text(re.sub(r"<collision>.*?</collision>", "", urdf.read_text(), flags=re.S))
+    result = cli("plan", "--robot", tmp_path / "arm", "--joints", "left_shoulder_joint=0.5", "-o", tmp_path / "p.mcap")
+    assert result.exit_code == 0, result.stderr
+    assert (tmp_path / "p.mcap").stat().st_size > 0

@@ -52,6 +52,8 @@ def _fit(model: pin.Model, hulls: pin.GeometryModel) -> SphereSet:
         radii.append(r)
         joints.append(np.full(len(r), obj.parentJoint, dtype=np.int64))
         owners.extend([str(model.frames[obj.parentFrame].name)] * len(r))
+    if not radii:  # a robot without collision geometry
+        return SphereSet(np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=np.int64), ())
     return SphereSet(np.concatenate(centres).reshape(-1, 3), np.concatenate(radii),
                      np.concatenate(joints), tuple(owners))
 

@@ -78,11 +78,12 @@ def robot_spheres(model: pin.Model, geometry: pin.GeometryModel, urdf: str) -> S
             share = max(1, round(_MOST * area / link_area[owner])) if link_area[owner] > 0 else _MOST
             parts.append(_placed(obj, *_fit_triangles(*surface, share)))
         joints = [obj.parentJoint for obj in objects]
+        # A robot without collision geometry (a bare kinematic model) has no spheres.
         spheres = SphereSet(
             np.concatenate([c for c, _ in parts]), np.concatenate([r for _, r in parts]),
             np.concatenate([np.full(len(r), j) for (_, r), j in zip(parts, joints, strict=True)]),
             tuple(o for (_, r), o in zip(parts, owners, strict=True) for _ in range(len(r))),
-        )
+        ) if parts else SphereSet(np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=np.int64), ())
         disk_cache.write(path, spheres)
     _CACHE[key] = spheres
     return spheres
