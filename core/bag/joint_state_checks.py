@@ -1,12 +1,14 @@
 """Checks of joint state samples as read: their order in time, and joints with no finite position.
 
 A recording whose times go back far, or whose joint was never measured, gives no check
-worth trusting: both are input errors naming the message and the joint.
+worth trusting: both are input errors naming the message and the joint. Both checks run
+batch by batch as the messages stream in, so that no check needs the whole recording held.
 """
 
 from __future__ import annotations
 
 import logging
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -14,70 +16,102 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from ..types import TimeSource
 
-__all__ = ["Indices", "check_finite", "check_order", "seconds_text"]
+__all__ = ["REORDER_LIMIT_NS", "OrderWatch", "finite_error", "seconds_text"]
 
 logger = logging.getLogger(__name__)
 
-# How far [ns] a time may go back from one message to the next and still count as a
-# reordering (two publishers' messages crossing in transport: milliseconds) rather than a
-# clock that went back (a restarted simulation, a clock step: chrony and ntpd step the
-# clock only for offsets above 128 ms by default, and slew it below).
-_REORDER_LIMIT_NS = 50_000_000
-
-Indices = list[tuple[int, int | NDArray[np.int64]]]
-"""Which messages of the topic the stored rows are, per batch: (rows, first index or indices)."""
+REORDER_LIMIT_NS = 50_000_000
+"""How far [ns] a time may go back from one message to the next and still count as a
+reordering (two publishers' messages crossing in transport: milliseconds) rather than a
+clock that went back (a restarted simulation, a clock step: chrony and ntpd step the
+clock only for offsets above 128 ms by default, and slew it below)."""
 
 
-def check_order(times: NDArray[np.int64], indices: Indices, time_source: TimeSource, where: str) -> None:
-    """Warn of times that go back a little in the topic's order; raise if one goes back far.
+@dataclass
+class OrderWatch:
+    """Times that go back from message to message, watched batch by batch in the topic's order.
 
-    Rows are stored per layout within a batch, so their order is restored first: only
-    times that go back from message to message count.
+    A message is behind when its time is earlier than the latest time before it; its lag is
+    by how much. Kept: how many are behind, the first of them, and the one furthest behind
+    (the first such) with the message holding the latest time before it (its first holder).
+    Messages are numbered as the topic's messages in the file, from 0.
     """
-    index = _indices(indices, len(times))
-    if np.any(index[1:] < index[:-1]):
-        order = np.argsort(index, kind="stable")
-        times, index = times[order], index[order]
-    lag = np.maximum.accumulate(times) - times
-    behind = np.flatnonzero(lag > 0)
-    if len(behind) == 0:
-        return
-    what = "header stamp" if time_source == "header" else "log time"
-    worst = int(behind[np.argmax(lag[behind])])
-    if lag[worst] > _REORDER_LIMIT_NS:
-        ahead = int(np.argmax(times[:worst]))
-        raise InputError(
-            f"{where} message {index[worst]} has a {what} "
-            f"{lag[worst] / 1e9:.3f} s earlier than message {index[ahead]} before it "
-            f"({seconds_text(int(times[worst]))} after {seconds_text(int(times[ahead]))}): a clock "
-            f"that went back, or two publishers of these joints on one topic")
-    first = int(behind[0])
-    logger.warning(
-        "%s: %d messages have a %s earlier than a message before them, by at most "
-        "%.3g ms (the first: message %d); samples sorted by %s", where, len(behind), what,
-        lag[worst] / 1e6, index[first], what)
 
+    latest: int = 0
+    latest_index: int = -1
+    behind: int = 0
+    first_behind: int = -1
+    worst_lag: int = 0
+    worst: tuple[int, int, int, int] = (0, 0, 0, 0)  # (index, time, ahead index, ahead time)
 
-def check_finite(positions: NDArray[np.float64], joints: tuple[str, ...], where: str) -> None:
-    """Raise InputError if a joint has no finite position in any message."""
-    if len(positions) == 0 or np.isfinite(positions[0]).all():
-        return  # every joint has a finite sample: the usual case costs one row
-    for column in np.flatnonzero(~np.isfinite(positions[0])).tolist():
-        if not np.isfinite(positions[:, column]).any():
-            joint = joints[column]
+    def add(self, times: NDArray[np.int64], indices: NDArray[np.int64]) -> None:
+        """Take the next messages' times [ns], in the topic's order, with their message numbers."""
+        if len(times) == 0:
+            return
+        start = times[0] if self.latest_index < 0 else self.latest
+        reach = np.maximum.accumulate(np.concatenate(([start], times)))[1:]
+        lag = reach - times
+        late = np.flatnonzero(lag > 0)
+        if len(late):
+            self.behind += len(late)
+            if self.first_behind < 0:
+                self.first_behind = int(indices[late[0]])
+            worst = int(late[np.argmax(lag[late])])
+            if int(lag[worst]) > self.worst_lag:
+                self.worst_lag = int(lag[worst])
+                self.worst = (int(indices[worst]), int(times[worst]),
+                              *self._holder(int(reach[worst]), times[:worst], indices))
+        top = int(reach[-1])
+        if self.latest_index < 0 or top > self.latest:
+            self.latest_index = int(indices[int(np.argmax(times == top))])
+            self.latest = top
+
+    def advance(self, times: NDArray[np.int64], indices: NDArray[np.int64]) -> None:
+        """Take the next messages' times [ns] when they are non-decreasing and none is behind."""
+        top = int(times[-1])
+        if self.latest_index < 0 or top > self.latest:
+            self.latest_index = int(indices[int(np.searchsorted(times, top, side="left"))])
+            self.latest = top
+
+    def _holder(self, value: int, earlier: NDArray[np.int64], indices: NDArray[np.int64]) -> tuple[int, int]:
+        """Return the first message before the current one holding `value`, and its time."""
+        if self.latest_index >= 0 and self.latest == value:
+            return self.latest_index, value
+        return int(indices[int(np.argmax(earlier == value))]), value
+
+    def report(self, time_source: TimeSource, where: str) -> None:
+        """Warn of times that go back a little; raise InputError if one goes back far."""
+        if self.behind == 0:
+            return
+        what = "header stamp" if time_source == "header" else "log time"
+        index, time_ns, ahead, ahead_ns = self.worst
+        if self.worst_lag > REORDER_LIMIT_NS:
             raise InputError(
-                f"{where} has no finite position of joint {joint} in "
-                f"any of its {len(positions)} messages (message 0: {positions[0, column]})")
+                f"{where} message {index} has a {what} {self.worst_lag / 1e9:.3f} s earlier than "
+                f"message {ahead} before it ({seconds_text(time_ns)} after "
+                f"{seconds_text(ahead_ns)}): a clock that went back, or two publishers of these "
+                "joints on one topic")
+        logger.warning(
+            "%s: %d messages have a %s earlier than a message before them, by at most "
+            "%.3g ms (the first: message %d); samples sorted by %s", where, self.behind, what,
+            self.worst_lag / 1e6, self.first_behind, what)
 
 
-def _indices(pieces: Indices, count: int) -> NDArray[np.int64]:
-    """Return the topic message index of each of `count` stored rows."""
-    index = np.empty(count, dtype=np.int64)
-    at = 0
-    for rows, where in pieces:
-        index[at : at + rows] = np.arange(where, where + rows) if isinstance(where, int) else where
-        at += rows
-    return index
+def finite_error(
+    finite: NDArray[np.bool_], first_row: NDArray[np.float64], joints: tuple[str, ...], count: int,
+    where: str,
+) -> InputError | None:
+    """Return the error for the first joint with no finite position in any message, or None.
+
+    `finite` says per joint whether any message had a finite position; `first_row` is the
+    first sample in time, whose value the message quotes.
+    """
+    missing = np.flatnonzero(~finite)
+    if len(missing) == 0:
+        return None
+    column = int(missing[0])
+    return InputError(f"{where} has no finite position of joint {joints[column]} in any of its "
+                      f"{count} messages (message 0: {first_row[column]})")
 
 
 def seconds_text(stamp_ns: int) -> str:

@@ -1,9 +1,12 @@
-"""Joint states from any MCAP file: sensor_msgs/msg/JointState messages as numpy columns.
+"""Joint states from any bag: sensor_msgs/msg/JointState messages as numpy columns.
 
 Fast enough for hour-long 1 kHz recordings: core.bag.topic_reader hands over a topic's
-payloads chunk by chunk, and the rows whose bytes up to the position array equal a
-template row's (same frame_id, same names, same array sizes) are decoded together with
-numpy. Rows laid out differently get their own template, or are decoded one by one.
+payloads chunk by chunk (MCAP) or batch by batch (rosbag2 sqlite3), and the rows whose
+bytes up to the position array equal a template row's (same frame_id, same names, same
+array sizes) are decoded together with numpy. Rows laid out differently get their own
+template, or are decoded one by one. Decoded rows go to temporary files batch by batch
+(core.bag.sample_store): `open_joint_states` hands back a store read by row ranges, whose
+memory does not grow with the recording; `read_joint_states` loads it all.
 The CDR layout itself is core.bag.jointstate_cdr's, which also encodes payloads
 (`encode_joint_states`, re-exported here with JOINT_STATE_TYPE and JointStateSeries).
 """
@@ -20,7 +23,7 @@ from numpy.typing import NDArray
 
 from ..errors import CorruptData, InputError, known
 from ..types import JointStateSeries, TimeSource
-from .joint_state_checks import check_finite, check_order, seconds_text
+from .joint_state_checks import seconds_text
 from .jointstate_cdr import (
     JOINT_STATE_TYPE,
     JointStateLayout,
@@ -28,10 +31,13 @@ from .jointstate_cdr import (
     encode_joint_states,
     parse_layout,
 )
-from .sample_columns import SampleColumns
+from .sample_store import JointStateStore, SampleSpool
 from .topic_reader import Channel, byte_rows, read_topic
 
-__all__ = ["JOINT_STATE_TYPE", "JointStateSeries", "encode_joint_states", "read_joint_states"]
+__all__ = [
+    "JOINT_STATE_TYPE", "JointStateSeries", "JointStateStore", "encode_joint_states", "open_joint_states",
+    "read_joint_states",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -47,7 +53,22 @@ def read_joint_states(
     time_source: TimeSource = "header",
     velocities: bool = True,
 ) -> JointStateSeries:
-    """Return the joint states recorded on `topic`, columns in the order of `joints`.
+    """Return the joint states recorded on `topic`, columns in the order of `joints`, in memory.
+
+    As `open_joint_states`, with every sample loaded: for short recordings and tests.
+    """
+    with open_joint_states(path, topic, joints, time_source, velocities) as store:
+        return store.series()
+
+
+def open_joint_states(
+    path: str | Path,
+    topic: str = "/joint_states",
+    joints: Sequence[str] | None = None,
+    time_source: TimeSource = "header",
+    velocities: bool = True,
+) -> JointStateStore:
+    """Return the joint states recorded on `topic` as a store read by row ranges (close it after use).
 
     Messages may list joints in any order and carry extra joints. Messages that lack one
     of `joints` (another publisher on the same topic, a gripper) are skipped, with a
@@ -55,16 +76,17 @@ def read_joint_states(
     before it (two publishers' messages crossing) with a warning, further back is an error.
 
     Args:
-        path: An MCAP file, or a rosbag2 folder whose *.mcap files are read in split order.
+        path: An MCAP or rosbag2 sqlite3 (.db3) file, or a rosbag2 bag folder whose split
+            files are read in order.
         topic: The sensor_msgs/msg/JointState topic.
         joints: Joints to keep, in column order; None = those of the first message.
         time_source: "header" for header.stamp (falls back to log time, with a warning,
-            when every stamp is zero), "log" for the MCAP log time (receive time).
-        velocities: False to leave the recorded velocities unread (series.velocities is None):
-            an hour at 1 kHz holds 170 MB of them.
+            when every stamp is zero), "log" for the bag's log time (receive time).
+        velocities: False to leave the recorded velocities unread (store.has_velocities is
+            False): an hour at 1 kHz holds 170 MB of them.
 
     Raises:
-        InputError: The file is missing, not MCAP, truncated or corrupt; the topic is
+        InputError: The file is missing, of no bag kind, truncated or corrupt; the topic is
             absent (the message lists the topics present) or not JointState; or no
             message carries all of `joints` (the message lists the joints present); a
             message names a joint twice; a time goes back more than 50 ms; or a wanted
@@ -74,19 +96,21 @@ def read_joint_states(
     if time_source not in ("header", "log"):
         raise ValueError(f"time_source must be 'header' or 'log', got {time_source!r}")
     source = Path(path)
-    decoder = _Decoder(source, topic, tuple(joints) if joints is not None else None, velocities)
+    decoder = _Decoder(source, topic, tuple(joints) if joints is not None else None, velocities,
+                       time_source)
     read_topic(source, topic, decoder)
-    return decoder.series(time_source)
+    return decoder.store(time_source)
 
 
 class _Decoder:
     """Collects decoded columns across chunks and files: the MessageSink of read_topic."""
 
     def __init__(
-        self, source: Path, topic: str, joints: tuple[str, ...] | None, velocities: bool = True
+        self, source: Path, topic: str, joints: tuple[str, ...] | None, velocities: bool = True,
+        time_source: TimeSource = "header",
     ) -> None:
         self.source, self.topic, self.joints = source, topic, joints
-        self.columns = SampleColumns(velocities)
+        self.columns = SampleSpool(velocities, time_source)
         # The layout of the last rows decoded together, and a row laid out so.
         self.template: tuple[NDArray[np.uint8], JointStateLayout] | None = None
         self.joint_columns: dict[tuple[str, ...], NDArray[np.intp] | None] = {}
@@ -107,8 +131,11 @@ class _Decoder:
             check_definition(path, topic, channel.schema_data)
 
     def reserve(self, count: int) -> None:
-        """Expect about `count` more messages."""
-        self.columns.reserve(count)
+        """Expect about `count` more messages: nothing to do, the samples go to disk as they come."""
+
+    def wants_log_times(self) -> bool:
+        """Return True while log times may be used: as the time source, or while every stamp is zero."""
+        return self.columns.wants_log_times
 
     def add_rows(self, rows: NDArray[np.uint8], log_times: NDArray[np.int64]) -> bool:
         """Decode payloads of equal length, one per row; return False if they differ in layout."""
@@ -123,6 +150,7 @@ class _Decoder:
         first = self.messages
         self.messages += len(rows)
         self._add_rows(rows, template[1], log_times, first)
+        self.columns.end_batch()
         return True
 
     def add(
@@ -135,6 +163,7 @@ class _Decoder:
         remaining = np.arange(len(starts))
         for _ in range(_MAX_LAYOUTS):
             if len(remaining) == 0:
+                self.columns.end_batch()
                 return
             template = self._layout(buf, int(starts[remaining[0]]), int(lengths[remaining[0]]))
             if not template.little:
@@ -150,6 +179,7 @@ class _Decoder:
             remaining = remaining[~matched[remaining]]
         self._add_each(buf, starts[remaining], lengths[remaining], log_times[remaining],
                        first + remaining)
+        self.columns.end_batch()
 
     def _layout(self, buf: NDArray[np.uint8], start: int, length: int) -> JointStateLayout:
         try:
@@ -233,8 +263,8 @@ class _Decoder:
                                 np.array(velocities, dtype=np.float64) if complete else None,
                                 np.array(kept, dtype=np.int64))
 
-    def series(self, time_source: TimeSource) -> JointStateSeries:
-        """Return the collected samples as a series, sorted by time."""
+    def store(self, time_source: TimeSource) -> JointStateStore:
+        """Return the collected samples as a store, sorted by time."""
         source = self.source
         if self.columns.count == 0:
             wanted = self.joints or ()
@@ -250,33 +280,15 @@ class _Decoder:
             logger.warning("%s: skipped %d of %d messages on %s that lack one of the joints %s",
                            source, self.skipped, self.messages, self.topic,
                            ", ".join(self.joints or ()))
-        times, log_times, positions, velocities, indices = self.columns.take()
-        if time_source == "log" or not times.any():
-            if time_source == "header":
-                logger.warning("%s: every header stamp on %s is zero; using log times", source,
-                               self.topic)
-                time_source = "log"
-            times = log_times
-        del log_times
+        if time_source == "header" and not self.columns.nonzero_stamp:
+            logger.warning("%s: every header stamp on %s is zero; using log times", source,
+                           self.topic)
+            time_source = "log"
         if not self.columns.all_velocities and self.columns.some_velocities:
             logger.warning("%s: only some messages on %s carry velocities; ignoring velocities",
                            source, self.topic)
-        if np.any(times[1:] < times[:-1]):
-            check_order(times, indices, time_source, f"{self.source}: {self.topic}")
-            order = np.argsort(times, kind="stable")
-            times, positions = times[order], positions[order]
-            velocities = velocities[order] if velocities is not None else None
-        check_finite(positions, tuple(self.joints or ()), f"{self.source}: {self.topic}")
-        start_ns = int(times[0])
-        times -= start_ns  # in place: a fresh hour-long array costs more in page faults
-        times_s = times / 1e9
-        for array in (times_s, positions, velocities):
-            if array is not None:
-                array.setflags(write=False)
-        return JointStateSeries(tuple(self.joints or ()), times_s, positions, velocities, start_ns,
-                                time_source, str(source))
-
-
+        return self.columns.store(time_source, tuple(self.joints or ()), str(source),
+                                  f"{source}: {self.topic}")
 
 
 def _matches(rows: np.ndarray, template: np.ndarray, layout: JointStateLayout) -> NDArray[np.bool_]:

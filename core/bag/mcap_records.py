@@ -19,21 +19,29 @@ from numpy.typing import NDArray
 from ..errors import CorruptData, InputError
 
 __all__ = [
+    "ATTACHMENT",
     "CHANNEL",
     "CHUNK",
     "DATA_AT",
     "FOOTER",
+    "HEADER",
     "MAGIC",
     "MESSAGE",
+    "MESSAGE_INDEX",
+    "METADATA",
     "MESSAGE_FIXED",
     "RECORD_HEAD",
     "SCHEMA",
     "ChunkIndex",
     "Codecs",
     "Summary",
+    "attachment_name",
+    "channel_metadata",
     "channel_record",
     "chunk_records",
+    "header_record",
     "message_index",
+    "metadata_name",
     "read_summary",
     "schema_record",
     "walk",
@@ -41,8 +49,8 @@ __all__ = [
 ]
 
 MAGIC = b"\x89MCAP0\r\n"
-FOOTER, SCHEMA, CHANNEL, MESSAGE, CHUNK, MESSAGE_INDEX, CHUNK_INDEX = 2, 3, 4, 5, 6, 7, 8
-STATISTICS = 11
+HEADER, FOOTER, SCHEMA, CHANNEL, MESSAGE, CHUNK, MESSAGE_INDEX, CHUNK_INDEX = 1, 2, 3, 4, 5, 6, 7, 8
+ATTACHMENT, STATISTICS, METADATA = 9, 11, 12
 RECORD_HEAD = 9  # opcode u8 + length u64
 FOOTER_SIZE = RECORD_HEAD + 20 + len(MAGIC)
 # A Message record: head, channel_id u16, sequence u32, log_time u64, publish_time u64, data.
@@ -143,6 +151,39 @@ def channel_record(content: memoryview) -> tuple[int, int, str, str]:
     topic, offset = _string(content, 4)
     encoding, _ = _string(content, offset)
     return channel_id, schema_id, topic, encoding
+
+
+def channel_metadata(content: memoryview) -> dict[str, str]:
+    """Return the metadata map of the Channel record `content`."""
+    _, offset = _string(content, 4)
+    _, offset = _string(content, offset)
+    (size,) = struct.unpack_from("<I", content, offset)
+    end, offset = offset + 4 + size, offset + 4
+    if end > len(content):
+        raise CorruptData("a channel's metadata runs past its record")
+    metadata = {}
+    while offset < end:
+        key, offset = _string(content, offset)
+        value, offset = _string(content, offset)
+        metadata[key] = value
+    return metadata
+
+
+def header_record(content: memoryview) -> tuple[str, str]:
+    """Return profile and library of the Header record `content`."""
+    profile, offset = _string(content, 0)
+    library, _ = _string(content, offset)
+    return profile, library
+
+
+def metadata_name(content: memoryview) -> str:
+    """Return the name of the Metadata record `content`."""
+    return _string(content, 0)[0]
+
+
+def attachment_name(content: memoryview) -> str:
+    """Return the name of the Attachment record `content` (after its log and create times)."""
+    return _string(content, 16)[0]
 
 
 def _chunk_index(content: memoryview) -> ChunkIndex:

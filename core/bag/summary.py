@@ -1,19 +1,24 @@
-"""What `moveplan inspect` shows of any MCAP file: profile, topics with types and counts, time range.
+"""What `moveplan inspect` shows of any bag: profile, topics with types and counts, time range.
 
-Taken from the summary section's statistics when they are complete, else counted in one
-linear pass (an unfinished or damaged file).
+Of an MCAP file, taken from the summary section's statistics when they are complete, else
+counted in one linear pass (an unfinished or damaged file) through the message indexes
+that follow each chunk (core.bag.mcap_linear). Of a rosbag2 sqlite3 file, counted by
+SQLite. Of a bag folder, its split files' summaries merged.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import IO
 
 from mcap.reader import SeekingReader
 from mcap.records import Channel, Header, Schema
 
-from .mcap_scan import DAMAGE, open_mcap, scan
+from .bag_files import bag_files
+from .db3 import db3_info, open_db3, topic_counts
+from .mcap_linear import survey
+from .mcap_scan import DAMAGE, open_mcap
 from .qos import durability
 
 __all__ = ["BagSummary", "TopicSummary", "summarize"]
@@ -45,30 +50,68 @@ class BagSummary:
 
 
 def summarize(path: Path) -> BagSummary:
-    """Return profile, topics, counts, time range, metadata and attachment names of an MCAP file.
+    """Return profile, topics, counts, time range, metadata and attachment names of a bag.
 
-    Uses the summary section's statistics when present, else counts in one linear pass.
+    `path` is an MCAP or rosbag2 sqlite3 (.db3) file, or a bag folder (its splits merged).
+    An MCAP file's summary section is used when complete, else it is counted in one pass.
 
     Raises:
-        InputError: The file is missing, not MCAP, truncated or corrupt.
+        InputError: A file is missing, of neither kind, truncated or corrupt.
 
     """
+    summaries = [_db3_summary(file.path) if file.storage == "sqlite3" else _mcap_summary(file.path)
+                 for file in bag_files(path)]
+    return summaries[0] if len(summaries) == 1 else _merged(summaries)
+
+
+def _mcap_summary(path: Path) -> BagSummary:
+    """Return the summary of one MCAP file: from its summary section, else counted."""
     with open_mcap(path) as stream:
         indexed = _summary_from_index(stream)
         if indexed is not None:
             return indexed
-        contents = scan(path, stream, keep_topics=())
-    return _bag_summary(
-        contents.header or Header(profile="", library=""),
-        contents.start_ns,
-        contents.end_ns,
-        [
-            (channel, contents.schemas.get(channel.schema_id), contents.counts[channel.id])
-            for channel in contents.channels.values()
-        ],
-        tuple(record.name for record in contents.metadata),
-        tuple(record.name for record in contents.attachments),
-    )
+        size = stream.seek(0, 2)
+        found = survey(path, stream, size)
+    topics = [
+        TopicSummary(topic, found.schemas.get(schema_id, ""), encoding, found.counts.get(channel_id, 0),
+                     durability(metadata.get("offered_qos_profiles", "")))
+        for channel_id, (topic, schema_id, encoding, metadata) in found.channels.items()
+    ]
+    return BagSummary(found.profile, found.library, found.start_ns, found.end_ns,
+                      (found.end_ns - found.start_ns) / 1e9,
+                      tuple(sorted(topics, key=lambda topic: topic.topic)),
+                      tuple(found.metadata), tuple(found.attachments))
+
+
+def _db3_summary(path: Path) -> BagSummary:
+    """Return the summary of one rosbag2 sqlite3 file, its messages counted by SQLite."""
+    with open_db3(path) as connection:
+        info = db3_info(connection, path)
+        counts, start_ns, end_ns = topic_counts(connection, [t.id for t in info.topics])
+    schema = f", schema version {info.schema_version}" if info.schema_version else ""
+    distro = f", {info.ros_distro}" if info.ros_distro else ""
+    topics = [TopicSummary(t.name, t.type, t.serialization_format, counts.get(t.id, 0),
+                           durability(t.offered_qos_profiles)) for t in info.topics]
+    return BagSummary("ros2", f"rosbag2 sqlite3 storage{schema}{distro}", start_ns, end_ns,
+                      (end_ns - start_ns) / 1e9, tuple(sorted(topics, key=lambda topic: topic.topic)),
+                      (), ())
+
+
+def _merged(summaries: list[BagSummary]) -> BagSummary:
+    """Return the summary of a bag folder's splits: counts added, time range spanning theirs."""
+    topics: dict[tuple[str, str, str], TopicSummary] = {}
+    for summary in summaries:
+        for topic in summary.topics:
+            key = (topic.topic, topic.type, topic.encoding)
+            known = topics.get(key)
+            topics[key] = topic if known is None else replace(known, count=known.count + topic.count)
+    timed = [s for s in summaries if any(t.count for t in s.topics)] or summaries[:1]
+    start_ns, end_ns = min(s.start_ns for s in timed), max(s.end_ns for s in timed)
+    first = summaries[0]
+    return BagSummary(first.profile, first.library, start_ns, end_ns, (end_ns - start_ns) / 1e9,
+                      tuple(sorted(topics.values(), key=lambda topic: topic.topic)),
+                      tuple(dict.fromkeys(n for s in summaries for n in s.metadata)),
+                      tuple(n for s in summaries for n in s.attachments))
 
 
 def _summary_from_index(stream: IO[bytes]) -> BagSummary | None:

@@ -1,4 +1,4 @@
-"""One topic's messages from MCAP files in bulk, handed to a sink chunk by chunk.
+"""One topic's messages from MCAP or rosbag2 sqlite3 files in bulk, handed to a sink chunk by chunk.
 
 The generic MCAP readers spend their time in per-message Python (mcap-ros2-support reads
 ~22 k messages/s, rosbags ~50 k/s). `read_topic` reads the summary's chunk indexes, then
@@ -6,7 +6,10 @@ per chunk one read, one decompression (zstd, lz4 or none) and the chunk's Messag
 offsets of the topic's channels, and hands a sink the message payloads as numpy bytes: a
 (messages, bytes) view of the chunk where the records lie back to back with one length,
 else offsets and lengths into it. A file without a usable summary (a recording that was
-cut off, or written without one) is read by a linear scan, with a warning.
+cut off, or written without one) is read by a linear scan (core.bag.mcap_linear), with a
+warning: chunk by chunk through the MessageIndex records that follow each chunk. A .db3
+file is read a batch of messages at a time (core.bag.db3). Only the current chunk or batch
+is held: memory does not grow with the recording.
 
 The records are core.bag.mcap_records' to parse, without the mcap package. Chunk CRCs
 are not checked, as rosbag2 writes none (CRC 0) by default; decompression and the
@@ -16,7 +19,6 @@ record structure still catch damaged chunks.
 from __future__ import annotations
 
 import logging
-import re
 import struct
 from dataclasses import dataclass, field
 from io import BufferedReader
@@ -29,12 +31,13 @@ from numpy.lib.stride_tricks import as_strided, sliding_window_view
 from numpy.typing import NDArray
 
 from ..errors import CorruptData, InputError
+from .bag_files import MCAP_MAGIC, bag_files
+from .db3 import db3_info, db3_messages, open_db3
+from .mcap_linear import CUT, DataRecord, Definitions, data_records
 from .mcap_records import (
     CHANNEL,
     CHUNK,
     DATA_AT,
-    FOOTER,
-    MAGIC,
     MESSAGE,
     MESSAGE_FIXED,
     RECORD_HEAD,
@@ -79,6 +82,10 @@ class MessageSink(Protocol):
         """Expect about `count` more messages, as the file's statistics count them."""
         ...
 
+    def wants_log_times(self) -> bool:
+        """Return False if the log times of the next payloads are not needed (zeros will do)."""
+        ...
+
     def add_rows(self, rows: NDArray[np.uint8], log_times: NDArray[np.int64]) -> bool:
         """Take payloads of one length, a row each; return False to take them through `add`."""
         ...
@@ -95,18 +102,23 @@ def read_topic(source: Path, topic: str, sink: MessageSink) -> None:
     """Hand every message on `topic` to `sink`, file by file, in file order.
 
     Args:
-        source: An MCAP file, or a rosbag2 folder whose *.mcap files are read in split order.
+        source: An MCAP or rosbag2 sqlite3 (.db3) file, or a rosbag2 bag folder whose
+            split files are read in order (core.bag.bag_files).
         topic: The topic to read.
         sink: Checks the topic's channels, then takes their payloads.
 
     Raises:
-        InputError: A file is missing, not MCAP or corrupt; the topic is absent (the
-            message lists the topics present) or has no messages; or `sink` refused a channel.
+        InputError: A file is missing, neither MCAP nor sqlite3, or corrupt; the topic is
+            absent (the message lists the topics present) or has no messages; or `sink`
+            refused a channel.
 
     """
     reader = _Reader(topic, sink)
-    for file in _files(source):
-        reader.read_file(file)
+    for file in bag_files(source):
+        if file.storage == "sqlite3":
+            reader.read_db3(file.path)
+        else:
+            reader.read_file(file.path)
     if not reader.topics.get(topic):
         present = ", ".join(f"{t} ({m})" for t, m in sorted(reader.topics.items())) or "(none)"
         cut = f" ({reader.cut[0]})" if reader.cut else ""
@@ -126,24 +138,6 @@ def byte_rows(buf: NDArray[np.uint8], starts: NDArray[np.int64], length: int) ->
                                                  strides=(stride, 1), writeable=False)
             return view
     return sliding_window_view(buf, length)[starts]
-
-
-def _files(source: Path) -> list[Path]:
-    """Return the MCAP files to read: `source` itself, or a rosbag2 folder's splits in order."""
-    if source.is_dir():
-        files = sorted(source.glob("*.mcap"), key=_split_order)
-        if not files:
-            raise InputError(f"{source}: folder holds no .mcap file")
-        return files
-    if not source.exists():
-        raise InputError(f"{source}: file not found")
-    return [source]
-
-
-def _split_order(path: Path) -> tuple[str, int]:
-    """Return a sort key putting rosbag2 splits name_0, name_1, ..., name_10 in order."""
-    match = re.fullmatch(r"(.*?)(\d+)", path.stem)
-    return (match.group(1), int(match.group(2))) if match else (path.stem, -1)
 
 
 @dataclass
@@ -171,7 +165,7 @@ class _Reader:
         with stream:
             size = stream.seek(0, 2)
             stream.seek(0)
-            if stream.read(len(MAGIC)) != MAGIC:
+            if stream.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
                 raise InputError(
                     f"{path}: not an MCAP file (it does not start with the MCAP magic)")
             # Channel and schema ids are per file.
@@ -184,10 +178,34 @@ class _Reader:
                     if summary is None:
                         logger.warning(
                             "%s: no summary index (an unfinished or cut-off recording?); reading "
-                            "it by a linear scan, which is slower", path)
+                            "it by a linear scan", path)
                     _read_linear(stream, size, self)
             except CorruptData as exc:
                 raise InputError(f"{path}: corrupt MCAP data: {exc}") from None
+
+    def read_db3(self, path: Path) -> None:
+        """Read one rosbag2 sqlite3 file, a batch of messages at a time."""
+        self.path = path
+        with open_db3(path) as connection:
+            ids = []
+            for topic in db3_info(connection, path).topics:
+                self.topics.setdefault(topic.name, topic.type)
+                if topic.name == self.topic:
+                    self.sink.check(path, Channel(topic.name, topic.serialization_format, topic.type,
+                                                  topic.definition_encoding, topic.definition))
+                    ids.append(topic.id)
+            if not ids:
+                return
+            try:
+                for batch in db3_messages(connection, path, ids, self.sink.wants_log_times):
+                    count = len(batch.starts)
+                    if batch.length and self.sink.add_rows(batch.buf.reshape(count, batch.length),
+                                                           batch.log_times):
+                        self.messages += count
+                    else:
+                        self.add(batch.buf, batch.starts, batch.lengths, batch.log_times)
+            except CorruptData as exc:
+                raise InputError(f"{path}: corrupt message data: {exc}") from None
 
     def select(
         self, schemas: dict[int, tuple[str, str, bytes]], channels: dict[int, tuple[int, str, str]]
@@ -312,9 +330,8 @@ def _decode_walked(buf: NDArray[np.uint8], wanted: set[int], reader: _Reader) ->
 
 
 def _read_linear(stream: IO[bytes], size: int, reader: _Reader) -> None:
-    """Read the topic's messages record by record from the start; stop at a cut record."""
-    position = len(MAGIC)
-    stream.seek(position)
+    """Read the topic's messages from the start, chunk by chunk; stop at a cut record."""
+    definitions = Definitions(stream, reader.learn, reader.codecs)
     batch: list[bytes] = []
     batch_times: list[int] = []
 
@@ -327,33 +344,39 @@ def _read_linear(stream: IO[bytes], size: int, reader: _Reader) -> None:
             batch.clear()
             batch_times.clear()
 
-    while position < size:
-        head = stream.read(RECORD_HEAD)
-        if len(head) < RECORD_HEAD:
-            reader.cut_at(position)
+    for record in data_records(stream, size):
+        if record.opcode == CUT:
+            reader.cut_at(record.position)
             break
-        opcode, length = struct.unpack("<BQ", head)
-        if opcode == FOOTER:
-            break
-        if position + RECORD_HEAD + length > size:
-            reader.cut_at(position)
-            break
-        if opcode in (SCHEMA, CHANNEL):
-            reader.learn(opcode, memoryview(stream.read(length)))
-        elif opcode == MESSAGE:
-            content = stream.read(length)
-            channel_id, _, log_time = struct.unpack_from("<HIQ", content)
+        if record.opcode in (SCHEMA, CHANNEL):
+            definitions.take(record.opcode, memoryview(record.content))
+        elif record.opcode == MESSAGE and len(record.content) >= MESSAGE_FIXED:
+            channel_id, _, log_time = struct.unpack_from("<HIQ", record.content)
             if channel_id in reader.wanted:
-                batch.append(content[MESSAGE_FIXED:])
+                batch.append(record.content[MESSAGE_FIXED:])
                 batch_times.append(log_time)
                 if len(batch) >= _BATCH:
                     flush()
-        elif opcode == CHUNK:
-            raw = memoryview(head + stream.read(length))
-            buf = chunk_records(raw, position, reader.codecs)
+        elif record.opcode == CHUNK:
             flush()
-            _decode_walked(buf, set(reader.wanted), reader)
-        else:
-            stream.seek(length, 1)
-        position += RECORD_HEAD + length
+            _read_chunk(record, definitions, reader)
     flush()
+
+
+def _read_chunk(record: DataRecord, definitions: Definitions, reader: _Reader) -> None:
+    """Hand over the wanted messages of a chunk met in a linear scan, through its message indexes."""
+    walked = definitions.chunk(record)
+    indexes = record.indexes
+    if indexes is None:
+        assert walked is not None  # a chunk without message indexes is always walked
+        _decode_walked(walked, set(reader.wanted), reader)
+        return
+    ids = [c for c in indexes if c in reader.wanted]
+    if not ids:
+        return
+    buf = walked if walked is not None else definitions.records(record)
+    index = indexes[ids[0]]
+    if len(ids) > 1:
+        index = np.concatenate([indexes[c] for c in ids])
+        index = index[np.argsort(index[:, 1], kind="stable")]
+    _decode_records(buf, index[:, 1].astype(np.int64), index[:, 0], reader, record.position)

@@ -19,20 +19,25 @@ largest joint distance, shortest angle for continuous joints, in [rad]:
   moves starts at its first sample. A robot already departing at the recording's first
   sample (its rest is not recorded) is aligned by where it leaves the zone instead: the
   goal started as long before that as the plan takes to leave it.
+
+Scans over the whole recording (departures, gaps) read it block by block through
+core.control.check_samples, carrying the zone state from block to block: the result is
+the same for any cut into blocks, and a recording of a shift is never held whole.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError, known
-from ..trajectory import sample, shortest_angular_distance
-from ..types import JointStateSeries, JointTrajectory
+from ..errors import InputError
+from ..trajectory import sample
+from ..types import JointTrajectory
+from .check_samples import SCAN_ROWS, Samples
 from .tolerances import position_error
 
 __all__ = [
@@ -62,7 +67,6 @@ _MAX_GAPS = 1000
 # Several cycles of the same plan cannot overlap: the controller follows the plan's timing.
 _MIN_CYCLE_FRACTION = 0.9
 _LOOKBACK_PAD_S = 0.05
-_DISTANCE_BLOCK = 16384
 
 
 @dataclass(frozen=True)
@@ -114,93 +118,36 @@ class StepProfile:
         return self._times_to[distance]
 
 
-@dataclass(frozen=True)
-class Samples:
-    """The recorded samples, read in a controller's joint order.
-
-    Attributes:
-        times: Sample times in [s] from the recording's first sample.
-        positions: The recording's positions, in its own column order.
-        columns: The recording's column of each controller joint.
-        continuous: Per controller joint, whether its distances wrap around.
-        period_s: The median time between samples in [s] (0 without two distinct times).
-
-    """
-
-    times: NDArray[np.float64]
-    positions: NDArray[np.float64]
-    columns: NDArray[np.intp]
-    continuous: NDArray[np.bool_]
-    period_s: float
-
-    @staticmethod
-    def build(
-        series: JointStateSeries, joints: Sequence[str], continuous_joints: Iterable[str]
-    ) -> Samples:
-        """Return `series` read in the order of `joints`; InputError if one is missing."""
-        missing = [j for j in joints if j not in series.names]
-        if missing:
-            raise InputError(
-                f"{series.source or 'the recording'}: no joint {', '.join(missing)} in the "
-                f"recording; joints present: {known(series.names)}")
-        columns = np.array([series.names.index(j) for j in joints], dtype=np.intp)
-        names = set(continuous_joints)
-        continuous = np.array([j in names for j in joints])
-        return Samples(series.times_s, series.positions, columns, continuous,
-                       _median_period(series.times_s))
-
-    def rows(self, begin: int, end: int) -> NDArray[np.float64]:
-        """Return the positions of samples [begin, end) in controller order."""
-        return self.positions[begin:end][:, self.columns]
-
-    def spans(self, begins: Sequence[int], ends: Sequence[int]) -> NDArray[np.float64]:
-        """Return the positions of samples [begins[i], ends[i]) end to end, in controller order."""
-        block = np.concatenate([self.positions[b:e] for b, e in zip(begins, ends, strict=True)])
-        if np.array_equal(self.columns, np.arange(self.positions.shape[1])):
-            return block
-        return block[:, self.columns]
-
-    def distance(self, begin: int, end: int, point: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Return per sample in [begin, end) the largest joint distance to `point` in [rad]."""
-        result = np.zeros(end - begin)
-        # Block by block: a block's columns stay in cache, where the columns of an hour-long
-        # recording would be read from memory once per joint.
-        with np.errstate(invalid="ignore"):  # a non-finite sample is far from any point
-            self._distance(begin, end, point, result)
-        return result
-
-    def _distance(
-        self, begin: int, end: int, point: NDArray[np.float64], result: NDArray[np.float64]
-    ) -> None:
-        for at in range(begin, end, _DISTANCE_BLOCK):
-            block = self.positions[at : min(at + _DISTANCE_BLOCK, end)]
-            out = result[at - begin : at - begin + len(block)]
-            for j, column in enumerate(self.columns):
-                values = block[:, column]
-                if self.continuous[j]:
-                    gap = np.abs(shortest_angular_distance(point[j], values))
-                else:
-                    gap = np.abs(values - point[j])
-                np.maximum(out, gap, out=out)
-
 
 def find_gaps(samples: Samples, warnings: list[str]) -> tuple[tuple[float, float], ...]:
-    """Return (start_s, length_s) of pauses longer than GAP_FACTOR median periods.
+    """Return (start_s, length_s) of the first pauses longer than GAP_FACTOR median periods.
 
     Appends a warning naming the longest to `warnings` when there are any.
     """
-    times, period = samples.times, samples.period_s
+    period = samples.period_s
     if period <= 0.0:
         return ()
-    steps = np.diff(times)
-    found = np.flatnonzero(steps > GAP_FACTOR * period)
-    if len(found):
-        longest = int(found[np.argmax(steps[found])])
+    found = 0
+    longest = (-math.inf, 0.0)  # (length, start) of the first longest
+    gaps: list[tuple[float, float]] = []
+    previous = np.zeros(0)
+    for _, times in samples.time_blocks():
+        joined = np.concatenate((previous, times))
+        steps = np.diff(joined)
+        where = np.flatnonzero(steps > GAP_FACTOR * period)
+        if len(where):
+            found += len(where)
+            worst = int(where[np.argmax(steps[where])])
+            if steps[worst] > longest[0]:
+                longest = (float(steps[worst]), float(joined[worst]))
+            gaps += [(float(joined[i]), float(steps[i])) for i in where[: _MAX_GAPS - len(gaps)]]
+        previous = times[-1:]
+    if found:
         warnings.append(
-            f"{len(found)} gap(s) in the recording longer than {GAP_FACTOR:g} median sample "
-            f"periods ({period * 1e3:.3g} ms), the longest {steps[longest]:.3f} s at "
-            f"{times[longest]:.3f} s: the tolerances are not checked inside them")
-    return tuple((float(times[i]), float(steps[i])) for i in found[:_MAX_GAPS])
+            f"{found} gap(s) in the recording longer than {GAP_FACTOR:g} median sample "
+            f"periods ({period * 1e3:.3g} ms), the longest {longest[0]:.3f} s at "
+            f"{longest[1]:.3f} s: the tolerances are not checked inside them")
+    return tuple(gaps)
 
 
 def first_start(samples: Samples, profile: StepProfile) -> tuple[float, str]:
@@ -209,20 +156,19 @@ def first_start(samples: Samples, profile: StepProfile) -> tuple[float, str]:
     How: "departure", "first departure" (never rested near the first point) or
     "first sample" (never moved, or the step does not move).
     """
-    count = len(samples.times)
     if not profile.moves:
-        return float(samples.times[0]), "first sample"
-    home = profile.trajectory.positions[0]
-    distance = samples.distance(0, count, home)
-    exits, dwell = _exits(distance, profile.zone_in, profile.zone_out, inside_at_first=False)
-    if len(exits):
+        return samples.first_time, "first sample"
+    zone = _Zone(profile.zone_in, profile.zone_out, inside_at_first=False)
+    for at, distance in samples.distances(0, samples.count, profile.trajectory.positions[0]):
+        if len(zone.feed(at, distance)):
+            break
+    if zone.exits:
+        exits, dwell = zone.result()
         return _departure_start(samples, profile, int(exits[0]), int(dwell[0])), "departure"
     # Never rested near the first point (the start check will say so), or never left it.
-    rest = samples.rows(0, 1)[0]
-    moved = samples.distance(0, count, rest)
-    departure = _crossing(samples.times, moved, profile.threshold, 0)
+    departure = _first_crossing(samples, samples.rows(0, 1)[0], profile.threshold)
     if departure is None:
-        return float(samples.times[0]), "first sample"
+        return samples.first_time, "first sample"
     return departure - profile.time_to(profile.threshold), "first departure"
 
 
@@ -235,25 +181,30 @@ def cycle_starts(samples: Samples, profiles: Sequence[StepProfile]) -> list[floa
 
     """
     profile = profiles[0]
-    times, count = samples.times, len(samples.times)
     if not profile.moves:
         raise InputError("the plan's first step does not move: executions cannot be told apart")
-    home = profile.trajectory.positions[0]
-    distance = samples.distance(0, count, home)
-    exits, dwell = _exits(distance, profile.zone_in, profile.zone_out, inside_at_first=False)
-    if len(exits) == 0:
-        closest = int(np.argmin(distance))
+    zone = _Zone(profile.zone_in, profile.zone_out, inside_at_first=False)
+    closest = (math.inf, 0)  # (distance, index): np.argmin's choice, the first NaN if any
+    for at, distance in samples.distances(0, samples.count, profile.trajectory.positions[0]):
+        zone.feed(at, distance)
+        nearest = int(np.argmin(distance))
+        value = float(distance[nearest])
+        if not math.isnan(closest[0]) and (math.isnan(value) or value < closest[0]):
+            closest = (value, at + nearest)
+    if not zone.exits:
         raise InputError(
             f"no execution of the plan found: the robot never rests within {profile.zone_in:g} "
             f"rad of the plan's first point and then leaves it (closest approach "
-            f"{distance[closest]:.4g} rad at {times[closest]:.3f} s)")
+            f"{closest[0]:.4g} rad at {samples.time(closest[1]):.3f} s)")
     cycle_s = sum(p.trajectory.duration_s for p in profiles)
     starts: list[float] = []
     accepted_exit = -math.inf
+    exits, dwell = zone.result()
     for exit_index, lower in zip(exits.tolist(), dwell.tolist(), strict=True):
-        if times[exit_index] - accepted_exit < _MIN_CYCLE_FRACTION * cycle_s:
+        exit_time = samples.time(exit_index)
+        if exit_time - accepted_exit < _MIN_CYCLE_FRACTION * cycle_s:
             continue
-        accepted_exit = float(times[exit_index])
+        accepted_exit = exit_time
         starts.append(_departure_start(samples, profile, exit_index, lower))
     return starts
 
@@ -266,33 +217,23 @@ def next_start(
     Samples at indices >= `end` are not searched. How: "departure" or "previous step".
     """
     after = max(after, 0)
-    fallback = float(samples.times[min(after, len(samples.times) - 1)])
+    fallback = samples.time(min(after, samples.count - 1))
     if not profile.moves or after >= end - 1:
         return fallback, "previous step"
     # Searched in growing windows: the robot usually departs soon. Without an exit in a
     # window the robot is still inside at its end, so the next window starts inside.
-    times, begin = samples.times, after
+    begin = after
     window = profile.time_to(profile.zone_out + profile.zone_in) + 1.0
     while begin < end:
-        stop = min(end, int(np.searchsorted(times, times[begin] + window, side="right")) + 1)
+        stop = min(end, samples.search(samples.time(begin) + window, side="right") + 1,
+                   begin + SCAN_ROWS)
         distance = samples.distance(begin, stop, profile.trajectory.positions[0])
-        exits, _ = _exits(distance, profile.zone_in, profile.zone_out, inside_at_first=True)
+        zone = _Zone(profile.zone_in, profile.zone_out, inside_at_first=True)
+        exits = zone.feed(begin, distance)
         if len(exits):
-            return _departure_start(samples, profile, begin + int(exits[0]), after), "departure"
+            return _departure_start(samples, profile, int(exits[0]), after), "departure"
         begin, window = stop, 4.0 * window
     return fallback, "previous step"
-
-
-def _median_period(times: NDArray[np.float64]) -> float:
-    """Return the median time between samples in [s], over up to 100 000 spread intervals."""
-    every = max(1, len(times) // 100_000)
-    steps = times[every::every] - times[every - 1 : -1 : every]
-    steps = np.sort(steps[steps > 0.0])
-    if len(steps) == 0:
-        return 0.0
-    # np.median's rule: np.median itself imports numpy.ma, 40 ms of every command's start-up.
-    middle = len(steps) // 2
-    return float(steps[middle] if len(steps) % 2 else (steps[middle - 1] + steps[middle]) / 2)
 
 
 def _crossing(
@@ -310,33 +251,71 @@ def _crossing(
     return float(times[k - 1] + min(max(fraction, 0.0), 1.0) * (times[k] - times[k - 1]))
 
 
-def _exits(
-    distance: NDArray[np.float64], zone_in: float, zone_out: float, inside_at_first: bool
-) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """Return sample indices where the robot leaves the zone, and where it last entered it.
+def _first_crossing(samples: Samples, point: NDArray[np.float64], level: float) -> float | None:
+    """Return `_crossing` of the distances of every sample to `point`, scanned block by block."""
+    for at, distance in samples.distances(0, samples.count, point):
+        above = np.flatnonzero(distance > level)
+        if len(above):
+            k = at + int(above[0])
+            if k == 0:
+                return samples.first_time
+            return _crossing(samples.times(k - 1, k + 1), samples.distance(k - 1, k + 1, point),
+                             level, 0)
+    return None
+
+
+@dataclass
+class _Zone:
+    """Where the robot leaves and enters a zone, found block by block of its distances to it.
 
     Hysteresis: inside is within `zone_in`, outside beyond `zone_out`; in between the
     previous state holds, so noise at the boundary does not count as many departures.
     """
-    event = np.zeros(len(distance), dtype=np.int8)
-    event[distance <= zone_in] = 1
-    event[distance > zone_out] = -1
-    # The state changes only where a run of samples inside (1) or outside (-1) begins:
-    # each such run is compared with the one before it, not each sample (an hour-long
-    # recording holds millions of samples and a few thousand runs).
-    runs = np.flatnonzero(event[1:] != event[:-1]) + 1
-    if len(event):
-        runs = np.concatenate(([0], runs))
-    changes = runs[event[runs] != 0]
-    now = event[changes]
-    before = np.concatenate(([1 if inside_at_first else 0], now[:-1]))
-    exits = changes[(now == -1) & (before == 1)]
-    entries = changes[(now == 1) & (before != 1)]
-    dwell = np.zeros(len(exits), dtype=np.intp)
-    if len(entries):
-        found = np.searchsorted(entries, exits, side="right") - 1
-        dwell = np.where(found >= 0, entries[np.maximum(found, 0)], 0)
-    return exits, dwell
+
+    zone_in: float
+    zone_out: float
+    inside_at_first: bool
+    exits: list[int] = field(default_factory=list)
+    entries: list[int] = field(default_factory=list)
+    _state: int = 0
+    _last: int | None = None
+
+    def __post_init__(self) -> None:
+        self._state = 1 if self.inside_at_first else 0
+
+    def feed(self, at: int, distance: NDArray[np.float64]) -> NDArray[np.intp]:
+        """Take the distances of samples from index `at` on; return the exits found among them."""
+        if len(distance) == 0:
+            return np.zeros(0, dtype=np.intp)
+        event = np.zeros(len(distance), dtype=np.int8)
+        event[distance <= self.zone_in] = 1
+        event[distance > self.zone_out] = -1
+        # The state changes only where a run of samples inside (1) or outside (-1) begins:
+        # each such run is compared with the one before it, not each sample (an hour-long
+        # recording holds millions of samples and a few thousand runs).
+        runs = np.flatnonzero(event[1:] != event[:-1]) + 1
+        if self._last is None or event[0] != self._last:
+            runs = np.concatenate(([0], runs))
+        self._last = int(event[-1])
+        changes = runs[event[runs] != 0]
+        now = event[changes]
+        before = np.concatenate(([self._state], now[:-1]))
+        exits = at + changes[(now == -1) & (before == 1)]
+        self.exits += exits.tolist()
+        self.entries += (at + changes[(now == 1) & (before != 1)]).tolist()
+        if len(now):
+            self._state = int(now[-1])
+        return exits
+
+    def result(self) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+        """Return the exits, and for each where the robot last entered the zone before it (0 if never)."""
+        exits = np.array(self.exits, dtype=np.intp)
+        entries = np.array(self.entries, dtype=np.intp)
+        dwell = np.zeros(len(exits), dtype=np.intp)
+        if len(entries):
+            found = np.searchsorted(entries, exits, side="right") - 1
+            dwell = np.where(found >= 0, entries[np.maximum(found, 0)], 0)
+        return exits, dwell
 
 
 def _departure_start(samples: Samples, profile: StepProfile, exit_index: int, lower: int) -> float:
@@ -345,21 +324,21 @@ def _departure_start(samples: Samples, profile: StepProfile, exit_index: int, lo
     The robot rested before it: the sample taken as rest is far enough before the exit
     for the plan to have been still, and not before `lower`.
     """
-    times = samples.times
     lookback = profile.time_to(profile.zone_out + profile.zone_in) + _LOOKBACK_PAD_S
     lookback += 3.0 * samples.period_s
-    rest = int(np.searchsorted(times, times[exit_index] - lookback, side="left"))
+    exit_time = samples.time(exit_index)
+    rest = samples.search(exit_time - lookback, side="left")
     rest = min(max(rest, lower), exit_index)
     moved = samples.distance(rest, exit_index + 1, samples.rows(rest, rest + 1)[0])
-    departure = _crossing(times[rest : exit_index + 1], moved, profile.threshold, 0)
+    departure = _crossing(samples.times(rest, exit_index + 1), moved, profile.threshold, 0)
     if departure is None:
-        departure = float(times[exit_index])
+        departure = exit_time
     start = departure - profile.time_to(profile.threshold)
-    if rest == 0 and start < times[0]:
+    if rest == 0 and start < samples.first_time:
         # Moving already at the first sample, which is then no rest to measure from.
         home = profile.trajectory.positions[0]
         away = samples.distance(0, exit_index + 1, home)
-        leaves = _crossing(times[: exit_index + 1], away, profile.zone_out, 0)
+        leaves = _crossing(samples.times(0, exit_index + 1), away, profile.zone_out, 0)
         if leaves is not None:
             start = min(start, leaves - profile.time_to(profile.zone_out))
     return start

@@ -6,12 +6,10 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
-import numpy as np
-from numpy.typing import NDArray
-
 from ..config.controllers import ControllerConfig, ExecutionConfig
-from ..types import JointStateSeries, JointTrajectory
-from .alignment import ZONE_RAD, Samples, StepProfile
+from ..types import JointTrajectory
+from .alignment import ZONE_RAD, StepProfile
+from .check_samples import Samples, SampleSource
 from .tolerances import SegmentTolerances, in_controller_order, segment_tolerances, velocity_error_computable
 
 __all__ = ["CheckContext", "CheckedPlan", "CheckedStep"]
@@ -46,9 +44,8 @@ class CheckContext:
     """Everything the checks share, computed once.
 
     Attributes:
-        samples: The recorded positions in controller order, with their times.
+        samples: The recorded positions (and velocities) in controller order, with their times.
         profiles: Per step of the plan, its trajectory in controller order and how it departs.
-        velocities: The recorded velocities in the recording's column order, or None.
         check_velocities: True if JTC computes velocity errors and the recording has velocities.
         controller: The JointTrajectoryController whose tolerances apply.
         execution: MoveIt's trajectory_execution settings.
@@ -58,7 +55,6 @@ class CheckContext:
 
     samples: Samples
     profiles: tuple[StepProfile, ...]
-    velocities: NDArray[np.float64] | None
     check_velocities: bool
     controller: ControllerConfig
     execution: ExecutionConfig
@@ -67,11 +63,11 @@ class CheckContext:
 
     @staticmethod
     def build(
-        plan: CheckedPlan, series: JointStateSeries, controller: ControllerConfig,
+        plan: CheckedPlan, recording: SampleSource, controller: ControllerConfig,
         execution: ExecutionConfig, continuous_joints: Iterable[str],
     ) -> CheckContext:
-        """Return the context of checking `series` against `plan` with these settings."""
-        samples = Samples.build(series, controller.joints, continuous_joints)
+        """Return the context of checking `recording` against `plan` with these settings."""
+        samples = Samples.build(recording, controller.joints, continuous_joints)
         zone = max(ZONE_RAD, 2.0 * execution.allowed_start_tolerance)
         profiles = tuple(
             StepProfile.build(step.name, in_controller_order(step.trajectory, controller),
@@ -86,12 +82,11 @@ class CheckContext:
                 f"the recording has a sample every {period * 1e3:.3g} ms, the controller checks "
                 f"every {1e3 / controller.update_rate_hz:.3g} ms: short excursions between "
                 "samples are not seen")
-        if series.velocities is None and computable:
+        if not samples.has_velocities and computable:
             warnings.append("the recording carries no velocities: the stopped velocity "
                             "tolerance is not checked")
-        return CheckContext(samples, profiles, series.velocities,
-                            computable and series.velocities is not None, controller, execution,
-                            segment_tolerances(controller), tuple(warnings))
+        return CheckContext(samples, profiles, computable and samples.has_velocities, controller,
+                            execution, segment_tolerances(controller), tuple(warnings))
 
     def before_recording(self, start: float) -> bool:
         """Return True if a goal started at `start` [s] was sent before the recording's first sample.
@@ -99,4 +94,4 @@ class CheckContext:
         A sample period of slack: an execution recorded from its send time (an executed file)
         is aligned to within a period of its first sample, on either side.
         """
-        return start < float(self.samples.times[0]) - self.samples.period_s
+        return start < self.samples.first_time - self.samples.period_s

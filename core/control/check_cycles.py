@@ -27,7 +27,7 @@ def executions(
     Step by step, every execution still going is judged in one pass. Samples of execution
     i at indices >= `ends[i]` belong to something else (the next cycle, or none exist).
     """
-    times = context.samples.times
+    samples = context.samples
     steps: list[list[StepCheck]] = [[] for _ in starts]
     begins, hows = list(starts), list(aligned_by)
     going = list(range(len(starts)))
@@ -36,8 +36,7 @@ def executions(
             going = [i for i in going if steps[i][-1].ok]
             for i in going:
                 previous = steps[i][-1]
-                decided = int(np.searchsorted(times, previous.start_s + previous.duration_s,
-                                              side="left"))
+                decided = samples.search(previous.start_s + previous.duration_s, side="left")
                 begins[i], hows[i] = next_start(context.samples, profile,
                                                 min(decided, ends[i] - 1), ends[i])
         verdicts = judge_steps(context, profile, [begins[i] for i in going],
@@ -49,18 +48,18 @@ def executions(
 
 def all_cycles(context: CheckContext) -> tuple[CycleCheck, ...]:
     """Return every execution of the plan found in the recording, judged."""
-    times = context.samples.times
-    starts = cycle_starts(context.samples, context.profiles)
+    samples = context.samples
+    starts = cycle_starts(samples, context.profiles)
     # Each execution ends where the next one starts.
-    ends = np.searchsorted(times, starts[1:], side="left").tolist()
-    ends.append(len(times))
+    ends = samples.search_many(starts[1:], side="left").tolist()
+    ends.append(samples.count)
     reasons = ["next cycle"] * (len(starts) - 1) + ["recording"]
     judged = executions(context, starts, ["departure"] * len(starts), ends, reasons)
     cycles = [(start, steps, execution_verdict(context, start, steps))
               for start, steps in zip(starts, judged, strict=True)]
     running = already_running(context)
     if running:
-        cycles.insert(0, (float(times[0]), (), ExecutionResult(INCOMPLETE, "INCOMPLETE", running)))
+        cycles.insert(0, (samples.first_time, (), ExecutionResult(INCOMPLETE, "INCOMPLETE", running)))
     return tuple(CycleCheck(index, start, steps, result)
                  for index, (start, steps, result) in enumerate(cycles))
 

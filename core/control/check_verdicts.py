@@ -17,10 +17,10 @@ def execution_verdict(context: CheckContext, start: float, steps: Sequence[StepC
     """Return an execution's result: its failure, else INCOMPLETE if the recording cuts it off."""
     last = steps[-1]
     result = last.report.result
-    times = context.samples.times
+    samples = context.samples
     if result.code == INCOMPLETE:
         number = len(steps) - 1
-        remaining = (last.start_s + context.profiles[number].trajectory.duration_s - times[-1]
+        remaining = (last.start_s + context.profiles[number].trajectory.duration_s - samples.last_time
                      + sum(p.trajectory.duration_s for p in context.profiles[number + 1 :]))
         if remaining > 0.0:
             return replace(result, message=(
@@ -30,7 +30,7 @@ def execution_verdict(context: CheckContext, start: float, steps: Sequence[StepC
                                        f"'{last.name}' ({result.message})")
     if result.code == SUCCESSFUL and context.before_recording(start):
         return ExecutionResult(INCOMPLETE, "INCOMPLETE", (
-            f"the recording begins about {times[0] - start:.3f} s after the execution started: "
+            f"the recording begins about {samples.first_time - start:.3f} s after the execution started: "
             "its start state and first motion are not recorded"))
     return result
 

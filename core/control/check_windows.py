@@ -86,10 +86,9 @@ def _open(
 ) -> _Window | tuple[ToleranceReport, float]:
     """Return the step's goal as sent at `start`, or its verdict if it is decided at once."""
     samples = context.samples
-    times = samples.times
     trajectory = profile.trajectory
-    first = int(np.searchsorted(times, start, side="left"))
-    at_send = max(first - 1, 0) if first >= len(times) or times[first] > start else first
+    first = samples.search(start, side="left")
+    at_send = max(first - 1, 0) if first >= samples.count or samples.time(first) > start else first
     current = samples.rows(at_send, at_send + 1)[0]
     if not context.before_recording(start):  # else the state at the send was not recorded
         refused = check_start_state(trajectory.joint_names, current, trajectory.positions[0],
@@ -102,7 +101,7 @@ def _open(
         result = ExecutionResult(INCOMPLETE, "INCOMPLETE", message) if cut else \
             ExecutionResult(TIMED_OUT, "TIMED_OUT", message)
         return ToleranceReport(result, (), {}, 0), 0.0
-    last_s = float(times[end - 1]) - start
+    last_s = samples.time(end - 1) - start
     timeout = _timeout(context, trajectory.duration_s, last_s, end_reason)
     # The recording ends before MoveIt would give up: its end cannot be a real timeout.
     runs_out = cut and last_s <= timeout.time_s
@@ -119,11 +118,10 @@ def _judge_windows(
     """
     if not windows:
         return []
-    times = context.samples.times
     duration = profile.trajectory.duration_s
     firsts = np.array([w.first for w in windows], dtype=np.intp)
     ends = np.array([w.end for w in windows], dtype=np.intp)
-    stops = np.searchsorted(times, [w.start + duration + extra for w in windows], side="right")
+    stops = context.samples.search_many([w.start + duration + extra for w in windows], side="right")
     stops = np.minimum(np.maximum(stops, firsts + 1), ends)
     judged: list[tuple[ToleranceReport, float, bool]] = []
     begin = 0
@@ -148,7 +146,7 @@ def _judge_stacked(
     lengths = stops - firsts
     span_starts = np.concatenate(([0], np.cumsum(lengths)[:-1]))
     begins, ends = firsts.tolist(), stops.tolist()
-    since = np.concatenate([samples.times[b:e] - w.start
+    since = np.concatenate([samples.times(b, e) - w.start
                             for w, b, e in zip(windows, begins, ends, strict=True)])
     derivatives = 1 if context.check_velocities else 0
     if trajectory.times_s[0] > 0.0:
@@ -188,11 +186,9 @@ def _velocities(
     context: CheckContext, begins: Sequence[int], ends: Sequence[int]
 ) -> NDArray[np.float64] | None:
     """Return recorded velocities of samples [begins[i], ends[i]) when JTC computes velocity errors."""
-    if not context.check_velocities or context.velocities is None:
+    if not context.check_velocities:
         return None
-    velocities = context.velocities
-    block = np.concatenate([velocities[b:e] for b, e in zip(begins, ends, strict=True)])
-    return block[:, context.samples.columns]
+    return context.samples.velocity_spans(begins, ends)
 
 
 def _timeout(context: CheckContext, duration: float, last_s: float, end_reason: str) -> Timeout:
@@ -224,8 +220,8 @@ def _point_before(context: CheckContext, window: _Window) -> PointBefore:
     """Return the state JTC blends from, with the fields its state interfaces provide."""
     states = context.controller.state_interfaces
     velocities = None
-    if "velocity" in states and context.velocities is not None:
-        velocities = context.velocities[window.at_send, context.samples.columns]
+    if "velocity" in states and context.samples.has_velocities:
+        velocities = context.samples.velocity_spans([window.at_send], [window.at_send + 1])[0]
     accelerations = None
     if velocities is not None and "acceleration" in states:
         accelerations = np.zeros_like(window.current)  # no acceleration is recorded: read as 0

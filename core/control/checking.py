@@ -20,7 +20,8 @@ state is not recorded, so MoveIt's start check is skipped), and, with `start="al
 already running when the recording began. A violation seen before the cut is still that
 failure.
 
-This module is the entry point; the parts are check_context (what the checks share),
+This module is the entry point; the parts are check_samples (the recording, read a block
+at a time from memory or from a store on disk), check_context (what the checks share),
 check_windows (one step judged over windows of samples), check_cycles (executions step by
 step, and every cycle), check_verdicts (results and reports) and check_report (the values).
 """
@@ -38,10 +39,11 @@ from .alignment import find_gaps, first_start
 from .check_context import CheckContext, CheckedPlan
 from .check_cycles import all_cycles, already_running, executions
 from .check_report import CheckReport, StepCheck
+from .check_samples import SampleSource, source_of
 from .check_verdicts import cycles_report, execution_report
 from .tolerances import velocity_error_computable
 
-__all__ = ["Start", "check_recording", "uses_velocities"]
+__all__ = ["SampleSource", "Start", "check_recording", "uses_velocities"]
 
 Start = float | Literal["auto", "all"]
 """Where the check starts: "auto", "all", or a time in [s] from the recording's first sample."""
@@ -49,7 +51,7 @@ Start = float | Literal["auto", "all"]
 
 def check_recording(
     plan: CheckedPlan,
-    series: JointStateSeries,
+    series: JointStateSeries | SampleSource,
     controller: ControllerConfig,
     execution: ExecutionConfig,
     continuous_joints: Iterable[str] = (),
@@ -59,7 +61,9 @@ def check_recording(
 
     Args:
         plan: The plan: steps with name, start_s and trajectory (a PlanFile).
-        series: The recorded joint states; must hold every controller joint.
+        series: The recorded joint states, in memory or read by row ranges (core.bag's
+            JointStateStore: memory then does not grow with the recording); must hold
+            every controller joint.
         controller: The JointTrajectoryController whose tolerances apply.
         execution: MoveIt's trajectory_execution settings (start tolerance, duration envelope).
         continuous_joints: URDF continuous joints: their errors wrap around.
@@ -74,15 +78,16 @@ def check_recording(
     """
     if not plan.steps:
         raise InputError("the plan has no steps")
-    context = CheckContext.build(plan, series, controller, execution, continuous_joints)
+    recording = source_of(series)
+    context = CheckContext.build(plan, recording, controller, execution, continuous_joints)
     warnings = list(context.warnings)
     gaps = find_gaps(context.samples, warnings)
     if start == "all":
-        return cycles_report(all_cycles(context), gaps, warnings, series.start_ns)
+        return cycles_report(all_cycles(context), gaps, warnings, recording.start_ns)
     first, aligned_by = _first_start(context, start, warnings)
-    (steps,) = executions(context, [first], [aligned_by], [len(series.times_s)], ["recording"])
+    (steps,) = executions(context, [first], [aligned_by], [recording.count], ["recording"])
     warnings += _alignment_warnings(steps)
-    return execution_report(context, first, steps, gaps, warnings, series.start_ns)
+    return execution_report(context, first, steps, gaps, warnings, recording.start_ns)
 
 
 def uses_velocities(plan: CheckedPlan, controller: ControllerConfig) -> bool:

@@ -1,4 +1,7 @@
-"""What `moveplan inspect` shows of an MCAP file: its topics and, for a plan file, each step's peak rates."""
+"""What `moveplan inspect` shows of a bag: its topics and, for a plan file, each step's peak rates.
+
+A bag is an MCAP file, a rosbag2 sqlite3 (.db3) file, or a bag folder; a plan file is MCAP.
+"""
 
 from __future__ import annotations
 
@@ -38,7 +41,7 @@ class StepPeaks:
 
 @dataclass(frozen=True)
 class Inspection:
-    """An MCAP file's summary, and for a plan file the plan and its steps' peak rates (else None and ())."""
+    """A bag's summary, and for a plan file the plan and its steps' peak rates (else None and ())."""
 
     path: Path
     summary: BagSummary
@@ -47,9 +50,14 @@ class Inspection:
 
 
 def inspect_file(path: Path) -> Inspection:
-    """Return the summary of any MCAP file; a plan file (moveplan metadata) is read back too."""
+    """Return the summary of any bag (MCAP, .db3 or a bag folder); a plan file (moveplan metadata) is read back too.
+
+    The summary comes from an MCAP file's summary section, or is counted in one pass
+    through the message indexes of an unfinished file, in memory that does not grow with
+    the file.
+    """
     summary = summarize(path)
-    if "moveplan" not in summary.metadata:
+    if "moveplan" not in summary.metadata or not path.is_file():
         return Inspection(path, summary, None)
     plan = read_valid_plan(path)
     return Inspection(path, summary, plan, step_peaks(plan))

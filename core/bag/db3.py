@@ -1,0 +1,191 @@
+"""rosbag2 sqlite3 files (.db3, Humble's default storage) read with Python's sqlite3.
+
+The tables, as rosbag2_storage_sqlite3 writes them: topics(id, name, type,
+serialization_format, offered_qos_profiles[, type_description_hash]) and messages(id,
+topic_id, timestamp, data), the timestamp being the receive time [ns]; since schema
+version 3 also schema(schema_version, ros_distro) and metadata, since version 4
+message_definitions(topic_type, encoding, encoded_message_definition, ...). Older files
+lack the schema table, and the oldest the QoS column.
+
+Messages are read in the order they were inserted (by id), a few thousand at a time:
+SQLite concatenates a batch's payloads and receive times (group_concat), which spares
+Python a tuple and a bytes object per message, and the payloads are handed on as numpy
+bytes like MCAP chunks. A damaged file (truncated, or not a bag) is an InputError naming it.
+"""
+
+from __future__ import annotations
+
+import sqlite3
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError
+
+__all__ = ["Db3Batch", "Db3Info", "Db3Topic", "db3_info", "db3_messages", "open_db3", "topic_counts"]
+
+# Message ids per query: a batch of a few MB, like an MCAP chunk.
+_BATCH_IDS = 8192
+
+
+@dataclass(frozen=True)
+class Db3Topic:
+    """A row of the topics table, with the message definition of its type if the file holds one."""
+
+    id: int
+    name: str
+    type: str
+    serialization_format: str
+    offered_qos_profiles: str
+    definition_encoding: str
+    definition: bytes
+
+
+@dataclass(frozen=True)
+class Db3Info:
+    """What a .db3 file says of itself: schema version (0: no schema table), ROS distro, topics."""
+
+    schema_version: int
+    ros_distro: str
+    topics: tuple[Db3Topic, ...]
+
+
+@dataclass(frozen=True)
+class Db3Batch:
+    """Payloads of consecutive messages: buf[starts[i] : starts[i] + lengths[i]], receive times [ns].
+
+    `length` is the length of every payload when they are all alike, else 0.
+    """
+
+    buf: NDArray[np.uint8]
+    starts: NDArray[np.int64]
+    lengths: NDArray[np.int64]
+    log_times: NDArray[np.int64]
+    length: int
+
+
+@contextmanager
+def open_db3(path: Path) -> Iterator[sqlite3.Connection]:
+    """Yield `path` opened read-only; an sqlite3 error inside the block becomes an InputError naming it."""
+    try:
+        connection = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True)
+    except sqlite3.Error as exc:
+        raise InputError(f"{path}: cannot open as a rosbag2 sqlite3 file: {exc}") from None
+    try:
+        yield connection
+    except sqlite3.Error as exc:
+        raise InputError(_damage(path, exc)) from None
+    finally:
+        connection.close()
+
+
+def _damage(path: Path, exc: sqlite3.Error) -> str:
+    """Return the one-line message of an sqlite3 error met reading `path`."""
+    text = str(exc)
+    if text.startswith("no such table") or text.startswith("no such column"):
+        return f"{path}: not a rosbag2 sqlite3 bag ({text})"
+    if "locked" in text:
+        return f"{path}: the sqlite3 file is locked ({text}): is a recorder still writing it?"
+    return f"{path}: corrupt or truncated sqlite3 file ({text})"
+
+
+def db3_info(connection: sqlite3.Connection, path: Path) -> Db3Info:
+    """Return the schema version, distro and topics of an open .db3 file."""
+    tables = {name for (name,) in connection.execute(
+        "SELECT name FROM sqlite_master WHERE type = 'table'")}
+    missing = {"topics", "messages"} - tables
+    if missing:
+        raise InputError(f"{path}: not a rosbag2 sqlite3 bag (no table {', '.join(sorted(missing))})")
+    version, distro = 0, ""
+    if "schema" in tables:
+        row = connection.execute("SELECT schema_version, ros_distro FROM schema "
+                                 "ORDER BY schema_version DESC LIMIT 1").fetchone()
+        if row is not None:
+            version, distro = int(row[0]), str(row[1])
+    definitions: dict[str, tuple[str, bytes]] = {}
+    if "message_definitions" in tables:
+        for topic_type, encoding, text in connection.execute(
+                "SELECT topic_type, encoding, encoded_message_definition FROM message_definitions"):
+            definitions.setdefault(str(topic_type), (str(encoding), _bytes(text)))
+    columns = {row[1] for row in connection.execute("PRAGMA table_info(topics)")}
+    qos = "offered_qos_profiles" if "offered_qos_profiles" in columns else "''"
+    topics = []
+    for topic_id, name, kind, encoding, offered in connection.execute(
+            f"SELECT id, name, type, serialization_format, {qos} FROM topics ORDER BY id"):
+        definition_encoding, definition = definitions.get(str(kind), ("", b""))
+        topics.append(Db3Topic(int(topic_id), str(name), str(kind), str(encoding), str(offered),
+                               definition_encoding, definition))
+    return Db3Info(version, distro, tuple(topics))
+
+
+def _bytes(value: object) -> bytes:
+    return value if isinstance(value, bytes) else str(value).encode()
+
+
+def topic_counts(connection: sqlite3.Connection, topic_ids: list[int]) -> tuple[dict[int, int], int, int]:
+    """Return the message count per topic id, and the first and last receive times [ns] (0 without messages)."""
+    if len(topic_ids) == 1:
+        # A bag of one topic: count(*) of the whole table walks its smallest index, not the data.
+        counts = {topic_ids[0]: int(connection.execute("SELECT count(*) FROM messages").fetchone()[0])}
+    else:
+        counts = dict.fromkeys(topic_ids, 0)
+        counts.update((int(t), int(c)) for t, c in connection.execute(
+            "SELECT topic_id, count(*) FROM messages GROUP BY topic_id"))
+    first, last = connection.execute("SELECT min(timestamp), max(timestamp) FROM messages").fetchone()
+    return counts, int(first or 0), int(last or 0)
+
+
+def db3_messages(
+    connection: sqlite3.Connection, path: Path, topic_ids: list[int],
+    wants_log_times: Callable[[], bool] = lambda: True,
+) -> Iterator[Db3Batch]:
+    """Yield the messages of `topic_ids` in insertion order, a batch at a time.
+
+    A batch read while `wants_log_times()` is False carries zeros for its receive times:
+    SQLite spends a third of a batch's time writing them out as text.
+    """
+    if connection.execute("PRAGMA encoding").fetchone()[0] != "UTF-8":
+        # group_concat reads payloads as text: in a UTF-16 file that would convert them.
+        raise InputError(f"{path}: the sqlite3 file is not UTF-8 encoded, as rosbag2 writes it")
+    first, last = connection.execute("SELECT min(id), max(id) FROM messages").fetchone()
+    if first is None:
+        return
+    wanted = ", ".join(str(int(t)) for t in topic_ids)
+    # One aggregate pass per batch; rows come in id order, as the scan of the id range reads them.
+    select = ("SELECT CAST(group_concat(data, '') AS BLOB), min(length(data)), max(length(data)), "
+              "count(*), {} FROM messages WHERE id BETWEEN ? AND ? AND topic_id IN ({})")
+    with_times = select.format("group_concat(timestamp, ',')", wanted)
+    without_times = select.format("''", wanted)
+    begin, last = int(first), int(last)
+    while begin <= last:
+        end = min(begin + _BATCH_IDS - 1, last)  # inclusive: ids may reach SQLite's largest integer
+        data, shortest, longest, count, times = connection.execute(
+            with_times if wants_log_times() else without_times, (begin, end)).fetchone()
+        if not count:
+            # Ids need not be dense (a merged bag): skip an empty stretch in one step.
+            (after,) = connection.execute("SELECT min(id) FROM messages WHERE id > ?", (end,)).fetchone()
+            begin = int(after) if after is not None else last + 1
+            continue
+        if times:
+            log_times = np.fromstring(times, dtype=np.int64, sep=",")  # text mode: not deprecated
+        else:
+            log_times = np.zeros(count, dtype=np.int64)
+        buf = np.frombuffer(data or b"", dtype=np.uint8)
+        if shortest == longest:
+            lengths = np.full(count, int(shortest), dtype=np.int64)
+        else:
+            (text,) = connection.execute(
+                f"SELECT group_concat(length(data), ',') FROM messages WHERE id BETWEEN ? AND ? "
+                f"AND topic_id IN ({wanted})", (begin, end)).fetchone()
+            lengths = np.fromstring(text, dtype=np.int64, sep=",")
+        if len(log_times) != count or len(lengths) != count or int(lengths.sum()) != len(buf):
+            raise InputError(f"{path}: corrupt sqlite3 file (messages {begin} to {end} do not read "
+                             "back whole)")
+        starts = np.zeros(count, dtype=np.int64)
+        np.cumsum(lengths[:-1], out=starts[1:])
+        yield Db3Batch(buf, starts, lengths, log_times, int(shortest) if shortest == longest else 0)
+        begin = end + 1
