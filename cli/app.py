@@ -176,11 +176,12 @@ def execute(
             start_joints=parse_joint_values(start_joints, "--start-joints") if start_joints else None,
             controllers=controllers, seed=seed,
         )
-        outcome = run(request)
-        if output is not None:
-            from moveplan.core.pipeline import report
+        if output is None:
+            outcome = run(request)
+        else:
+            from moveplan.core.pipeline.report import execute_to_file
 
-            report.write_execution(output, outcome, ros_distro, tf=outcome.tf)
+            outcome = execute_to_file(request, output, ros_distro)
     render.execution_summary(outcome, output, as_json, quiet)
     raise typer.Exit(0 if outcome.ok else 5)
 
@@ -188,7 +189,8 @@ def execute(
 @app.command("check-tolerances")
 def check_tolerances(
     plan_file: Annotated[Path, typer.Argument(metavar="PLAN", help="Plan file written by moveplan plan.")],
-    recording_file: Annotated[Path, typer.Argument(metavar="RECORDING", help="MCAP with sensor_msgs/JointState.")],
+    recording_file: Annotated[Path, typer.Argument(
+        metavar="RECORDING", help="A ROS 2 bag with sensor_msgs/JointState: .mcap, .db3 or a bag folder.")],
     topic: Annotated[str, typer.Option(help="JointState topic in the recording.")] = "/joint_states",
     controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml overriding the plan's.")] = None,
     start: Annotated[str, typer.Option(help="auto, a time [s] from the recording's start, or all.")] = "auto",
@@ -240,11 +242,12 @@ def robot_info(
 
 @app.command()
 def inspect(
-    file: Annotated[Path, typer.Argument(help="Any MCAP file; plan files get a per-step summary.")],
+    file: Annotated[Path, typer.Argument(
+        help="Any ROS 2 bag (.mcap, .db3 or a bag folder); plan files get a per-step summary.")],
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
 ) -> None:
-    """Summarise an MCAP bag: topics, types, counts; for plans, each step's duration and peak rates."""
+    """Summarise a ROS 2 bag (MCAP, .db3 or a bag folder): topics, counts; a plan's step durations and peak rates."""
     _logging(False, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render

@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 import secrets
 import stat
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from contextlib import contextmanager, suppress
 from importlib.metadata import version
 from pathlib import Path
@@ -22,7 +22,7 @@ from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 from ..errors import InputError, UsageError
 from .qos import offered_qos_profiles
 
-__all__ = ["atomic_file", "output_problem", "write_bag"]
+__all__ = ["BagStream", "atomic_file", "open_bag", "output_problem", "write_bag"]
 
 _MEDIA_TYPES = {".urdf": "application/xml", ".srdf": "application/xml", ".yaml": "application/yaml"}
 
@@ -31,7 +31,7 @@ def write_bag(
     path: Path,
     topics: Mapping[str, tuple[str, bool]],
     schemas: Mapping[str, bytes],
-    messages: list[tuple[str, int, bytes]],
+    messages: Iterable[tuple[str, int, bytes]],
     metadata: Mapping[str, dict[str, str]],
     attachments: Mapping[str, bytes],
 ) -> None:
@@ -46,6 +46,55 @@ def write_bag(
         InputError: `path` cannot be written.
 
     """
+    with open_bag(path, topics, schemas) as bag:
+        for topic, log_time_ns, data in messages:
+            bag.add(topic, log_time_ns, data)
+        for name, record in metadata.items():
+            bag.add_metadata(name, record)
+        for name, content in attachments.items():
+            bag.add_attachment(name, content)
+
+
+class BagStream:
+    """A ROS 2 bag being written (`open_bag`): messages added as they come, then metadata and attachments."""
+
+    def __init__(self, writer: Writer, channel_ids: Mapping[str, int]) -> None:
+        self._writer = writer
+        self._channel_ids = dict(channel_ids)
+
+    def add(self, topic: str, log_time_ns: int, data: bytes) -> None:
+        """Add one message (CDR) on a registered `topic` at `log_time_ns` [ns]; return None.
+
+        Messages go into the file in the order they are added: add them in log-time order.
+        """
+        self._writer.add_message(self._channel_ids[topic], log_time_ns, data, log_time_ns)
+
+    def add_metadata(self, name: str, record: dict[str, str]) -> None:
+        """Add a metadata record `name`; return None."""
+        self._writer.add_metadata(name, record)
+
+    def add_attachment(self, name: str, content: bytes) -> None:
+        """Add an attachment, its media type from the name's suffix; return None."""
+        media_type = _MEDIA_TYPES.get(Path(name).suffix.lower(), "application/octet-stream")
+        self._writer.add_attachment(0, 0, name, media_type, content)
+
+
+@contextmanager
+def open_bag(
+    path: Path, topics: Mapping[str, tuple[str, bool]], schemas: Mapping[str, bytes]
+) -> Iterator[BagStream]:
+    """Yield a ROS 2 bag on a temporary file beside `path`, channels registered; finish and rename after the block.
+
+    `topics` maps topic -> (message type, latched), in channel order; `schemas` maps message
+    type -> schema text. Nothing is kept per message (the mcap writer holds one chunk), so a
+    file of any length is written in bounded memory. On any error the temporary file is
+    removed and `path` is left as it was (`atomic_file`).
+
+    Raises:
+        UsageError: `path` cannot be an output file: a directory, a symbolic link, a device.
+        InputError: `path` cannot be written.
+
+    """
     with _atomic_writer(path) as writer:
         schema_ids: dict[str, int] = {}
         channel_ids: dict[str, int] = {}
@@ -54,14 +103,7 @@ def write_bag(
                 schema_ids[msgtype] = writer.register_schema(msgtype, "ros2msg", schemas[msgtype])
             qos = {"offered_qos_profiles": offered_qos_profiles(latched)}
             channel_ids[topic] = writer.register_channel(topic, "cdr", schema_ids[msgtype], qos)
-        add_message = writer.add_message
-        for topic, log_time_ns, data in messages:
-            add_message(channel_ids[topic], log_time_ns, data, log_time_ns)
-        for name, record in metadata.items():
-            writer.add_metadata(name, record)
-        for name, content in attachments.items():
-            media_type = _MEDIA_TYPES.get(Path(name).suffix.lower(), "application/octet-stream")
-            writer.add_attachment(0, 0, name, media_type, content)
+        yield BagStream(writer, channel_ids)
 
 
 def output_problem(path: Path) -> str | None:

@@ -1,10 +1,18 @@
-"""Executed files: what a replay or check did, per control cycle, written as one ROS 2 bag."""
+"""Executed files: what a replay or check did, per control cycle, written as one ROS 2 bag.
+
+The file is written while the execution runs (`execution_writer`): blocks of cycles and /tf
+samples go in as they are produced, so memory does not grow with the execution's length.
+"""
 
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+import math
+from bisect import bisect_left
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
+from operator import itemgetter
 from pathlib import Path
 from typing import Any
 
@@ -13,24 +21,33 @@ from numpy.typing import NDArray
 
 from ..types import ControllerStates, TfSamples
 from . import messages as msgs
-from .bag_writer import write_bag
+from .bag_writer import BagStream, open_bag
 from .definitions import CONTROLLER_STATE, schema_text
 from .generic_cdr import encoder
 from .jointstate_cdr import JOINT_STATE_TYPE, encode_joint_states
 from .message_cdr import controller_states_cdr, tf_messages_cdr
 from .plan_file import ROBOT_DESCRIPTION, STRING
 
-__all__ = ["EXECUTION_RESULT_TOPIC", "ExecutedStep", "write_execution"]
+__all__ = ["EXECUTION_RESULT_TOPIC", "ExecutedStep", "ExecutionWriter", "execution_writer", "write_execution"]
 
 EXECUTION_RESULT_TOPIC = "/moveplan/execution_result"
 """Topic of an executed file's result: a std_msgs/String holding the result JSON."""
 
 _TF = "tf2_msgs/msg/TFMessage"
 
+# At one log time the messages go in this order (then in the order they were added): the
+# robot description, the cycles (joint state, then controller state), /tf, the result.
+_DESCRIPTION, _CYCLES, _TF_SAMPLES, _RESULT = range(4)
+_Pending = tuple[int, int, str, bytes]
+_ORDER = itemgetter(0, 1)
+_TIME = itemgetter(0)
+
 
 @dataclass(frozen=True)
 class ExecutedStep:
-    """One executed step as written: per control cycle the measured joint state and the controller's state.
+    """Executed cycles as written: per control cycle the measured joint state and the controller's state.
+
+    A whole step, or a block of its cycles.
 
     Attributes:
         joint_names: Column order of `positions` and `velocities` (n).
@@ -43,6 +60,145 @@ class ExecutedStep:
     positions: NDArray[np.float64]
     velocities: NDArray[np.float64]
     states: ControllerStates
+
+
+class ExecutionWriter:
+    """An executed file being written (`execution_writer`): cycles and /tf as they come, then the result.
+
+    Each message is written as soon as nothing still to come can precede it: the cycles and
+    the /tf samples are each added in log-time order, so only messages at or after the last
+    time of either wait. The file is the one that sorting every message by log time would
+    give (at equal times: robot description, cycles, /tf, result, each in the order added).
+    """
+
+    def __init__(self, bag: BagStream, state_topic: str, distro: str, tf: bool) -> None:
+        self._bag = bag
+        self._state_topic = state_topic
+        self._distro = distro
+        self._string = encoder(STRING, schema_text(STRING, distro))
+        self._pending: list[_Pending] = []
+        # Per stream, the log time [ns] no message still to come precedes (None: no such stream).
+        self._next: dict[int, int | None] = {_CYCLES: 0, _TF_SAMPLES: 0 if tf else None}
+        self._written_until = 0
+        self.finished = False
+
+    def add_description(self, urdf: str) -> None:
+        """Add /robot_description at log time 0; return None."""
+        self._pending.append((0, _DESCRIPTION, ROBOT_DESCRIPTION, self._string(msgs.string(urdf))))
+
+    def add_cycles(self, cycles: ExecutedStep) -> None:
+        """Add cycles: per cycle its /joint_states, then its controller state; return None.
+
+        Blocks come in log-time order; add a step's /tf before its cycles, so that the cycles
+        are written as they come.
+
+        Raises:
+            ValueError: The block's log times go back.
+
+        """
+        stamps_ns = cycles.states.stamps_ns
+        if not len(stamps_ns):
+            return
+        self._advance(_CYCLES, stamps_ns)
+        joint_states = encode_joint_states(cycles.joint_names, stamps_ns, cycles.positions, cycles.velocities)
+        states = controller_states_cdr(cycles.states, self._distro)
+        topic = self._state_topic
+        for stamp, joint_state, state in zip(stamps_ns.tolist(), joint_states, states, strict=True):
+            self._pending += [(stamp, _CYCLES, "/joint_states", joint_state), (stamp, _CYCLES, topic, state)]
+        self._flush()
+
+    def add_tf(self, tf: TfSamples) -> None:
+        """Add /tf samples (times on the execution's timeline), in log-time order; return None.
+
+        Raises:
+            ValueError: The writer was opened without /tf, or the samples' log times go back.
+
+        """
+        if self._next[_TF_SAMPLES] is None:
+            raise ValueError("this executed file was opened without /tf")
+        stamps_ns = msgs.stamps_ns(tf.times_s)
+        if not len(stamps_ns):
+            return
+        self._advance(_TF_SAMPLES, stamps_ns)
+        stamps = stamps_ns.tolist()
+        encoded = tf_messages_cdr(tf.parents, tf.children, tf.transforms, stamps)
+        self._pending += [(stamp, _TF_SAMPLES, "/tf", data) for stamp, data in zip(stamps, encoded, strict=True)]
+        self._flush()
+
+    def finish(self, document: dict[str, Any], end_ns: int) -> None:
+        """Add the result `document` at `end_ns` [ns] and as metadata, and write what waits; return None.
+
+        Raises:
+            ValueError: A message already written lies after `end_ns`.
+
+        """
+        if end_ns < self._written_until:
+            raise ValueError(f"the result at {end_ns} ns would precede messages written up to {self._written_until} ns")
+        result = self._string(msgs.string(json.dumps(document)))
+        self._pending.append((end_ns, _RESULT, EXECUTION_RESULT_TOPIC, result))
+        self._flush(final=True)
+        self._bag.add_metadata("rosbag2", {"ROS_DISTRO": self._distro})
+        self._bag.add_metadata("moveplan_execution", {key: json.dumps(value) for key, value in document.items()})
+        self.finished = True
+
+    def _advance(self, stream: int, stamps_ns: NDArray[np.int64]) -> None:
+        """Record that `stream` continues at `stamps_ns`; raise ValueError if they go back."""
+        floor = self._next[stream]
+        assert floor is not None
+        if stamps_ns[0] < floor or np.any(np.diff(stamps_ns) < 0):
+            raise ValueError(f"executed file: log times go back (at {int(stamps_ns[0])} ns, after {floor} ns); "
+                             "add steps in order")
+        self._next[stream] = int(stamps_ns[-1])
+
+    def _flush(self, final: bool = False) -> None:
+        """Write, in order, the waiting messages that nothing still to come can precede."""
+        # Stable, and the waiting messages are sorted runs: a merge, not a full sort.
+        self._pending.sort(key=_ORDER)
+        floor = math.inf if final else min(t for t in self._next.values() if t is not None)
+        ready = len(self._pending) if final else bisect_left(self._pending, floor, key=_TIME)
+        add = self._bag.add
+        for stamp, _, topic, data in self._pending[:ready]:
+            add(topic, stamp, data)
+        if ready:
+            self._written_until = self._pending[ready - 1][0]
+        del self._pending[:ready]
+
+
+@contextmanager
+def execution_writer(
+    path: Path, *, controller: str, urdf: str = "", distro: str = "jazzy", tf: bool = False
+) -> Iterator[ExecutionWriter]:
+    """Yield an executed file for `distro` being written to `path`; it is renamed into place when the block ends.
+
+    Channels: /robot_description (with `urdf`, which is added at once), /joint_states and
+    /<controller>/controller_state (JointTrajectoryControllerState in the layout of
+    `distro`) per control cycle, /tf if `tf`, and the result. The block must end with
+    `finish`; on any error the file is not written (bag_writer.atomic_file).
+
+    Raises:
+        UsageError: `distro` has no shipped message definitions, or `path` cannot be an
+            output file (a directory, a symbolic link, a device: bag_writer.output_problem).
+        InputError: `path` cannot be written (missing or read-only folder, full disk).
+        RuntimeError: The block ended without `finish`.
+
+    """
+    state_topic = f"/{controller}/controller_state"
+    # Channels exist even without messages (an execution refused before its first cycle),
+    # so every executed file has the same topics and schemas.
+    topics = {ROBOT_DESCRIPTION: (STRING, True)} if urdf else {}
+    topics |= {"/joint_states": (JOINT_STATE_TYPE, False), state_topic: (CONTROLLER_STATE, False)}
+    if tf:
+        topics["/tf"] = (_TF, False)
+    # Latched: a late subscriber (a dashboard, `ros2 topic echo`) still gets the verdict.
+    topics[EXECUTION_RESULT_TOPIC] = (STRING, True)
+    schemas = {msgtype: schema_text(msgtype, distro) for msgtype, _ in topics.values()}
+    with open_bag(path, topics, schemas) as bag:
+        writer = ExecutionWriter(bag, state_topic, distro, tf)
+        if urdf:
+            writer.add_description(urdf)
+        yield writer
+        if not writer.finished:
+            raise RuntimeError("executed file left without its result: call finish()")
 
 
 def write_execution(
@@ -68,42 +224,12 @@ def write_execution(
         UsageError: `distro` has no shipped message definitions, or `path` cannot be an
             output file (a directory, a symbolic link, a device: bag_writer.output_problem).
         InputError: `path` cannot be written (missing or read-only folder, full disk).
+        ValueError: The steps' log times go back (steps out of order).
 
     """
-    state_topic = f"/{controller}/controller_state"
-    # Channels exist even without messages (an execution refused before its first cycle),
-    # so every executed file has the same topics and schemas.
-    topics = {ROBOT_DESCRIPTION: (STRING, True)} if urdf else {}
-    topics |= {"/joint_states": (JOINT_STATE_TYPE, False), state_topic: (CONTROLLER_STATE, False)}
-    if tf is not None:
-        topics["/tf"] = (_TF, False)
-    # Latched: a late subscriber (a dashboard, `ros2 topic echo`) still gets the verdict.
-    topics[EXECUTION_RESULT_TOPIC] = (STRING, True)
-    schemas = {msgtype: schema_text(msgtype, distro) for msgtype, _ in topics.values()}
-    string = encoder(STRING, schemas[STRING])
-
-    messages: list[tuple[str, int, bytes]] = []
-    if urdf:
-        messages.append((ROBOT_DESCRIPTION, 0, string(msgs.string(urdf))))
-    messages += _cycle_messages(steps, state_topic, distro)
-    if tf is not None:
-        tf_stamps = msgs.stamps_ns(tf.times_s).tolist()
-        encoded = tf_messages_cdr(tf.parents, tf.children, tf.transforms, tf_stamps)
-        messages += [("/tf", stamp, data) for stamp, data in zip(tf_stamps, encoded, strict=True)]
-    messages.append((EXECUTION_RESULT_TOPIC, end_ns, string(msgs.string(json.dumps(document)))))
-    # A stable sort: within a cycle the joint state comes before the controller state.
-    messages.sort(key=lambda item: item[1])
-    metadata = {key: json.dumps(value) for key, value in document.items()}
-    write_bag(path, topics, schemas, messages, {"rosbag2": {"ROS_DISTRO": distro}, "moveplan_execution": metadata}, {})
-
-
-def _cycle_messages(steps: Sequence[ExecutedStep], state_topic: str, distro: str) -> list[tuple[str, int, bytes]]:
-    """Return (topic, log time [ns], CDR) of every cycle: its joint state, then its controller state."""
-    messages: list[tuple[str, int, bytes]] = []
-    for step in steps:
-        stamps_ns = step.states.stamps_ns
-        joint_states = encode_joint_states(step.joint_names, stamps_ns, step.positions, step.velocities)
-        controller_states = controller_states_cdr(step.states, distro)
-        for stamp, joint_state, state in zip(stamps_ns.tolist(), joint_states, controller_states, strict=True):
-            messages += [("/joint_states", stamp, joint_state), (state_topic, stamp, state)]
-    return messages
+    with execution_writer(path, controller=controller, urdf=urdf, distro=distro, tf=tf is not None) as writer:
+        if tf is not None:
+            writer.add_tf(tf)
+        for step in steps:
+            writer.add_cycles(step)
+        writer.finish(document, end_ns)

@@ -13,7 +13,7 @@ Both files may use ROS 2 launch substitutions, as ur_robot_driver's ur_controlle
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -22,7 +22,10 @@ from ..errors import ConfigError
 from .fields import boolean, check_keys, mapping, number
 from .substitutions import load_substituted_yaml
 
-__all__ = ["MAX_UPDATE_RATE_HZ", "ControllerConfig", "ExecutionConfig", "parse_controllers", "parse_execution"]
+__all__ = [
+    "MAX_UPDATE_RATE_HZ", "ControllerConfig", "ExecutionConfig", "default_controller", "parse_controllers",
+    "parse_execution",
+]
 
 # What a JointTrajectoryController declares, in any release from Humble to master: ros2_controllers'
 # joint_trajectory_controller/src/joint_trajectory_controller_parameters.yaml (@9c53e68, Humble-era
@@ -108,6 +111,16 @@ def parse_controllers(path: Path, launch_args: Mapping[str, str] | None = None) 
             controllers[name] = _joint_trajectory_controller(name, kind, _ros_parameters(top, name, path), rate,
                                                              f"{path}: {name}.ros__parameters")
     return controllers
+
+
+def default_controller(joints: Sequence[str]) -> ControllerConfig:
+    """Return a JointTrajectoryController over `joints` with ros2_controllers' and controller_manager's defaults."""
+    return ControllerConfig(
+        name="joint_trajectory_controller", joints=tuple(joints), update_rate_hz=100.0,
+        command_interfaces=("position",), state_interfaces=("position",), goal_time_s=0.0,
+        stopped_velocity_tolerance=0.01, trajectory_tolerance=dict.fromkeys(joints, 0.0),
+        goal_tolerance=dict.fromkeys(joints, 0.0), gains={},
+    )
 
 
 def parse_execution(path: Path, launch_args: Mapping[str, str] | None = None) -> ExecutionConfig:

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import numpy.typing as npt
@@ -32,6 +32,7 @@ from .results import (
     PATH_TOLERANCE_VIOLATED,
     TIMED_OUT,
     ExecutionResult,
+    ExecutionSummary,
     ToleranceReport,
     Violation,
 )
@@ -40,6 +41,8 @@ from .tolerances import in_controller_order, position_error, segment_tolerances,
 __all__ = ["WAIT_LIMIT_S", "Disturbance", "ExecutionReport", "simulate"]
 
 _FIRST_CHUNK = 256
+# Cycle times sampled at a time: the spline's temporaries (a dozen arrays) stay this size.
+_SAMPLE_BLOCK = 16_384
 
 # Three (K, n) arrays per cycle and joint: positions, velocities, and accelerations or outputs.
 _PerCycle = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
@@ -110,6 +113,16 @@ class ExecutionReport:
         for name in _SERIES:
             object.__setattr__(self, name, frozen_array(getattr(self, name), shape, name))
 
+    def summary(self) -> ExecutionSummary:
+        """Return the verdict without the per-cycle samples: what a plan's execution keeps of a step."""
+        return ExecutionSummary(self.ok, self.result, self.violations, self.margins, self.duration_s,
+                                self.joint_names, len(self.times_s), self.output_interface)
+
+    def cycles(self, start: int, stop: int) -> ExecutionReport:
+        """Return the report restricted to cycles [start, stop), same verdict: a block of them to write."""
+        rows = slice(start, stop)
+        return replace(self, times_s=self.times_s[rows], **{name: getattr(self, name)[rows] for name in _SERIES})
+
 
 def simulate(
     trajectory: JointTrajectory,
@@ -155,8 +168,7 @@ def simulate(
     if np.any(bumps[0]):
         p0, v0 = plant.displace(bumps[0])
     initial_output = plant.last_output.copy()
-    reference = sample(trajectory, grid, point_before=_point_before(controller, p0, v0),
-                       continuous=continuous)
+    reference = _reference(trajectory, grid, _point_before(controller, p0, v0), continuous)
     verdict_of = _judge_cycles(trajectory, controller, grid, reference, timeout, continuous)
     actual_p, actual_v, output, verdict = _run(plant, reference, bumps, (p0, v0), dt, verdict_of)
     return _executed(verdict, joints, grid, reference, (actual_p, actual_v, output), initial_output, continuous,
@@ -194,6 +206,24 @@ def _executed(
         error=position_error(ref_p[:end], actual_p[:end], continuous),
         output_interface=interface,
     )
+
+
+def _reference(
+    trajectory: JointTrajectory, grid: NDArray[np.float64], point_before: PointBefore, continuous: NDArray[np.bool_]
+) -> _PerCycle:
+    """Return what the controller samples at each cycle time of `grid`: positions, velocities, accelerations.
+
+    Sampled in blocks into arrays of the grid's length: the spline's temporaries (a dozen
+    arrays per sample) then stay a block's size however long the step.
+    """
+    shape = (len(grid), len(trajectory.joint_names))
+    reference = (np.empty(shape), np.empty(shape), np.empty(shape))
+    for first in range(0, len(grid), _SAMPLE_BLOCK):
+        rows = slice(first, first + _SAMPLE_BLOCK)
+        block = sample(trajectory, grid[rows], point_before=point_before, continuous=continuous)
+        for values, sampled in zip(reference, block, strict=True):
+            values[rows] = sampled
+    return reference
 
 
 def _judge_cycles(
@@ -240,23 +270,25 @@ def _run(
     growing chunks, so an execution that ends early does not simulate the rest of the horizon.
     """
     ref_p, ref_v, ref_a = reference
-    count = len(ref_p) - 1
+    count, n = len(ref_p) - 1, ref_p.shape[1]
     after = np.vstack((bumps[1:], np.zeros_like(bumps[:1])))
-    parts: list[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]] = []
+    # Filled chunk by chunk, no copies of what came before: row k + 1 of the states is what
+    # command k leads to, which cycle k + 1 reads.
+    actual_p, actual_v, output = np.empty((count + 1, n)), np.empty((count + 1, n)), np.empty((count, n))
+    actual_p[0], actual_v[0] = initial
     done, size = 0, _FIRST_CHUNK
     while True:
         stop = min(count, done + size)
         # A diverging plant (unstable gains) overflows; the verdict comes from the cycles before.
         with np.errstate(over="ignore", invalid="ignore"):
-            parts.append(plant.run(ref_p[done + 1 : stop + 1], ref_v[done + 1 : stop + 1],
-                                   ref_a[done + 1 : stop + 1], dt, after[done:stop]))
-        measured_p, measured_v, output = (np.concatenate(s) for s in zip(*parts, strict=True))
-        actual_p = np.vstack((initial[0], measured_p[:-1]))
-        actual_v = np.vstack((initial[1], measured_v[:-1]))
-        verdict = verdict_of(actual_p, actual_v)
+            measured_p, measured_v, outputs = plant.run(ref_p[done + 1 : stop + 1], ref_v[done + 1 : stop + 1],
+                                                        ref_a[done + 1 : stop + 1], dt, after[done:stop])
+        actual_p[done + 1 : stop + 1], actual_v[done + 1 : stop + 1], output[done:stop] = (
+            measured_p, measured_v, outputs)
+        verdict = verdict_of(actual_p[:stop], actual_v[:stop])
         # On a partial series, a TIMED_OUT verdict at its last cycle only means "not decided yet".
         if stop == count or verdict.result.code != TIMED_OUT or verdict.end_index < stop - 1:
-            return actual_p, actual_v, output, verdict
+            return actual_p[:stop], actual_v[:stop], output[:stop], verdict
         done, size = stop, 2 * size
 
 

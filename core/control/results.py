@@ -12,6 +12,7 @@ __all__ = [
     "SUCCESSFUL",
     "TIMED_OUT",
     "ExecutionResult",
+    "ExecutionSummary",
     "ToleranceReport",
     "Violation",
     "result_of",
@@ -101,3 +102,28 @@ class ToleranceReport:
     def ok(self) -> bool:
         """Return True if the execution succeeded."""
         return self.result.code == SUCCESSFUL
+
+
+@dataclass(frozen=True)
+class ExecutionSummary:
+    """What a simulated execution decided, without its per-cycle samples: what a plan keeps of each step.
+
+    Attributes:
+        ok: True if the goal succeeded.
+        result: How it ended.
+        violations: The failed checks on the cycle it ended.
+        margins: Per joint with a nonzero tolerance, the smallest tolerance - |error| in [rad].
+        duration_s: Simulated time until the result in [s].
+        joint_names: The controller's joints, in its order.
+        cycles: Control cycles run; 0 if it never started.
+        output_interface: The command interface the plant was driven through.
+    """
+
+    ok: bool
+    result: ExecutionResult
+    violations: tuple[Violation, ...]
+    margins: dict[str, float]
+    duration_s: float
+    joint_names: tuple[str, ...]
+    cycles: int
+    output_interface: str = "position"

@@ -8,38 +8,43 @@ wherever the simulated robot then is.
 
 from __future__ import annotations
 
+import logging
 import tempfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import AbstractContextManager, ExitStack
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .. import bag as recording
-from ..bag.jointstates import read_joint_states
-from ..config.controllers import ControllerConfig, parse_controllers
+from ..bag.jointstates import open_joint_states
+from ..config.controllers import ControllerConfig, ExecutionConfig, default_controller, parse_controllers
 from ..config.robot_config import RobotConfig, load_robot_config
 from ..config.sources import CONFIG_FILE
 from ..control.check_report import CheckReport
 from ..control.checking import check_recording, uses_velocities
 from ..control.goal_validation import validate_goal
 from ..control.margins import merged_margins
-from ..control.results import ExecutionResult, Violation
+from ..control.results import ExecutionResult, ExecutionSummary, Violation
 from ..errors import ConfigError, InputError, UnknownName
 from ..types import TfSamples
 
 if TYPE_CHECKING:
     from ..control.controller import Disturbance, ExecutionReport
+    from ..control.plants import Plant
     from ..model.robot import Robot
 
 _TF_RATE_HZ = 30.0
 
 __all__ = [
-    "CheckRequest", "ExecuteRequest", "PlanExecution", "StepExecution", "check", "execute", "pick_controller",
-    "plan_config", "read_valid_plan",
+    "CheckRequest", "ExecuteRequest", "OpenRecorder", "PlanExecution", "StepExecution", "StepRecorder", "check",
+    "execute", "pick_controller", "plan_config", "read_valid_plan",
 ]
+
+_LOG = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -69,15 +74,23 @@ class CheckRequest:
 
 @dataclass(frozen=True)
 class StepExecution:
-    """One step's simulated execution; its times are from the step's start."""
+    """One step's simulated execution; its times are from the step's start.
+
+    `report` is the step's summary when it comes from `execute` (its samples went to the
+    executed file, or nowhere), or a whole report when built by hand.
+    """
 
     name: str
-    report: ExecutionReport
+    report: ExecutionReport | ExecutionSummary
 
 
 @dataclass(frozen=True)
 class PlanExecution:
-    """A whole plan's execution: the first failing step ends it."""
+    """A whole plan's execution: the first failing step ends it.
+
+    `tf` holds link poses along it, if whoever built it computed them; `request` is what
+    `execute` was asked (report.write_execution replays it to write a file).
+    """
 
     ok: bool
     result: ExecutionResult
@@ -85,6 +98,7 @@ class PlanExecution:
     controller: ControllerConfig
     plan: recording.PlanFile
     tf: TfSamples | None = None
+    request: ExecuteRequest | None = None
 
     @property
     def violations(self) -> tuple[tuple[str, Violation], ...]:
@@ -102,6 +116,23 @@ class PlanExecution:
         return sum(s.report.duration_s for s in self.steps)
 
 
+class StepRecorder(Protocol):
+    """Where `execute` hands each step as it is simulated (report.ExecutionRecorder writes an executed file)."""
+
+    def add_tf(self, tf: TfSamples) -> None:
+        """Take link poses along a step (times on the execution's timeline), before the step's report."""
+
+    def add_step(self, report: ExecutionReport) -> None:
+        """Take a step's report, samples and all; it is dropped afterwards."""
+
+    def finish(self, execution: PlanExecution) -> None:
+        """Take the whole execution, after its last step."""
+
+
+OpenRecorder = Callable[[ControllerConfig, recording.PlanFile, bool], AbstractContextManager[StepRecorder]]
+"""Opens a StepRecorder for the controller and plan; the flag says whether link poses will come."""
+
+
 def plan_config(plan: recording.PlanFile, source: Path) -> RobotConfig:
     """Return the robot config embedded in a plan file."""
     if CONFIG_FILE not in plan.attachments:
@@ -113,10 +144,16 @@ def plan_config(plan: recording.PlanFile, source: Path) -> RobotConfig:
                 raise InputError(f"{source}: attachment name '{name}' points outside the config")
             path.parent.mkdir(parents=True, exist_ok=True)
             path.write_bytes(data)
+        # Its warnings were given when the plan was made, and would name a temporary folder here.
+        config_log = logging.getLogger("moveplan.core.config")
+        level = config_log.level
+        config_log.setLevel(logging.ERROR)
         try:
             return load_robot_config(folder)
         except ConfigError as exc:
             raise InputError(f"{source}: embedded config: {exc}") from None
+        finally:
+            config_log.setLevel(level)
 
 
 def read_valid_plan(path: Path) -> recording.PlanFile:
@@ -144,55 +181,97 @@ def pick_controller(
     return min(fitting, key=lambda c: len(c.joints))
 
 
-def execute(request: ExecuteRequest) -> PlanExecution:
-    """Return what executing the plan through the simulated controller did."""
+def execute(request: ExecuteRequest, record: OpenRecorder | None = None) -> PlanExecution:
+    """Return what executing the plan through the simulated controller did; `record` gets each step as it runs.
+
+    Each step is simulated, handed to the recorder `record` opens (its link poses, then
+    its report) and dropped: the execution keeps per step only its summary, so memory does
+    not grow with the number of steps or the update rate (one step's samples are the most
+    it holds). report.execute_to_file records into an executed file.
+
+    Raises:
+        InputError: The plan is unreadable or invalid; and whatever the recorder raises.
+
+    """
     # Imported here: check-tolerances shares this module and simulates nothing.
-    from ..control.controller import Disturbance, simulate
     from ..control.plants import make_plant
 
     plan = read_valid_plan(request.plan)
     config = plan_config(plan, request.plan)
-    controller = _controller(config, plan, request.controllers)
+    controller = _controller(config, plan, request.plan, request.controllers)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
     plant = make_plant(request.plant, dict(request.plant_params or {}), controller, continuous)
+    reports = _simulated_steps(request, plan, controller, config.execution, plant, continuous)
+    robot = None
+    if record is not None:
+        # pinocchio is imported here, not at the top: check-tolerances shares this module and needs no kinematics.
+        from ..model.robot import Robot
+
+        robot = Robot(config, plan.group)
+    steps: list[StepExecution] = []
+    with ExitStack() as stack:
+        recorder: StepRecorder | None = None
+        offset_s = 0.0
+        for name, report in reports:
+            if record is not None and robot is not None:
+                if recorder is None:
+                    # Link poses come when the first step ran at all: a refused step is the last one.
+                    recorder = stack.enter_context(record(controller, plan, len(report.times_s) > 0))
+                tf = _step_tf(robot, report, offset_s)
+                if tf is not None:
+                    recorder.add_tf(tf)
+                recorder.add_step(report)
+            offset_s += report.duration_s
+            steps.append(StepExecution(name, report.summary()))
+            del report  # before the next step is simulated
+        last = steps[-1].report
+        execution = PlanExecution(last.ok, last.result, tuple(steps), controller, plan, request=request)
+        if recorder is not None:
+            recorder.finish(execution)
+    return execution
+
+
+def _simulated_steps(
+    request: ExecuteRequest,
+    plan: recording.PlanFile,
+    controller: ControllerConfig,
+    execution: ExecutionConfig,
+    plant: Plant,
+    continuous: list[str],
+) -> Iterator[tuple[str, ExecutionReport]]:
+    """Yield each step's name and report as it is simulated; a failing step is the last.
+
+    Each step is one goal, sent from where the simulated robot ended the one before.
+    """
+    from ..control.controller import Disturbance, simulate
+
     start = _start_positions(request, plan, controller)
-    steps = []
     for step in plan.steps:
         end = step.start_s + step.trajectory.duration_s
         last = step is plan.steps[-1]
         bumps = [Disturbance(d.time_s - step.start_s, d.joint, d.delta)
                  for d in request.disturbances if step.start_s <= d.time_s < end or (d.time_s >= end and last)]
-        report = simulate(step.trajectory, controller, config.execution, plant, continuous_joints=continuous,
+        report = simulate(step.trajectory, controller, execution, plant, continuous_joints=continuous,
                           start_positions=start, disturbances=bumps, seed=request.seed)
-        steps.append(StepExecution(step.name, report))
-        if not report.ok:
-            break
-        start = report.actual_positions[-1] if len(report.times_s) else start
-    last = steps[-1].report
-    # pinocchio is imported here, not at the top: check-tolerances shares this module and needs no kinematics.
-    from ..model.robot import Robot
-
-    tf = _executed_tf(Robot(config, plan.group), steps)
-    return PlanExecution(last.ok, last.result, tuple(steps), controller, plan, tf)
+        ok = report.ok
+        # A copy, not a view: a view would keep the step's samples alive through the next step.
+        start = report.actual_positions[-1].copy() if len(report.times_s) else start
+        yield step.name, report
+        del report
+        if not ok:
+            return
 
 
-def _executed_tf(robot: Robot, steps: list[StepExecution]) -> TfSamples | None:
-    """Return link poses along what the simulated robot did, at a playback rate, steps end to end."""
-    times, values = [], []
-    offset = 0.0
-    for step in steps:
-        report = step.report
-        if len(report.times_s):
-            period = float(np.median(np.diff(report.times_s))) if len(report.times_s) > 1 else 1.0
-            every = max(1, int(round(1.0 / (_TF_RATE_HZ * period))))
-            rows = np.unique(np.append(np.arange(0, len(report.times_s), every), len(report.times_s) - 1))
-            columns = [report.joint_names.index(j) for j in robot.joint_names]
-            times.append(offset + report.times_s[rows])
-            values.append(report.actual_positions[rows][:, columns])
-        offset += report.duration_s
-    if not times:
+def _step_tf(robot: Robot, report: ExecutionReport, offset_s: float) -> TfSamples | None:
+    """Return link poses along what the simulated robot did in one step, at a playback rate, from `offset_s` [s]."""
+    times = report.times_s
+    if not len(times):
         return None
-    return robot.tf_samples(np.concatenate(times), np.concatenate(values), robot.neutral())
+    period = float(np.median(np.diff(times))) if len(times) > 1 else 1.0
+    every = max(1, int(round(1.0 / (_TF_RATE_HZ * period))))
+    rows = np.unique(np.append(np.arange(0, len(times), every), len(times) - 1))
+    columns = [report.joint_names.index(j) for j in robot.joint_names]
+    return robot.tf_samples(offset_s + times[rows], report.actual_positions[rows][:, columns], robot.neutral())
 
 
 def _start_positions(
@@ -214,18 +293,25 @@ def check(request: CheckRequest) -> CheckReport:
     """Return the verdict of the controller's and MoveIt's rules on a recorded execution of a plan."""
     plan = read_valid_plan(request.plan)
     config = plan_config(plan, request.plan)
-    controller = _controller(config, plan, request.controllers)
-    series = read_joint_states(request.recording, request.topic, joints=controller.joints,
-                               time_source=request.time_source,
-                               velocities=uses_velocities(plan, controller))
+    controller = _controller(config, plan, request.plan, request.controllers)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
-    return check_recording(plan, series, controller, config.execution, continuous, request.start)
+    # The samples wait on disk and are read back a window at a time: memory does not grow with the recording.
+    with open_joint_states(request.recording, request.topic, joints=controller.joints,
+                           time_source=request.time_source,
+                           velocities=uses_velocities(plan, controller)) as recorded:
+        return check_recording(plan, recorded, controller, config.execution, continuous, request.start)
 
 
-def _controller(config: RobotConfig, plan: recording.PlanFile, override: Path | None) -> ControllerConfig:
+def _controller(config: RobotConfig, plan: recording.PlanFile, path: Path, override: Path | None) -> ControllerConfig:
     """Return the controller driving the plan's joints, from `override` or the plan's own config."""
-    controllers = config.controllers
-    source = str(config.sources.get("controllers", config.root / "ros2_controllers.yaml"))
+    joints = plan.steps[0].trajectory.joint_names
     if override is not None:
-        controllers, source = parse_controllers(override), str(override)
-    return pick_controller(controllers, plan.steps[0].trajectory.joint_names, source)
+        return pick_controller(parse_controllers(override), joints, str(override))
+    if "controllers" not in config.sources:
+        # A config without ros2_controllers.yaml (ABB's, most Setup Assistant packages before Humble): the
+        # controller ros2_control would load with no parameters file, as users get from mock hardware.
+        _LOG.warning("%s: the robot config has no ros2_controllers.yaml; executing with a "
+                     "JointTrajectoryController at ros2_controllers' defaults (100 Hz, position interface, "
+                     "no path or goal tolerances); --controllers FILE gives yours", path)
+        return default_controller(joints)
+    return pick_controller(config.controllers, joints, f"{path}: embedded {config.sources['controllers'].name}")

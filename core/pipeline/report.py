@@ -8,12 +8,17 @@ document is strict JSON.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
 from .. import bag as recording
 from ..bag import messages as msgs
+from ..bag.execution_file import ExecutedStep, ExecutionWriter, execution_writer
+from ..config.controllers import ControllerConfig
+from ..control.controller import ExecutionReport
 from ..control.published import controller_states
+from ..control.results import ExecutionSummary
 from ..errors import InputError
 from ..types import TfSamples
 
@@ -22,35 +27,117 @@ if TYPE_CHECKING:
 
     from ..control.check_report import CheckReport
     from ..control.results import ExecutionResult, Violation
-    from .execute import PlanExecution
+    from .execute import ExecuteRequest, PlanExecution
 
-__all__ = ["check_document", "execution_document", "finite", "write_execution"]
+__all__ = [
+    "ExecutionRecorder", "check_document", "execute_to_file", "execution_document", "execution_recorder", "finite",
+    "write_execution",
+]
+
+
+_BLOCK_CYCLES = 4096
+"""Control cycles encoded and written at a time: the encoded messages of a long step stay a few MB."""
+
+
+class ExecutionRecorder:
+    """An executed file written while the execution runs (`execution_recorder`), one step at a time.
+
+    Log times run from 0, the execution's start; each step starts where the one before it
+    ended (its start plus its duration_s, in whole nanoseconds: no drift over many steps).
+    """
+
+    def __init__(self, writer: ExecutionWriter, controller: ControllerConfig) -> None:
+        self._writer = writer
+        self._controller = controller
+        self._start_ns = 0
+
+    def add_tf(self, tf: TfSamples) -> None:
+        """Write link poses (times on the execution's timeline); add a step's before its cycles; return None."""
+        self._writer.add_tf(tf)
+
+    def add_step(self, report: ExecutionReport) -> None:
+        """Write a step's cycles, in blocks, starting where the previous step ended; return None.
+
+        Raises:
+            ValueError: The report's output interface is not a JTC command interface.
+
+        """
+        times_ns = msgs.stamps_ns(report.times_s)
+        for first in range(0, len(times_ns), _BLOCK_CYCLES):
+            stop = first + _BLOCK_CYCLES
+            block, block_ns = report.cycles(first, stop), times_ns[first:stop]
+            states = controller_states(block, self._controller, self._start_ns + block_ns, block_ns)
+            self._writer.add_cycles(ExecutedStep(block.joint_names, block.actual_positions, block.actual_velocities,
+                                                 states))
+        self._start_ns += msgs.seconds_to_ns(report.duration_s)
+
+    def finish(self, execution: PlanExecution) -> None:
+        """Write the result document when the last step ended: that is when it was known; return None."""
+        self._writer.finish(execution_document(execution), self._start_ns)
+
+
+@contextmanager
+def execution_recorder(
+    path: Path, controller: ControllerConfig, plan: recording.PlanFile, distro: str = "jazzy", tf: bool = False
+) -> Iterator[ExecutionRecorder]:
+    """Yield a recorder writing an executed file for `distro` to `path`, renamed into place when the block ends.
+
+    The file has /robot_description (the plan's URDF), /tf if `tf`, and the block must end
+    with `ExecutionRecorder.finish`; on any error no file is written.
+
+    Raises:
+        UsageError: `distro` has no shipped message definitions, or `path` cannot be an output file.
+        InputError: `path` cannot be written.
+
+    """
+    urdf = recording.plan_urdf(plan)
+    with execution_writer(path, controller=controller.name, urdf=urdf, distro=distro, tf=tf) as writer:
+        yield ExecutionRecorder(writer, controller)
+
+
+def execute_to_file(request: ExecuteRequest, path: Path, distro: str = "jazzy") -> PlanExecution:
+    """Return what executing the plan did, written to `path` for `distro` as it runs (`execute -o`).
+
+    Memory does not grow with the number of steps or the update rate: each step's samples
+    go to the file as soon as the step is simulated. On any error no file is written.
+
+    Raises:
+        UsageError: `distro` has no shipped message definitions, or `path` cannot be an output file.
+        InputError: The plan is unreadable or invalid, or `path` cannot be written.
+
+    """
+    from .execute import execute
+
+    return execute(request, lambda controller, plan, tf: execution_recorder(path, controller, plan, distro, tf))
 
 
 def write_execution(path: Path, execution: PlanExecution, distro: str = "jazzy", tf: TfSamples | None = None) -> None:
     """Write what `execution` did to `path` as a ROS 2 bag for `distro`, atomically; return None.
 
-    Log times run from 0, the execution's start; each step starts where the one before it
-    ended (its start plus its duration_s, in whole nanoseconds: no drift over many steps).
-    The result document is logged when the last step ended: that is when it was known.
+    Steps that carry their samples (reports built by hand) are written with `tf`, if given.
+    An execution from `pipeline.execute.execute` keeps only per-step summaries: it is run
+    again from its request straight into the file (the simulation is deterministic, so the
+    file holds what it did); `execute_to_file` writes it in the one run.
 
     Raises:
         UsageError: `distro` has no shipped message definitions.
         InputError: `path` cannot be written.
-        ValueError: A step's output interface is not a JTC command interface.
+        ValueError: A step's output interface is not a JTC command interface, or the steps
+            are summaries and the execution has no request to run again.
 
     """
-    steps, start_ns = [], 0
-    for step in execution.steps:
-        report = step.report
-        times_ns = msgs.stamps_ns(report.times_s)
-        states = controller_states(report, execution.controller, start_ns + times_ns, times_ns)
-        steps.append(recording.ExecutedStep(report.joint_names, report.actual_positions, report.actual_velocities,
-                                            states))
-        start_ns += msgs.seconds_to_ns(report.duration_s)
-    recording.write_execution(path, steps, execution_document(execution), start_ns,
-                              controller=execution.controller.name, urdf=recording.plan_urdf(execution.plan),
-                              distro=distro, tf=tf)
+    if any(isinstance(step.report, ExecutionSummary) for step in execution.steps):
+        if execution.request is None:
+            raise ValueError("the execution kept only per-step summaries and has no request to run again")
+        execute_to_file(execution.request, path, distro)
+        return
+    with execution_recorder(path, execution.controller, execution.plan, distro, tf is not None) as recorder:
+        if tf is not None:
+            recorder.add_tf(tf)
+        for step in execution.steps:
+            assert isinstance(step.report, ExecutionReport)
+            recorder.add_step(step.report)
+        recorder.finish(execution)
 
 
 def execution_document(execution: PlanExecution) -> dict[str, Any]:
