@@ -89,6 +89,26 @@ def test_an_output_naming_an_input_is_a_usage_error_and_replaces_nothing(
     assert snapshot(inputs) == before and snapshot(UR10E) == config_before
 
 
+@pytest.mark.parametrize(("output", "named"), [
+    ("scene.yaml", "the scene"),  # named by the task file, not on the command line
+    (UR10E / "joint_limits.yaml", "the robot config's joint_limits"),
+    (UR10E / "ur10e.urdf", "the robot config's urdf"),
+])
+def test_an_output_naming_a_file_the_task_or_config_names_replaces_nothing(
+    cli: Cli, inputs: Path, monkeypatch: pytest.MonkeyPatch, output: Any, named: str
+) -> None:
+    monkeypatch.chdir(inputs)
+    task = inputs / "task.yaml"
+    task.write_text(task.read_text().replace("ur10e_table_scene.yaml", "scene.yaml")
+                    .replace("../configs/ur10e", str(UR10E)))
+    before, config_before = snapshot(inputs), snapshot(UR10E)
+    result = cli("plan", task, "-o", output)
+    assert result.exit_code == 2, result.stderr
+    line = one_line_error(result)
+    assert f"is also {named}" in line and "must not replace an input" in line
+    assert snapshot(inputs) == before and snapshot(UR10E) == config_before
+
+
 def test_benchmark_outputs_may_not_replace_a_problem_or_each_other(cli: Cli, tmp_path: Path) -> None:
     problem = shutil.copy(ROOT / "tests" / "data" / "mbm" / "bookshelf_scene0093.yaml", tmp_path / "scene0001.yaml")
     before = snapshot(tmp_path)

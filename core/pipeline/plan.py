@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import logging
+import os
 from importlib.metadata import version
 from pathlib import Path
 
@@ -20,7 +21,7 @@ from ..bag import write_plan
 from ..collision.motion import MotionChecker, exact_checks, scene_checks
 from ..config import JointGoal, NamedGoal, RobotConfig, StartFrom, load_robot_config, load_task
 from ..config.limits import DEFAULT_ACCELERATION
-from ..errors import InputError, MoveplanError, StartInCollision, StartOutsideLimits, UnknownName
+from ..errors import InputError, MoveplanError, StartInCollision, StartOutsideLimits, UnknownName, UsageError
 from ..model.moveit_messages import known_joints
 from ..model.planning_scene import attach_request_objects
 from ..model.robot import Robot
@@ -43,9 +44,31 @@ _TF_RATE_HZ = 30.0
 def plan_to_file(task: Path | None, flags: PlanFlags, output: Path, ros_distro: str = "jazzy") -> Plan:
     """Plan what a task file (if any) and the flags ask for, write it to `output` for `ros_distro`, return it."""
     request = resolve_request(load_task(task) if task is not None else None, flags)
-    result = plan(request)
+    config = load_robot_config(request.robot, request.package_paths, request.xacro_args, urdf=request.urdf,
+                               srdf=request.srdf, strict_limits=request.strict_limits)
+    _refuse_replacing_inputs(output, request, config)
+    if (request.group or config.planning["group"]) in config.srdf.groups:
+        _warn_default_accelerations(config, request.group or config.planning["group"])
+    result = plan(request, config)
     write_plan(output, result, ros_distro)
     return result
+
+
+def _refuse_replacing_inputs(output: Path, request: PlanRequest, config: RobotConfig) -> None:
+    """Raise UsageError if `output` is a file the plan is made from: writing it would replace that file."""
+    named = [
+        ("the task file", request.task.source if request.task else None),
+        ("the scene", request.scene),
+        ("the MotionPlanRequest", request.motion_request.source if request.motion_request else None),
+        ("the --start-from plan", request.start.plan if isinstance(request.start, StartFrom) else None),
+        *((f"the robot config's {key}", path) for key, path in config.sources.items()),
+        *(("a file of the robot's URDF", path) for path in config.urdf_includes),
+    ]
+    if not output.exists():
+        return
+    for what, path in named:
+        if path is not None and Path(path).exists() and os.path.samefile(output, path):
+            raise UsageError(f"-o '{output}': is also {what} ({path}); an output must not replace an input")
 
 
 def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: bool = False) -> Plan:
@@ -67,7 +90,7 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
                                    srdf=request.srdf, strict_limits=request.strict_limits)
     robot = _robot(request, config)
     if loaded_here:
-        _warn_default_accelerations(config, robot)
+        _warn_default_accelerations(config, robot.group.name)
     scene = load_scene(request.scene, robot) if request.scene else empty_scene()
     base, current = _start_values(request, robot, scene)
     if request.motion_request is not None:  # objects the request's start state carries
@@ -100,9 +123,9 @@ def _robot(request: PlanRequest, config: RobotConfig) -> Robot:
     return robot
 
 
-def _warn_default_accelerations(config: RobotConfig, robot: Robot) -> None:
+def _warn_default_accelerations(config: RobotConfig, group: str) -> None:
     """Log a warning naming the group's joints the config gives no acceleration limit, and the file."""
-    defaulted = config.missing_acceleration_limits(robot.group.name)
+    defaulted = config.missing_acceleration_limits(group)
     if defaulted:
         where = config.sources.get("joint_limits", config.urdf_path)
         logger.warning("%s: no acceleration limit for joints %s; planning with the default %g rad/s^2 (m/s^2 for "
