@@ -247,3 +247,28 @@ def test_a_quoted_false_in_moveit_controllers_exits_3(cli: Cli, tmp_path: Path) 
     result = cli("robot", robot_folder(tmp_path, **{"moveit_controllers.yaml": text}))
     assert result.exit_code == 3
     assert "moveit_controllers.yaml: trajectory_execution.execution_duration_monitoring" in result.stderr
+
+
+@pytest.mark.parametrize(("manager_key", "controller_key"), [
+    ("/robot/controller_manager", "/robot/arm_controller"),  # launched in a namespace
+    ("/**/controller_manager", "/**/arm_controller"),
+    ("/**", "arm_controller"),  # one wildcard section for every node
+])
+def test_namespaced_and_wildcard_parameter_sections_configure_the_controllers(
+    tmp_path: Path, manager_key: str, controller_key: str
+) -> None:
+    manager = {"update_rate": 250, "arm_controller": {"type": "joint_trajectory_controller/JointTrajectoryController"}}
+    arm = {"joints": ["j1", "j2"], "command_interfaces": ["position"], "state_interfaces": ["position"],
+           "constraints": {"j1": {"goal": 0.02}}}
+    sections = {manager_key: {"ros__parameters": manager}}
+    if controller_key == manager_key:
+        manager.update(arm)
+    else:
+        sections[controller_key] = {"ros__parameters": arm}
+    if manager_key == "/**":
+        sections = {"/**": {"ros__parameters": manager}, "arm_controller": {"ros__parameters": arm}}
+    path = tmp_path / "ros2_controllers.yaml"
+    path.write_text(yaml.safe_dump(sections))
+    controller = parse_controllers(path)["arm_controller"]
+    assert controller.update_rate_hz == 250 and controller.joints == ("j1", "j2")
+    assert controller.goal_tolerance["j1"] == 0.02

@@ -13,6 +13,7 @@ Both files may use ROS 2 launch substitutions, as ur_robot_driver's ur_controlle
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -108,8 +109,10 @@ def parse_controllers(path: Path, launch_args: Mapping[str, str] | None = None) 
     for name, entry in manager.items():
         kind = str(entry.get("type", "")) if isinstance(entry, dict) else ""
         if "JointTrajectoryController" in kind:
-            controllers[name] = _joint_trajectory_controller(name, kind, _ros_parameters(top, name, path), rate,
-                                                             f"{path}: {name}.ros__parameters")
+            declared = _JTC_KEYS | _NODE_KEYS | (_SCALED_JTC_KEYS if "Scaled" in kind else frozenset())
+            params = _ros_parameters(top, name, path, declared)
+            where = f"{path}: {name}.ros__parameters"
+            controllers[name] = _joint_trajectory_controller(name, kind, params, rate, where)
     return controllers
 
 
@@ -152,9 +155,32 @@ def parse_execution(path: Path, launch_args: Mapping[str, str] | None = None) ->
     )
 
 
-def _ros_parameters(top: dict[str, Any], node: str, path: Path) -> dict[str, Any]:
-    section = mapping(top.get(node), f"{path}: {node}")
-    return mapping(section.get("ros__parameters"), f"{path}: {node}.ros__parameters")
+def _ros_parameters(
+    top: dict[str, Any], node: str, path: Path, declared: frozenset[str] | None = None
+) -> dict[str, Any]:
+    """Return the parameters a ROS 2 parameter file gives `node`, merged in file order as rclcpp does.
+
+    A section applies to the node when its key names it in any namespace (`controller_manager`,
+    `/robot/controller_manager`) or matches it by wildcard (`/**`, `/**/controller_manager`, `*`).
+    A wildcard section serves every node: of its parameters, only those in `declared` are the
+    node's (a node ignores overrides it does not declare); a section naming the node is kept whole.
+    """
+    merged: dict[str, Any] = {}
+    for key, section in top.items():
+        if isinstance(key, str) and _names_node(key, node):
+            entry = mapping(section, f"{path}: {key}")
+            params = mapping(entry.get("ros__parameters"), f"{path}: {key}.ros__parameters")
+            if "*" in key and declared is not None:
+                params = {k: v for k, v in params.items() if k in declared}
+            merged.update(params)
+    return merged
+
+
+def _names_node(key: str, node: str) -> bool:
+    """Return whether a parameter file's top-level key applies to a node named `node` (in some namespace)."""
+    # The namespace is the launch file's choice, unknown here: only the key's last name is compared.
+    last = key.strip("/").rsplit("/", 1)[-1]
+    return last == "**" or re.fullmatch(re.escape(last).replace(r"\*", "[^/]*"), node) is not None
 
 
 def _joint_trajectory_controller(
