@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
@@ -272,3 +273,17 @@ def test_namespaced_and_wildcard_parameter_sections_configure_the_controllers(
     controller = parse_controllers(path)["arm_controller"]
     assert controller.update_rate_hz == 250 and controller.joints == ("j1", "j2")
     assert controller.goal_tolerance["j1"] == 0.02
+
+
+def test_a_controller_joint_the_urdf_lacks_exits_3_naming_the_file_controller_and_joint(
+    cli: Cli, tmp_path: Path
+) -> None:
+    shutil.copytree(ROOT / "configs" / "ur10e", tmp_path / "ur10e")
+    path = tmp_path / "ur10e" / "ros2_controllers.yaml"
+    path.write_text(path.read_text().replace("- shoulder_pan_joint", "- shoulder_pan_jiont", 1)
+                    .replace("      shoulder_pan_joint: {", "      shoulder_pan_jiont: {"))
+    result = cli("plan", "--robot", tmp_path / "ur10e", "--named", "home", "-o", tmp_path / "p.mcap")
+    assert result.exit_code == 3, result.stderr
+    line = result.stderr.strip()
+    assert "\n" not in line and "joint 'shoulder_pan_jiont' not found" in line and "ros2_controllers.yaml" in line
+    assert not (tmp_path / "p.mcap").exists()

@@ -102,18 +102,33 @@ def _listed(folder: Path, metadata: Path) -> list[Path]:
             f"{info.get('compression_format') or '?'}); moveplan reads uncompressed bags: "
             "decompress it first (ros2 bag convert, or zstd -d on each split for FILE mode)")
     names = info.get("relative_file_paths")
-    if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
+    if not isinstance(names, list) or not names or not all(isinstance(n, str) and n.strip() for n in names):
         raise InputError(f"{metadata}: rosbag2_bagfile_information.relative_file_paths: expected "
                          "a list of file names")
-    paths = []
+    paths: list[Path] = []
     for name in names:
-        # Bags before version 4 name their files relative to the folder's parent.
-        candidates = [folder / name, folder.parent / name, folder / Path(name).name]
-        path = next((c for c in candidates if c.is_file()), None)
-        if path is None:
-            raise InputError(f"{metadata}: lists {name}, which is not in {folder}")
+        path = _split(folder, metadata, name)
+        if any(path.samefile(other) for other in paths):
+            # Read twice, its messages would count twice and seem to go back in time.
+            raise InputError(f"{metadata}: lists {name} twice (relative_file_paths); each split is read once")
         paths.append(path)
     return paths
+
+
+def _split(folder: Path, metadata: Path, name: str) -> Path:
+    """Return the split file `name` of metadata.yaml's list: a file inside the bag folder, not metadata.yaml."""
+    if Path(name).is_absolute() or ".." in Path(name).parts:
+        raise InputError(f"{metadata}: lists {name}, outside the bag folder {folder}; a bag's "
+                         "relative_file_paths name files inside it")
+    # Bags before version 4 name their files relative to the folder's parent.
+    candidates = [folder / name, folder.parent / name, folder / Path(name).name]
+    path = next((c for c in candidates if c.is_file()), None)
+    if path is None:
+        raise InputError(f"{metadata}: lists {name}, which is not in {folder}")
+    if path.samefile(metadata):
+        raise InputError(f"{metadata}: lists itself as a split file ({name}); relative_file_paths "
+                         "name the .db3 or .mcap files beside it")
+    return path
 
 
 def _information(metadata: Path) -> dict[str, Any]:

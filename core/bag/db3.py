@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError
+from ..errors import CorruptData, InputError
 
 __all__ = ["Db3Batch", "Db3Info", "Db3Topic", "db3_info", "db3_messages", "open_db3", "topic_counts"]
 
@@ -79,6 +79,8 @@ def open_db3(path: Path) -> Iterator[sqlite3.Connection]:
         yield connection
     except sqlite3.Error as exc:
         raise InputError(_damage(path, exc)) from None
+    except CorruptData as exc:
+        raise InputError(f"{path}: {exc}") from None
     finally:
         connection.close()
 
@@ -133,10 +135,27 @@ def topic_counts(connection: sqlite3.Connection, topic_ids: list[int]) -> tuple[
         counts = {topic_ids[0]: int(connection.execute("SELECT count(*) FROM messages").fetchone()[0])}
     else:
         counts = dict.fromkeys(topic_ids, 0)
-        counts.update((int(t), int(c)) for t, c in connection.execute(
-            "SELECT topic_id, count(*) FROM messages GROUP BY topic_id"))
+        for topic_id, count in connection.execute("SELECT topic_id, count(*) FROM messages GROUP BY topic_id"):
+            if topic_id not in counts:
+                raise CorruptData(_orphans(f"s ({count} of them)", topic_id))
+            counts[topic_id] = int(count)
     first, last = connection.execute("SELECT min(timestamp), max(timestamp) FROM messages").fetchone()
+    for value in (first, last):
+        # Integers sort before reals and text in SQLite: a text time shows up as the largest.
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int)):
+            raise CorruptData(f"a message's timestamp is {_shown(value)}, not an integer number of nanoseconds")
     return counts, int(first or 0), int(last or 0)
+
+
+def _orphans(row: object, topic_id: object) -> str:
+    """Return the message of a row (or rows) whose topic_id the topics table does not have."""
+    return (f"message row {row} names topic id {_shown(topic_id)}, which the topics table does not have "
+            "(a damaged bag; rosbag2 would drop such rows unseen)")
+
+
+def _shown(value: object) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def db3_messages(
@@ -147,6 +166,10 @@ def db3_messages(
 
     A batch read while `wants_log_times()` is False carries zeros for its receive times:
     SQLite spends a third of a batch's time writing them out as text.
+
+    Raises:
+        CorruptData: A row names a topic id the topics table lacks (rosbag2's reader would drop
+            it unseen), or holds a payload that is no blob or a timestamp that is no integer.
     """
     if connection.execute("PRAGMA encoding").fetchone()[0] != "UTF-8":
         # group_concat reads payloads as text: in a UTF-16 file that would convert them.
@@ -155,6 +178,7 @@ def db3_messages(
     if first is None:
         return
     wanted = ", ".join(str(int(t)) for t in topic_ids)
+    known = ", ".join(str(int(t)) for (t,) in connection.execute("SELECT id FROM topics")) or "NULL"
     # One aggregate pass per batch; rows come in id order, as the scan of the id range reads them.
     select = ("SELECT CAST(group_concat(data, '') AS BLOB), min(length(data)), max(length(data)), "
               "count(*), {} FROM messages WHERE id BETWEEN ? AND ? AND topic_id IN ({})")
@@ -165,27 +189,61 @@ def db3_messages(
         end = min(begin + _BATCH_IDS - 1, last)  # inclusive: ids may reach SQLite's largest integer
         data, shortest, longest, count, times = connection.execute(
             with_times if wants_log_times() else without_times, (begin, end)).fetchone()
+        if count < end - begin + 1:
+            # Other topics' rows, sparse ids, or rows of no topic: only a batch not all wanted is looked at.
+            _check_topic_ids(connection, begin, end, known)
         if not count:
             # Ids need not be dense (a merged bag): skip an empty stretch in one step.
             (after,) = connection.execute("SELECT min(id) FROM messages WHERE id > ?", (end,)).fetchone()
             begin = int(after) if after is not None else last + 1
             continue
-        if times:
-            log_times = np.fromstring(times, dtype=np.int64, sep=",")  # text mode: not deprecated
-        else:
-            log_times = np.zeros(count, dtype=np.int64)
+        try:
+            log_times = (np.fromstring(times, dtype=np.int64, sep=",")  # text mode: not deprecated
+                         if times else np.zeros(count, dtype=np.int64))
+            lengths = _lengths(connection, begin, end, wanted, shortest, longest, count)
+        except (ValueError, TypeError):
+            log_times = lengths = np.zeros(0, dtype=np.int64)
         buf = np.frombuffer(data or b"", dtype=np.uint8)
-        if shortest == longest:
-            lengths = np.full(count, int(shortest), dtype=np.int64)
-        else:
-            (text,) = connection.execute(
-                f"SELECT group_concat(length(data), ',') FROM messages WHERE id BETWEEN ? AND ? "
-                f"AND topic_id IN ({wanted})", (begin, end)).fetchone()
-            lengths = np.fromstring(text, dtype=np.int64, sep=",")
         if len(log_times) != count or len(lengths) != count or int(lengths.sum()) != len(buf):
+            _check_types(connection, begin, end, wanted)
             raise InputError(f"{path}: corrupt sqlite3 file (messages {begin} to {end} do not read "
                              "back whole)")
         starts = np.zeros(count, dtype=np.int64)
         np.cumsum(lengths[:-1], out=starts[1:])
         yield Db3Batch(buf, starts, lengths, log_times, int(shortest) if shortest == longest else 0)
         begin = end + 1
+
+
+def _lengths(
+    connection: sqlite3.Connection, begin: int, end: int, wanted: str, shortest: int, longest: int, count: int
+) -> NDArray[np.int64]:
+    """Return the payload lengths of a batch's wanted rows: all alike, or asked of SQLite one by one."""
+    if shortest == longest:
+        return np.full(count, int(shortest), dtype=np.int64)
+    (text,) = connection.execute(
+        f"SELECT group_concat(length(data), ',') FROM messages WHERE id BETWEEN ? AND ? "
+        f"AND topic_id IN ({wanted})", (begin, end)).fetchone()
+    return np.fromstring(text, dtype=np.int64, sep=",")
+
+
+def _check_topic_ids(connection: sqlite3.Connection, begin: int, end: int, known: str) -> None:
+    """Raise CorruptData naming the first row of ids [begin, end] whose topic_id the topics table lacks."""
+    row = connection.execute(
+        f"SELECT id, topic_id FROM messages WHERE id BETWEEN ? AND ? AND (topic_id NOT IN ({known}) "
+        "OR topic_id IS NULL) ORDER BY id LIMIT 1", (begin, end)).fetchone()
+    if row is not None:
+        raise CorruptData(_orphans(row[0], row[1]))
+
+
+def _check_types(connection: sqlite3.Connection, begin: int, end: int, wanted: str) -> None:
+    """Raise CorruptData naming the first wanted row of ids [begin, end] whose data is no blob or time no integer."""
+    row = connection.execute(
+        f"SELECT id, typeof(data), typeof(timestamp) FROM messages WHERE id BETWEEN ? AND ? AND topic_id IN "
+        f"({wanted}) AND (typeof(data) <> 'blob' OR typeof(timestamp) <> 'integer') ORDER BY id LIMIT 1",
+        (begin, end)).fetchone()
+    if row is None:
+        return
+    row_id, data_type, time_type = row
+    problem = (f"its data is {data_type}, not a blob" if data_type != "blob"
+               else f"its timestamp is {time_type}, not an integer number of nanoseconds")
+    raise CorruptData(f"message row {row_id}: {problem} (rosbag2 writes a CDR blob and an integer time)")

@@ -140,8 +140,11 @@ def mapping(value: Any, where: str) -> dict[str, Any]:
     """Return `value` if it is a mapping with string keys, else raise ConfigError at `where`."""
     if value is None:
         return {}
-    if not isinstance(value, Mapping) or not all(isinstance(k, str) for k in value):
+    if not isinstance(value, Mapping):
         raise ConfigError(f"{where}: expected a mapping, got {type(value).__name__}")
+    for key in value:
+        if not isinstance(key, str):
+            raise ConfigError(f"{where}: keys must be names, got {str(key)[:60]!r}")
     return dict(value)
 
 

@@ -19,12 +19,13 @@ from __future__ import annotations
 
 import logging
 import math
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import ConfigError, UnknownName
-from .fields import load_yaml, mapping, number
+from .fields import MAX_MAGNITUDE, coordinate, load_yaml, mapping
 from .limits import JointLimit
 from .urdf import UrdfJoint, xml_root
 
@@ -32,6 +33,9 @@ __all__ = ["DEFAULT_STATE", "InitialState", "default_position", "initial_state",
            "ros2_control_initial_positions"]
 
 logger = logging.getLogger(__name__)
+
+# What std::stod, which GenericSystem parses the value with, reads whole: no "1_000", "0x10" or "infinity".
+_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?")
 
 DEFAULT_STATE = "MoveIt's default state (0, or the middle of the joint's limits)"
 """InitialState.sources value of a joint that neither the URDF nor initial_positions.yaml places."""
@@ -78,11 +82,28 @@ def initial_state(
         if joint.mimic in positions and not joints[joint.mimic].mimic:
             positions[name] = joint.mimic_multiplier * positions[joint.mimic] + joint.mimic_offset
             sources[name] = f"joint '{joint.mimic}', which it mimics"
-    ignored = sorted(set(hardware) - set(limits))
-    if ignored:
-        logger.debug("%s: <ros2_control> initial values of joints that do not move ignored: %s",
-                     urdf_path, ", ".join(ignored))
+    _warn_ignored(hardware, positions, joints, limits, urdf_path)
     return InitialState(positions, sources)
+
+
+def _warn_ignored(
+    hardware: dict[str, float], positions: dict[str, float], joints: dict[str, UrdfJoint],
+    limits: dict[str, JointLimit], urdf_path: Path,
+) -> None:
+    """Warn about `<ros2_control>` initial values moveplan does not start from: unknown joints, mimic joints."""
+    unknown = sorted(set(hardware) - set(joints))
+    if unknown:
+        logger.warning("%s: <ros2_control> gives initial values of joints the URDF does not have: %s; ignored",
+                       urdf_path, ", ".join(unknown))
+    fixed = sorted(set(hardware) & set(joints) - set(limits))
+    if fixed:
+        logger.debug("%s: <ros2_control> initial values of joints that do not move ignored: %s",
+                     urdf_path, ", ".join(fixed))
+    differ = [f"{name} ({hardware[name]:g}, follows as {positions[name]:g})" for name in sorted(hardware)
+              if name in limits and joints[name].mimic and abs(hardware[name] - positions[name]) > 1e-9]
+    if differ:
+        logger.warning("%s: <ros2_control> initial values of mimic joints ignored: %s; a mimic joint follows "
+                       "its leader, as in MoveIt", urdf_path, ", ".join(differ))
 
 
 def default_position(limit: JointLimit) -> float:
@@ -118,7 +139,7 @@ def parse_initial_positions(path: Path, limits: dict[str, JointLimit]) -> dict[s
     for joint, value in values.items():
         if joint not in limits:
             raise UnknownName("joint", joint, f"{path}: initial_positions", limits)
-        result[joint] = number(value, f"{path}: initial_positions.{joint}")
+        result[joint] = coordinate(value, f"{path}: initial_positions.{joint}")
     return result
 
 
@@ -136,13 +157,16 @@ def _initial_position_text(joint: ET.Element) -> str:
 
 
 def _finite(text: str, where: str) -> float:
-    """Return `text` as a finite number; ConfigError names `where` otherwise."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise ConfigError(f"{where}: initial value '{text}' is not a number") from None
-    if not math.isfinite(value):
-        raise ConfigError(f"{where}: initial value '{text}' is not a finite number")
+    """Return `text` as a finite number within MAX_MAGNITUDE; ConfigError names `where` otherwise."""
+    shown = text if len(text) <= 40 else f"{text[:37]}... ({len(text)} characters)"
+    if text.lower() in ("nan", "inf", "+inf", "-inf", "infinity", "+infinity", "-infinity"):
+        raise ConfigError(f"{where}: initial value '{shown}' is not a finite number")
+    if not _NUMBER.fullmatch(text):
+        raise ConfigError(f"{where}: initial value '{shown}' is not a number")
+    value = float(text)
+    if not abs(value) <= MAX_MAGNITUDE:
+        raise ConfigError(f"{where}: initial value '{shown}' is out of range; values are limited to "
+                          f"|value| <= {MAX_MAGNITUDE:,.0f}")
     return value
 
 

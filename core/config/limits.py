@@ -9,7 +9,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from .fields import boolean, check_keys, load_yaml, mapping, number
+from .fields import MAX_MAGNITUDE, boolean, check_keys, load_yaml, mapping, number
+from .tasks import MIN_SCALING
 from .urdf import MOVABLE_JOINT_TYPES, UrdfJoint
 
 __all__ = ["DEFAULT_ACCELERATION", "DEFAULT_SOURCE", "JointLimit", "merge_limits", "parse_joint_limits"]
@@ -67,8 +68,9 @@ def parse_joint_limits(path: Path | None) -> tuple[dict[str, dict[str, Any]], fl
     scales = []
     for key in ("default_velocity_scaling_factor", "default_acceleration_scaling_factor"):
         value = number(top.get(key, _DEFAULT_SCALING), f"{path}: {key}", positive=True)
-        if value > 1.0:
-            raise ConfigError(f"{path}: {key}: expected a number in (0, 1], got {value}")
+        if not MIN_SCALING <= value <= 1.0:
+            raise ConfigError(f"{path}: {key}: expected a number in [{MIN_SCALING:g}, 1], got {value:g} "
+                              "(the bounds of --velocity-scaling and --acceleration-scaling)")
         scales.append(value)
     entries = mapping(top.get("joint_limits"), f"{path}: joint_limits")
     overrides: dict[str, dict[str, Any]] = {}
@@ -124,14 +126,15 @@ def _merged(joint: UrdfJoint, urdf_path: Path, limits_path: Path | None, entry: 
     source = {"position": urdf_name, "velocity": urdf_name, "acceleration": DEFAULT_SOURCE}
     where = f"{limits_path}: joint_limits.{joint.name}"
     if _flag(entry, "has_position_limits", where) and not continuous:
-        lower = number(entry.get("min_position", lower), f"{where}.min_position")
-        upper = number(entry.get("max_position", upper), f"{where}.max_position")
+        lower = number(entry.get("min_position", lower), f"{where}.min_position", bound=MAX_MAGNITUDE)
+        upper = number(entry.get("max_position", upper), f"{where}.max_position", bound=MAX_MAGNITUDE)
         source["position"] = file_name
     if _flag(entry, "has_velocity_limits", where):
-        velocity = number(entry.get("max_velocity"), f"{where}.max_velocity", positive=True)
+        velocity = number(entry.get("max_velocity"), f"{where}.max_velocity", positive=True, bound=MAX_MAGNITUDE)
         source["velocity"] = file_name
     if _flag(entry, "has_acceleration_limits", where):
-        acceleration = number(entry.get("max_acceleration"), f"{where}.max_acceleration", positive=True)
+        acceleration = number(entry.get("max_acceleration"), f"{where}.max_acceleration", positive=True,
+                              bound=MAX_MAGNITUDE)
         source["acceleration"] = file_name
     if not lower <= upper:
         raise ConfigError(f"{urdf_path}: joint '{joint.name}': lower limit {lower} above upper {upper}")

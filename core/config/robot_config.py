@@ -181,6 +181,7 @@ def load_robot_config(
     limits = merge_limits(paths["urdf"], model.urdf_joints, paths.get("joint_limits"), limit_overrides,
                           strict=strict_limits)
     controllers = parse_controllers(paths["controllers"], model.xacro_args) if "controllers" in paths else {}
+    _check_controller_joints(controllers, model.urdf_joints, paths.get("controllers"))
     execution = (parse_execution(paths["moveit_controllers"], model.xacro_args)
                  if "moveit_controllers" in paths else ExecutionConfig())
     initial = initial_state(model.urdf_text, paths["urdf"], model.urdf_joints, limits, paths.get("initial_positions"))
@@ -262,3 +263,14 @@ def _sources(found: _Located, planning_source: Path) -> dict[str, Path]:
         sources["moveplan"] = found.manifest
     sources["planning"] = planning_source
     return sources
+
+
+def _check_controller_joints(
+    controllers: Mapping[str, ControllerConfig], joints: Mapping[str, UrdfJoint], source: Path | None
+) -> None:
+    """Raise for a controller joint the URDF lacks: ros2_control refuses to configure such a controller."""
+    for name, controller in controllers.items():
+        for joint in controller.joints:
+            if joint not in joints:
+                raise UnknownName("joint", joint, f"{source}: {name}.ros__parameters.joints", joints)
+

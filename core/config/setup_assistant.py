@@ -62,6 +62,9 @@ def read_setup_assistant(folder: Path) -> SetupAssistant | None:
     """Return what `folder`'s .setup_assistant says, or None if it has none."""
     path = folder / SETUP_ASSISTANT_FILE
     if not path.is_file():
+        if path.is_symlink() or path.exists():
+            raise ConfigError(f"{path}: not a readable file (a folder, or a link to nothing); "
+                              "remove it or make it the Setup Assistant's YAML")
         return None
     top = mapping(load_yaml(path), str(path))
     config = mapping(top.get(_TOP), f"{path}: {_TOP}")
@@ -70,10 +73,21 @@ def read_setup_assistant(folder: Path) -> SetupAssistant | None:
     return SetupAssistant(
         path=path,
         urdf_package=_text(urdf, "package", path, "urdf"),
-        urdf_path=_text(urdf, "relative_path", path, "urdf"),
+        urdf_path=_relative(_text(urdf, "relative_path", path, "urdf"), path, "urdf"),
         xacro_args=_xacro_args(urdf.get("xacro_args"), path),
-        srdf_path=_text(srdf, "relative_path", path, "srdf"),
+        srdf_path=_relative(_text(srdf, "relative_path", path, "srdf"), path, "srdf"),
     )
+
+
+def _relative(value: str | None, path: Path, where: str) -> str | None:
+    """Return a `relative_path` that stays inside its package: not absolute, no `..`, no NUL."""
+    if value is None:
+        return None
+    if Path(value).is_absolute() or ".." in Path(value).parts or "\0" in value or len(value) > 4096:
+        shown = value if len(value) <= 80 else value[:77] + "..."
+        raise ConfigError(f"{path}: {_TOP}.{where}.relative_path: '{shown}' leaves the package; the Setup "
+                          "Assistant writes a path inside it, such as config/robot.srdf")
+    return value
 
 
 def _entry(config: dict[str, Any], key: str, path: Path) -> dict[str, Any]:

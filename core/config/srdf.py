@@ -275,6 +275,8 @@ def _with_subgroups(own: dict[str, set[str]], subgroups: dict[str, list[str]], p
             if not waiting[user]:
                 ready.append(user)
     stuck = [name for name in own if name not in members]
+    if len(stuck) == 1:
+        raise ConfigError(f"{path}: group '{stuck[0]}' includes itself as a subgroup; a group cannot contain itself")
     if stuck:
         raise ConfigError(f"{path}: groups {', '.join(stuck)} include each other as subgroups; "
                           "a group cannot contain itself")
@@ -306,21 +308,41 @@ def _group_states(
         group, name = element.get("group", "").strip(), element.get("name", "").strip()
         if group not in groups:
             raise UnknownName("group", group, f"{path} group_state '{name}'", groups)
-        values: dict[str, float] = {}
-        for joint in element.findall("joint"):
-            jname = joint.get("name", "").strip()
-            if not tree.is_joint(jname):
-                raise UnknownName("joint", jname, f"{path} group_state '{name}'", [*tree.joints, *tree.virtual])
-            where = f"{path}: group_state '{name}' joint '{jname}'"
-            if jname in tree.virtual or tree.joints[jname].type in _BASE_JOINT_TYPES:
-                _numbers(joint.get("value", ""), where)
-                continue
-            value = float_attr(joint, "value", path, 0.0)
-            if not math.isfinite(value):
-                raise ConfigError(f"{where}: value='{joint.get('value')}' is not a finite number")
-            values[jname] = value
-        states[group][name] = values
+        if name in states[group]:
+            _log.warning("%s: group_state '%s' of group '%s' is defined twice; the last one counts, as in MoveIt",
+                         path, name, group)
+        states[group][name] = _state_values(element, name, tree, groups[group])
     return states
+
+
+def _state_values(element: ET.Element, name: str, tree: _Tree, group: Group) -> dict[str, float]:
+    """Return joint -> value of one `<group_state>`; values of joints outside the group are checked, then dropped.
+
+    MoveIt (RobotModel::buildGroupStates) logs an error for a joint the group does not have
+    and keeps the state's other values: so does this, with a warning.
+    """
+    path = tree.path
+    values: dict[str, float] = {}
+    outside: list[str] = []
+    for joint in element.findall("joint"):
+        jname = joint.get("name", "").strip()
+        if not tree.is_joint(jname):
+            raise UnknownName("joint", jname, f"{path} group_state '{name}'", [*tree.joints, *tree.virtual])
+        where = f"{path}: group_state '{name}' joint '{jname}'"
+        if jname in tree.virtual or tree.joints[jname].type in _BASE_JOINT_TYPES:
+            _numbers(joint.get("value", ""), where)
+            continue
+        value = float_attr(joint, "value", path, 0.0)
+        if not math.isfinite(value):
+            raise ConfigError(f"{where}: value='{joint.get('value')}' is not a finite number")
+        if jname in tree.movable and jname not in group.joints:
+            outside.append(jname)
+            continue
+        values[jname] = value
+    if outside:
+        _log.warning("%s: group_state '%s' gives joints that group '%s' does not have: %s; ignored, as MoveIt "
+                     "ignores them", path, name, group.name, ", ".join(outside))
+    return values
 
 
 def _numbers(text: str, where: str) -> list[float]:

@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from .fields import load_yaml, parse_yaml
+from .fields import MAX_YAML_BYTES, load_yaml, parse_yaml
 
 __all__ = ["load_substituted_yaml", "read_substituted", "substitute"]
 
@@ -35,6 +35,8 @@ _log = logging.getLogger(__name__)
 
 _IDENTIFIER = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")
 _SHOWN = 60  # characters of a substitution quoted in a message
+MAX_NESTING = 32
+"""Substitutions inside substitutions: launch files nest two or three (`$(var a $(env B))`)."""
 
 
 def load_substituted_yaml(path: Path, launch_args: Mapping[str, str] | None = None) -> Any:
@@ -90,6 +92,7 @@ class _Parser:
     def template(self) -> str:
         """Return the whole text, substituted; text outside `$(...)` is kept as it is."""
         out: list[str] = []
+        size = 0
         while True:
             start = self.text.find("$(", self.pos)
             if start < 0:
@@ -102,10 +105,17 @@ class _Parser:
             out.append(self.text[self.pos:start])
             self.pos = start
             out.append(self._substitution())
+            size += len(out[-2]) + len(out[-1])
+            if size > MAX_YAML_BYTES:
+                # A long value used many times must not grow a parameter file without bound.
+                raise self._error(start, f"the substituted file grows beyond {MAX_YAML_BYTES:,} characters, "
+                                         "moveplan's limit for a YAML file")
 
-    def _substitution(self) -> str:
+    def _substitution(self, depth: int = 0) -> str:
         """Return the value of the substitution at `pos` (at its `$(`), moving past its `)`."""
         start = self.pos
+        if depth >= MAX_NESTING:
+            raise self._error(start, f"substitutions nested more than {MAX_NESTING} deep")
         self.pos += 2
         name = _IDENTIFIER.match(self.text, self.pos)
         if name is None:
@@ -116,13 +126,13 @@ class _Parser:
             while self._peek() == " ":
                 self.pos += 1
             if self._peek() != ")":
-                args.append(self._argument(start))
+                args.append(self._argument(start, depth))
         if self._peek() != ")":
             raise self._error(start, "unterminated substitution: expected ')'")
         self.pos += 1
         return self._perform(name.group(), args, start)
 
-    def _argument(self, start: int) -> str:
+    def _argument(self, start: int, depth: int) -> str:
         """Return one argument: unquoted characters, quoted strings and substitutions, up to a space or ')'."""
         parts: list[str] = []
         while True:
@@ -132,9 +142,9 @@ class _Parser:
             if char in (" ", ")"):
                 return "".join(parts)
             if self.text.startswith("$(", self.pos):
-                parts.append(self._substitution())
+                parts.append(self._substitution(depth + 1))
             elif char in ("'", '"'):
-                parts.append(self._quoted(char, start))
+                parts.append(self._quoted(char, start, depth))
             elif char == "\\" and self.pos + 1 < len(self.text):
                 parts.append(self.text[self.pos + 1])
                 self.pos += 2
@@ -142,7 +152,7 @@ class _Parser:
                 parts.append(char)
                 self.pos += 1
 
-    def _quoted(self, quote: str, start: int) -> str:
+    def _quoted(self, quote: str, start: int, depth: int) -> str:
         """Return a quoted argument's text, its substitutions made, moving past the closing quote."""
         self.pos += 1
         parts: list[str] = []
@@ -150,7 +160,7 @@ class _Parser:
             if self._peek() in ("", "\n"):
                 raise self._error(start, f"unterminated quoted argument: expected {quote}")
             if self.text.startswith("$(", self.pos):
-                parts.append(self._substitution())
+                parts.append(self._substitution(depth + 1))
             else:
                 parts.append(self._peek())
                 self.pos += 1

@@ -12,11 +12,13 @@ from ..errors import ConfigError
 from .xacro import PackagePath
 
 __all__ = [
-    "MOVABLE_JOINT_TYPES", "CollisionMesh", "UrdfJoint", "float_attr", "parse_urdf", "resolve_collision_meshes",
-    "xml_root",
+    "JOINT_TYPES", "MOVABLE_JOINT_TYPES", "CollisionMesh", "UrdfJoint", "float_attr", "parse_urdf",
+    "resolve_collision_meshes", "xml_root",
 ]
 
 MOVABLE_JOINT_TYPES = ("revolute", "continuous", "prismatic")
+JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+"""The joint types urdfdom reads."""
 
 
 @dataclass(frozen=True)
@@ -65,44 +67,122 @@ def float_attr(element: ET.Element, name: str, path: Path, default: float = math
 
 
 def parse_urdf(text: str, path: Path) -> dict[str, UrdfJoint]:
-    """Return the URDF's joints by name, in file order; every link they name must be defined."""
+    """Return the URDF's joints by name, in file order, checked as urdfdom checks a model.
+
+    Every link and joint has a unique name, joints a known type and links that exist,
+    limits finite numbers (velocity and effort given, as urdfdom requires), a movable joint a
+    non-zero axis, a mimic joint a leader other than itself and no mimic loop; the links form
+    one tree.
+    """
     root = xml_root(text, path)
     if root.tag != "robot":
         raise ConfigError(f"{path}: not a URDF (root element is <{root.tag}>, expected <robot>)")
-    links = {link.get("name", "") for link in root.findall("link")}
-    joints: dict[str, UrdfJoint] = {}
-    for element in root.findall("joint"):
-        name = element.get("name", "")
-        parent, child = element.find("parent"), element.find("child")
-        if parent is None or child is None:
-            raise ConfigError(f"{path}: joint '{name}' needs <parent> and <child>")
-        for link in (parent.get("link", ""), child.get("link", "")):
-            if link not in links:
-                raise ConfigError(f"{path}: joint '{name}' names link '{link}', which is not defined")
-        limit = element.find("limit")
-        lower = upper = velocity = math.nan
-        if limit is not None:
-            lower = float_attr(limit, "lower", path, 0.0)
-            upper = float_attr(limit, "upper", path, 0.0)
-            velocity = float_attr(limit, "velocity", path)
-        mimic = element.find("mimic")
-        leader, multiplier, offset = "", 1.0, 0.0
-        if mimic is not None:
-            leader = mimic.get("joint", "")
-            multiplier, offset = float_attr(mimic, "multiplier", path, 1.0), float_attr(mimic, "offset", path, 0.0)
-        joints[name] = UrdfJoint(
-            name, element.get("type", ""), parent.get("link", ""), child.get("link", ""),
-            lower, upper, velocity, leader, multiplier, offset,
-        )
-    for joint in joints.values():
-        if joint.mimic and joint.mimic not in joints:
-            raise ConfigError(f"{path}: joint '{joint.name}' mimics joint '{joint.mimic}', which is not defined")
-    _check_tree(joints, path)
+    links = _names(root.findall("link"), "link", path)
+    if not links:
+        raise ConfigError(f"{path}: defines no <link>; a URDF needs at least one")
+    _names(root.findall("joint"), "joint", path)
+    joints = {joint.name: joint for joint in (_joint(element, links, path) for element in root.findall("joint"))}
+    _check_mimics(joints, path)
+    _check_tree(joints, path, links)
     return joints
 
 
-def _check_tree(joints: dict[str, UrdfJoint], path: Path) -> None:
-    """Raise ConfigError unless the joints make a tree: one parent joint per link, no link its own ancestor."""
+def _names(elements: list[ET.Element], what: str, path: Path) -> list[str]:
+    """Return the names of URDF `<link>` or `<joint>` elements; ConfigError for a missing or repeated one."""
+    names: list[str] = []
+    seen: set[str] = set()
+    for element in elements:
+        name = element.get("name", "")
+        if not name:
+            raise ConfigError(f"{path}: a <{what}> has no name")
+        if name in seen:
+            raise ConfigError(f"{path}: {what} '{name}' is defined twice; names in a URDF are unique")
+        seen.add(name)
+        names.append(name)
+    return names
+
+
+def _joint(element: ET.Element, links: list[str], path: Path) -> UrdfJoint:
+    """Return one `<joint>` element read as urdfdom reads it, checked."""
+    name, kind = element.get("name", ""), element.get("type", "")
+    if kind not in JOINT_TYPES:
+        raise ConfigError(f"{path}: joint '{name}' has type '{kind}'; expected one of {', '.join(JOINT_TYPES)}")
+    parent, child = element.find("parent"), element.find("child")
+    if parent is None or child is None:
+        raise ConfigError(f"{path}: joint '{name}' needs <parent> and <child>")
+    for link in (parent.get("link", ""), child.get("link", "")):
+        if link not in links:
+            raise ConfigError(f"{path}: joint '{name}' names link '{link}', which is not defined")
+    limit = element.find("limit")
+    lower = upper = velocity = math.nan
+    if limit is not None:
+        where = f"joint '{name}' <limit>"
+        lower, upper = _finite_attr(limit, "lower", path, where, 0.0), _finite_attr(limit, "upper", path, where, 0.0)
+        velocity = _finite_attr(limit, "velocity", path, where)
+        _finite_attr(limit, "effort", path, where)
+    elif kind in ("revolute", "prismatic"):
+        raise ConfigError(f"{path}: joint '{name}' is {kind} but has no <limit> (urdfdom requires one)")
+    if kind in MOVABLE_JOINT_TYPES:
+        _check_axis(element, name, path)
+    mimic = element.find("mimic")
+    leader, multiplier, offset = "", 1.0, 0.0
+    if mimic is not None:
+        leader = mimic.get("joint", "")
+        where = f"joint '{name}' <mimic>"
+        multiplier = _finite_attr(mimic, "multiplier", path, where, 1.0)
+        offset = _finite_attr(mimic, "offset", path, where, 0.0)
+    return UrdfJoint(name, kind, parent.get("link", ""), child.get("link", ""), lower, upper, velocity,
+                     leader, multiplier, offset)
+
+
+def _finite_attr(element: ET.Element, name: str, path: Path, where: str, default: float | None = None) -> float:
+    """Return an attribute as a finite float, `default` when absent (None: required, as urdfdom requires it)."""
+    text = element.get(name)
+    if text is None:
+        if default is None:
+            raise ConfigError(f"{path}: {where} has no {name} (urdfdom requires it)")
+        return default
+    value = float_attr(element, name, path)
+    if not math.isfinite(value):
+        raise ConfigError(f"{path}: {where} {name}='{text[:40]}' is not a finite number")
+    return value
+
+
+def _check_axis(element: ET.Element, name: str, path: Path) -> None:
+    """Raise ConfigError unless a movable joint's `<axis xyz>` is three finite numbers, not all zero."""
+    axis = element.find("axis")
+    text = axis.get("xyz", "1 0 0") if axis is not None else "1 0 0"
+    try:
+        values = [float(word) for word in text.split()]
+    except ValueError:
+        values = []
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise ConfigError(f"{path}: joint '{name}' <axis xyz='{text[:60]}'>: expected three finite numbers")
+    if not any(values):
+        # Normalised by the kinematics, a zero axis turns every pose below the joint into NaN.
+        raise ConfigError(f"{path}: joint '{name}' <axis xyz='{text}'> has zero length; give the axis it turns about")
+
+
+def _check_mimics(joints: dict[str, UrdfJoint], path: Path) -> None:
+    """Raise ConfigError for a mimic joint whose leader is missing, itself, or part of a loop of mimics."""
+    for joint in joints.values():
+        if not joint.mimic:
+            continue
+        if joint.mimic not in joints:
+            raise ConfigError(f"{path}: joint '{joint.name}' mimics joint '{joint.mimic}', which is not defined")
+        chain = [joint.name]
+        while joints[chain[-1]].mimic:
+            chain.append(joints[chain[-1]].mimic)
+            if chain[-1] in chain[:-1]:
+                loop = " -> ".join(chain[chain.index(chain[-1]):])
+                raise ConfigError(f"{path}: mimic joints follow each other in a loop ({loop}); "
+                                  "a mimic joint follows a joint that moves on its own")
+            if chain[-1] not in joints:
+                break
+
+
+def _check_tree(joints: dict[str, UrdfJoint], path: Path, links: list[str]) -> None:
+    """Raise ConfigError unless the joints make one tree: one parent joint per link, no cycle, one root."""
     parent_joint: dict[str, UrdfJoint] = {}
     for joint in joints.values():
         if joint.child in parent_joint:
@@ -120,6 +200,11 @@ def _check_tree(joints: dict[str, UrdfJoint], path: Path) -> None:
             seen.append(link)
             link = parent_joint[link].parent
         done.update(seen)
+    roots = [link for link in links if link not in parent_joint]
+    if len(roots) > 1:
+        shown = ", ".join(roots[:5]) + (f", ... ({len(roots) - 5} more)" if len(roots) > 5 else "")
+        raise ConfigError(f"{path}: {len(roots)} root links ({shown}); a URDF is one tree: attach each "
+                          "to the others with a joint")
 
 
 def resolve_collision_meshes(

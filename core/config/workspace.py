@@ -11,11 +11,12 @@ from __future__ import annotations
 
 import functools
 import logging
+import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 from types import MappingProxyType
 
-__all__ = ["MAX_DEPTH", "MAX_FOLDERS", "package_name", "packages_under", "workspace_src"]
+__all__ = ["MAX_DEPTH", "MAX_FOLDERS", "duplicate_packages", "package_name", "packages_under", "workspace_src"]
 
 _log = logging.getLogger(__name__)
 
@@ -26,19 +27,32 @@ MAX_FOLDERS = 5_000
 """Folders one search folder's walk may read: a search folder that is a home directory must not stall a run."""
 
 _SKIPPED = frozenset({"build", "install", "log"})
+# REP 144 asks for [a-z][a-z0-9_]*; real packages also use capitals, dots and dashes. Bounded, so that a
+# name from a package.xml makes a file name (config/<name>.srdf) the system accepts.
+_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,199}")
 _IGNORE_MARKERS = ("COLCON_IGNORE", "CATKIN_IGNORE", "AMENT_IGNORE")
 
 
-def package_name(folder: Path) -> str | None:
-    """Return the name a folder's package.xml gives, or None (no or unreadable package.xml)."""
+def package_name(folder: Path, warn: bool = False) -> str | None:
+    """Return the name a folder's package.xml gives, or None (no, unreadable or malformed package.xml).
+
+    With `warn`, a package.xml that gives no usable name is logged as a warning naming it: colcon
+    refuses such a workspace, moveplan only skips the package.
+    """
     manifest = folder / "package.xml"
     if not manifest.is_file():
         return None
     try:
-        name = ET.parse(manifest).getroot().findtext("name")
-    except (ET.ParseError, OSError):
-        return None
-    return name.strip() if name else None
+        name = (ET.parse(manifest).getroot().findtext("name") or "").strip()
+    except (ET.ParseError, OSError) as exc:
+        problem = f"cannot be read ({exc})"
+    else:
+        if _NAME.fullmatch(name):
+            return name
+        problem = "has no <name>" if not name else f"names the package {name[:40]!r}, not a package name"
+    if warn:
+        _log.warning("%s %s; its package is skipped", manifest, problem)
+    return None
 
 
 def workspace_src(folder: Path) -> Path | None:
@@ -49,18 +63,39 @@ def workspace_src(folder: Path) -> Path | None:
     return None
 
 
-@functools.lru_cache(maxsize=128)
 def packages_under(folder: Path) -> MappingProxyType[str, Path]:
     """Return package name -> folder for every package below `folder` (the first of a name, in sorted order)."""
-    found: dict[str, Path] = {}
+    return _packages(folder)[0]
+
+
+def duplicate_packages(folder: Path) -> MappingProxyType[str, tuple[Path, ...]]:
+    """Return package name -> its folders, for the names that more than one package below `folder` gives."""
+    return _packages(folder)[1]
+
+
+@functools.lru_cache(maxsize=128)
+def _packages(folder: Path) -> tuple[MappingProxyType[str, Path], MappingProxyType[str, tuple[Path, ...]]]:
+    """Return the packages below `folder` by name, and the names given by several (different) folders."""
+    found: dict[str, list[Path]] = {}
     budget = [MAX_FOLDERS]
     for package in _walk(folder, MAX_DEPTH, budget):
-        name = package_name(package)
-        if name is not None:
-            found.setdefault(name, package)
+        name = package_name(package, warn=True)
+        folders = found.setdefault(name, []) if name is not None else []
+        # A link to a package inside the same tree is that package, not a second one.
+        if name is not None and not any(_same(package, other) for other in folders):
+            folders.append(package)
     if budget[0] <= 0:
         _log.warning("%s: stopped looking for packages after %d folders", folder, MAX_FOLDERS)
-    return MappingProxyType(found)
+    first = {name: folders[0] for name, folders in found.items()}
+    twice = {name: tuple(folders) for name, folders in found.items() if len(folders) > 1}
+    return MappingProxyType(first), MappingProxyType(twice)
+
+
+def _same(one: Path, other: Path) -> bool:
+    try:
+        return one.samefile(other)
+    except OSError:
+        return False
 
 
 def _walk(folder: Path, depth: int, budget: list[int]) -> list[Path]:

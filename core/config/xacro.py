@@ -28,7 +28,7 @@ import xacro as _xacro  # type: ignore[import-untyped]  # the PyPI package ships
 from xacro import substitution_args as _substitution_args
 
 from ..errors import ConfigError, UsageError
-from .workspace import package_name, packages_under
+from .workspace import duplicate_packages, package_name, packages_under
 
 __all__ = ["PackagePath", "XacroResult", "parse_xacro_args", "process_xacro"]
 
@@ -58,6 +58,13 @@ class PackagePath:
             return self._found[package]
         for folder in self.folders:
             hit = self._in(folder, package)
+            # Only a package found by the walk below `folder` may have a namesake there.
+            walked = hit is not None and hit not in (folder, folder / package)
+            twice = duplicate_packages(folder).get(package) if walked else None
+            if hit is not None and twice and hit in twice:
+                # colcon refuses such a workspace ("Duplicate package names not supported").
+                raise ConfigError(f"{source}: package '{package}' is defined by {len(twice)} folders in {folder}: "
+                                  f"{', '.join(str(t) for t in twice)}; keep one, or mark the others COLCON_IGNORE")
             if hit is not None:
                 self._found[package] = hit.resolve()  # absolute: xacro joins relative paths to the including file
                 return self._found[package]
@@ -96,9 +103,17 @@ class PackagePath:
         if path.is_absolute():
             return path, ""
         for folder in (base, *self.folders):
-            if (folder / path).exists():
+            if _exists(folder / path):
                 return folder / path, ""
         return base / path, ""
+
+
+def _exists(path: Path) -> bool:
+    """Return whether `path` exists; a name the system refuses (too long) does not."""
+    try:
+        return path.exists()
+    except OSError:
+        return False
 
 
 @dataclass(frozen=True)

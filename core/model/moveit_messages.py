@@ -22,6 +22,7 @@ from ..errors import ConfigError, UnknownName
 from ..types import Shape
 from .poses import pose_matrix
 from .robot import Robot
+from .scene import mesh_file
 
 __all__ = [
     "ObjectMessage",
@@ -333,8 +334,14 @@ def _mesh_file(entry: dict[str, Any], where: str, folder: Path, packages: Packag
         raise ConfigError(f"{where}.dimensions: expected the scale [x, y, z] of the mesh, got {scale!r}")
     sx, sy, sz = (number(v, f"{where}.dimensions[{i}]", positive=True, bound=MAX_MAGNITUDE)
                   for i, v in enumerate(scale))
+    if len(uri) > 4096 or "\0" in uri:
+        raise ConfigError(f"{where}.resource: {uri[:60]!r}... is not a file name or package:// URI")
     path, package = packages.resolve_uri(uri.strip(), folder, f"{where}.resource")
-    if not path.is_file():
-        inside = f" (package '{package}' is {packages.find(package, where)})" if package else ""
-        raise ConfigError(f"{where}.resource: mesh file not found: {path}{inside}")
-    return Shape("mesh", (), str(path.resolve()), (sx, sy, sz))
+    inside = f" (package '{package}' is {packages.find(package, where)})" if package else ""
+    try:
+        found = path.is_file()
+    except OSError:
+        found = False
+    if not found:
+        raise ConfigError(f"{where}.resource: mesh file not found: {str(path)[:200]}{inside}")
+    return Shape("mesh", (), str(mesh_file(path, f"{where}.resource")), (sx, sy, sz))

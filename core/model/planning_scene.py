@@ -180,6 +180,11 @@ def _attach(
         link, written, touch = attached_object(value, at)
         if link not in robot.link_names:
             raise UnknownName("link", link, f"{at}.link_name", robot.link_names)
+        unknown = [t for t in touch if t not in robot.link_names and t not in {*objects.world, *objects.attached}]
+        if unknown:
+            # MoveIt takes any name; one that is no link or object allows nothing, likely a typo.
+            logger.warning("%s.touch_links: %s name no robot link or object; they allow no contact",
+                           at, ", ".join(unknown[:10]))
         message = collision_object(written, f"{at}.object", folder, packages)
         world = objects.world.pop(message.id, None)
         objects.attached.pop(message.id, None)

@@ -12,6 +12,7 @@ core/model/scene_file.py tells the two apart.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,7 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config.fields import check_keys, mapping, number
+from ..config.fields import MAX_MAGNITUDE, check_keys, mapping, number
 from ..errors import ConfigError, FrameNotFound
 from ..types import CollisionObject, Frame, Shape
 from .poses import pose_matrix, vector
@@ -28,7 +29,7 @@ from .robot import Robot
 
 __all__ = [
     "MAX_SCENE_FRAMES", "MAX_SCENE_SHAPES", "PLANNING_SCENE_KEYS", "Scene", "check_shape_count", "empty_scene",
-    "first_repeated", "moveplan_scene", "planning_frame_names", "resolve_frames",
+    "first_repeated", "mesh_file", "moveplan_scene", "planning_frame_names", "resolve_frames",
 ]
 
 MAX_SCENE_SHAPES = 10_000
@@ -37,6 +38,9 @@ each shape costs collision checks at every state of every motion (docs/formats.m
 MAX_SCENE_FRAMES = 10_000
 """Frames a scene may define, subframes of PlanningScene objects included."""
 
+_STL_HEADER = 84  # 80 bytes of text, then the triangle count
+_STL_TRIANGLE = 50  # normal and three vertices as float32, then a 2-byte attribute
+_STL_NUMBER = re.compile(rb"vertex\s+(\S+)\s+(\S+)\s+(\S+)")
 _FRAME_KEYS = {"name", "parent", "xyz", "rpy", "quat"}
 _SHAPE_KEYS = {"box", "cylinder", "sphere", "mesh", "scale"}
 _OBJECT_KEYS = {"name", "frame", "xyz", "rpy", "quat"} | _SHAPE_KEYS
@@ -124,10 +128,64 @@ def _shape(entry: dict[str, Any], where: str, folder: Path) -> Shape:
         if not isinstance(value, str):
             raise ConfigError(f"{where}.mesh: expected a file name, got {value!r}")
         scale = tuple(float(v) for v in vector(entry.get("scale", [1, 1, 1]), 3, f"{where}.scale"))
-        return Shape("mesh", (), str(folder / value), (scale[0], scale[1], scale[2]))
+        if any(not 0 < s <= MAX_MAGNITUDE for s in scale):
+            raise ConfigError(f"{where}.scale: expected positive sizes up to {MAX_MAGNITUDE:g}, got {list(scale)}")
+        path = mesh_file(folder / value, f"{where}.mesh")
+        return Shape("mesh", (), str(path), (scale[0], scale[1], scale[2]))
     if any(d <= 0 for d in dims):
         raise ConfigError(f"{where}.{kind}: sizes must be positive, got {list(dims)}")
     return Shape(kind, dims)
+
+
+def mesh_file(path: Path, where: str) -> Path:
+    """Return a mesh file's absolute path, after checking it is a file and, for an STL, that it is whole and finite.
+
+    The mesh loader (assimp) reads a cut binary STL, or one whose vertices are NaN, into
+    geometry whose checks answer anything; other formats are left to it.
+
+    Raises:
+        ConfigError: Not a file, or an STL that is empty, cut, or has a vertex that is not finite.
+    """
+    try:
+        if not path.is_file():
+            raise ConfigError(f"{where}: mesh file not found: {path}")
+        resolved = path.resolve()
+        size = resolved.stat().st_size
+    except OSError as exc:
+        raise ConfigError(f"{where}: cannot use {str(path)[:120]} as a mesh file: {exc.strerror or exc}") from None
+    if path.suffix.lower() == ".stl":
+        problem = _stl_problem(resolved, size)
+        if problem:
+            raise ConfigError(f"{where}: {path}: {problem}")
+    return resolved
+
+
+def _stl_problem(path: Path, size: int) -> str:
+    """Return what is wrong with an STL file ("" if nothing): binary when its size says so, else ASCII."""
+    if size == 0:
+        return "empty file, not an STL mesh"
+    with path.open("rb") as stream:
+        head = stream.read(_STL_HEADER)
+    count = int.from_bytes(head[80:84], "little") if len(head) == _STL_HEADER else -1
+    if count >= 0 and size == _STL_HEADER + _STL_TRIANGLE * count:
+        if count == 0:
+            return "binary STL with no triangles"
+        triangles = np.memmap(path, dtype=np.dtype([("normal", "<f4", 3), ("vertices", "<f4", 9),
+                                                    ("attribute", "<u2")]), mode="r", offset=_STL_HEADER)
+        bad = np.flatnonzero(~np.isfinite(triangles["vertices"]).all(axis=1))
+        return f"binary STL: triangle {bad[0]} has a vertex that is not finite" if len(bad) else ""
+    if not head.lstrip().startswith(b"solid"):
+        return (f"not an STL mesh: {size} bytes, but a binary STL of {count} triangles has "
+                f"{_STL_HEADER + _STL_TRIANGLE * max(count, 0)} (cut, or not a mesh)")
+    vertices = _STL_NUMBER.findall(path.read_bytes())
+    if not vertices:
+        return "ASCII STL with no vertices (cut, or not a mesh)"
+    try:
+        values = np.array(vertices, dtype=np.float64)
+    except ValueError:
+        return "ASCII STL: a vertex coordinate is not a number"
+    bad = np.flatnonzero(~np.isfinite(values).all(axis=1))
+    return f"ASCII STL: vertex {bad[0]} is not finite" if len(bad) else ""
 
 
 def moveplan_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
