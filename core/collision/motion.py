@@ -10,7 +10,8 @@ loses only the little space between a mesh and its hull.
 
 Certification checks a trajectory as the controller interpolates it, at states so
 close that no point of the robot moves more than `step_m` between two of them
-(core/collision/certify.py bounds that motion).
+(core/collision/certify.py bounds that motion). The spheres skip the states a clearance
+proves free (core/collision/_kernels.py `certify`); coal decides the rest in one batch.
 """
 
 from __future__ import annotations
@@ -51,6 +52,15 @@ class Filter(Protocol):
         """Return the worst verdict on the edge's states, and the verdicts and configurations not CLEAR."""
         ...
 
+    def certify(
+        self, values: NDArray[np.float64], travel: NDArray[np.float64]
+    ) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+        """Return per state along a motion its verdict and the configurations, skipping what clearances prove free.
+
+        `travel[k]` bounds how far any robot point moves from the first state to state k.
+        """
+        ...
+
 
 class MotionChecker:
     """Answers whether group states, straight edges and timed trajectories are collision-free."""
@@ -86,6 +96,15 @@ class MotionChecker:
         a hull check costs a quarter of a mesh check.
         """
         verdict, q = self._classified(values)
+        return self._decided(verdict, q, conservative)
+
+    def _decided(
+        self, verdict: NDArray[np.int8], q: NDArray[np.float64], conservative: bool = False
+    ) -> NDArray[np.bool_]:
+        """Return per state True if free, given the spheres' verdicts and the configurations (k, nq).
+
+        What the spheres leave unsure goes to coal in one batch per geometry, hulls first.
+        """
         free = verdict == CLEAR
         maybe = np.flatnonzero(verdict == MAYBE)
         if len(maybe):
@@ -138,16 +157,16 @@ class MotionChecker:
 
     def first_collision_on_trajectory(self, trajectory: JointTrajectory) -> NDArray[np.float64] | None:
         """Return the first colliding state along the interpolated trajectory, or None if it is free."""
-        return self._first_collision(certify.trajectory_states(trajectory, self.reach, CERTIFY_STEP_M))
+        return self._first_collision(*certify.trajectory_states(trajectory, self.reach, CERTIFY_STEP_M))
 
     def first_collision_on_path(self, waypoints: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """Return the first colliding state along the straight segments between waypoints, or None."""
-        states = [certify.segment_states(a, b, self.reach, CERTIFY_STEP_M)
-                  for a, b in zip(waypoints[:-1], waypoints[1:], strict=True)]
-        return self._first_collision(np.concatenate(states) if states else waypoints)
+        return self._first_collision(*certify.path_states(waypoints, self.reach, CERTIFY_STEP_M))
 
-    def _first_collision(self, states: NDArray[np.float64]) -> NDArray[np.float64] | None:
-        free = self.free(states)
+    def _first_collision(self, states: NDArray[np.float64], travel: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """Return the first colliding state of a motion through `states` (`travel`: see certify.trajectory_states)."""
+        verdict, q = self._classified(states) if self.spheres is None else self.spheres.certify(states, travel)
+        free = self._decided(verdict, q)
         return None if free.all() else states[int(np.argmin(free))]
 
     def colliding_pair(self, values: NDArray[np.float64]) -> tuple[str, str] | None:

@@ -35,6 +35,8 @@ __all__ = ["CLEAR", "COLLIDES", "MAYBE", "SphereFilter", "UnsupportedJoint"]
 _REVOLUTE, _PRISMATIC, _UNBOUNDED = 1, 2, 3
 _AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
 _BOX, _SPHERE, _CYLINDER = 0, 1, 2
+# The most clearance a state is credited with [m]: past ~5 cm, finding it costs more than the states it skips.
+CLEARANCE_CAP_M = 0.05
 
 
 def _joint_kind(model: pin.Model, jid: int) -> tuple[int, tuple[float, float, float]]:
@@ -84,9 +86,10 @@ class SphereFilter:
         self.tabulated = tuple((t.upper, t.lower) for t in tables)
         world = [obj for obj in objects if not obj.link]
         check = _world_checks(names, owner_joint, world, allowed)
+        from . import _clearance  # numba too: the certification walk
         from . import _kernels as sphere_kernels  # numba: compiled once, then loaded from its disk cache
 
-        self._kernels = sphere_kernels
+        self._kernels, self._clearance = sphere_kernels, _clearance
         base = robot.neutral() if base is None else base
         inner = inner_spheres(model, hulls or geometry, robot.config.urdf)
         # Packed once: the kernels run thousands of times per search, and a call costs per argument.
@@ -112,6 +115,20 @@ class SphereFilter:
         out = np.empty(len(values), dtype=np.int8)
         judged = self._kernels.classify(_plain(values), stop, *self._packed, q, out)
         return out[:judged], q[:judged]
+
+    def certify(
+        self, values: NDArray[np.float64], travel: NDArray[np.float64]
+    ) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+        """Return per state along a motion (rows of `values`) CLEAR, MAYBE or COLLIDES, and the configurations (k, nq).
+
+        `travel[k]` bounds how far any robot point moves from the first state to state k. The
+        states a CLEAR state's clearance proves free are not judged by the spheres (core/collision/
+        _clearance.py `certify`): they read CLEAR where the distance tables say apart.
+        """
+        q = np.empty((len(values), self._nq))
+        out = np.empty(len(values), dtype=np.int8)
+        self._clearance.certify(_plain(values), _plain(travel), CLEARANCE_CAP_M, *self._packed, q, out)
+        return out, q
 
     def edge(
         self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, stop: bool = False
