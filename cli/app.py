@@ -63,9 +63,22 @@ _ROBOT_HELP = ("Robot config: a moveplan.yaml or its folder, a MoveIt config pac
                "or a shipped name.")
 
 
+class _Format(logging.Formatter):
+    """`moveplan: LEVEL: message`, and `moveplan: message` for a notice of one-time work (INFO)."""
+
+    def format(self, record: logging.LogRecord) -> str:
+        text = super().format(record)
+        return f"moveplan: {text}" if record.levelno == logging.INFO else f"moveplan: {record.levelname}: {text}"
+
+
 def _logging(verbose: bool, quiet: bool) -> None:
     level = logging.DEBUG if verbose else logging.ERROR if quiet else logging.WARNING
-    logging.basicConfig(level=level, format="moveplan: %(levelname)s: %(message)s")
+    logging.basicConfig(level=level)
+    for handler in logging.getLogger().handlers:
+        handler.setFormatter(_Format("%(message)s"))
+    if not quiet and not verbose:
+        # Seconds of one-time work (sphere fitting, distance tables) are announced, not left silent.
+        logging.getLogger("moveplan.core.collision._cache").setLevel(logging.INFO)
 
 
 @app.command()

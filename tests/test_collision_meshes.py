@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 from conftest import ROOT, SAMPLES, Cli
 
-from moveplan.core.collision import motion
 from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import ConfigError
 from moveplan.core.model.robot import Robot
 from moveplan.core.model.scene_file import load_scene
+from moveplan.core.pipeline import checks
 
 PANDA = ROOT / "configs" / "panda"
 SHELF_SCENE = SAMPLES / "panda_shelf_scene.yaml"
@@ -116,7 +116,7 @@ def test_collision_key_in_moveplan_yaml_selects_convex_mode(
             super().__init__(*args, **kwargs)
             modes.append(self.mode)
 
-    monkeypatch.setattr(motion, "CollisionChecker", Spy)
+    monkeypatch.setattr(checks, "CollisionChecker", Spy)
     result = cli("plan", "--robot", folder, "--start-named", "ready", "--joints", "panda_joint1=0.3",
                  "-o", tmp_path / "out.mcap")
     assert result.exit_code == 0, result.stderr

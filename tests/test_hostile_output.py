@@ -397,12 +397,17 @@ def test_partial_files_left_by_killed_runs_are_swept_when_the_entry_is_written(t
     assert sorted(p.name for p in tmp_path.iterdir()) == ["entry.pickle", young.name]
 
 
-def _plan_process(out: Path, cache: Path, limit: int | None = None) -> subprocess.Popen[str]:
+# Plans enough states that the sphere filter is built, so that the cache is used (core/pipeline/checks.py).
+CACHE_PLAN = (SAMPLES / "panda_shelf_bays.yaml", "--seed", "0")
+
+
+def _plan_process(out: Path, cache: Path, limit: int | None = None, args: tuple[Any, ...] = QUICK_PLAN
+                  ) -> subprocess.Popen[str]:
     def limited() -> None:
         if limit is not None:  # a full disk: writing past `limit` bytes fails with EFBIG (Python ignores SIGXFSZ)
             resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 
-    return subprocess.Popen([sys.executable, "-m", "moveplan.cli.app", "plan", *map(str, QUICK_PLAN), "-o", out],
+    return subprocess.Popen([sys.executable, "-m", "moveplan.cli.app", "plan", *map(str, args), "-o", out],
                             env={**os.environ, "MOVEPLAN_CACHE_DIR": str(cache)}, preexec_fn=limited,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
@@ -419,7 +424,7 @@ def test_a_full_disk_fails_the_plan_as_bad_input_and_leaves_no_partial_files(tmp
 
 def test_concurrent_cold_cache_runs_agree_byte_for_byte_with_warm_and_repaired_caches(tmp_path: Path) -> None:
     cache = tmp_path / "cache"
-    runs = [_plan_process(tmp_path / f"cold{i}.mcap", cache) for i in range(3)]
+    runs = [_plan_process(tmp_path / f"cold{i}.mcap", cache, args=CACHE_PLAN) for i in range(3)]
     for process in runs:
         _, stderr = process.communicate(timeout=300)
         assert process.returncode == 0, stderr
@@ -431,11 +436,11 @@ def test_concurrent_cold_cache_runs_agree_byte_for_byte_with_warm_and_repaired_c
         data = bytearray(entry.read_bytes())
         data[len(data) // 2] ^= 0x10
         entry.write_bytes(bytes(data))
-    repaired = _plan_process(tmp_path / "repaired.mcap", cache)
+    repaired = _plan_process(tmp_path / "repaired.mcap", cache, args=CACHE_PLAN)
     _, stderr = repaired.communicate(timeout=300)
     assert repaired.returncode == 0, stderr
     assert stderr.count("cannot be used (checksum mismatch") == len(entries), stderr
-    warm = _plan_process(tmp_path / "warm.mcap", cache)
+    warm = _plan_process(tmp_path / "warm.mcap", cache, args=CACHE_PLAN)
     _, stderr = warm.communicate(timeout=300)
     assert warm.returncode == 0 and "WARNING" not in stderr, stderr
     reference = (tmp_path / "cold0.mcap").read_bytes()
@@ -446,12 +451,12 @@ def test_concurrent_cold_cache_runs_agree_byte_for_byte_with_warm_and_repaired_c
 def test_json_stays_clean_when_the_cache_warns(tmp_path: Path) -> None:
     cache = tmp_path / "cache"
     cache.mkdir()
-    first = _plan_process(tmp_path / "a.mcap", cache)
+    first = _plan_process(tmp_path / "a.mcap", cache, args=CACHE_PLAN)
     assert first.communicate(timeout=300) and first.returncode == 0
     for entry in cache.iterdir():
         entry.write_bytes(b"garbage")
     result = subprocess.run(
-        [sys.executable, "-m", "moveplan.cli.app", "plan", *map(str, QUICK_PLAN), "-o", tmp_path / "b.mcap", "--json"],
+        [sys.executable, "-m", "moveplan.cli.app", "plan", *map(str, CACHE_PLAN), "-o", tmp_path / "b.mcap", "--json"],
         env={**os.environ, "MOVEPLAN_CACHE_DIR": str(cache)}, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
     assert json.loads(result.stdout)["ok"] is True

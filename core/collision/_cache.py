@@ -26,7 +26,7 @@ from typing import Any
 
 import pinocchio as pin
 
-__all__ = ["FORMAT", "digest", "path", "read", "write"]
+__all__ = ["FORMAT", "announce", "digest", "path", "read", "write"]
 
 logger = logging.getLogger(__name__)
 
@@ -74,6 +74,14 @@ def read(where: Path, kind: type) -> Any:
     if not isinstance(value, kind):
         return _untrusted(where, f"holds a {type(value).__name__}, not a {kind.__name__}")
     return value
+
+
+def announce(work: str, where: Path) -> None:
+    """Log at INFO, before it starts, one-time work (seconds) whose result is cached at `where`; return None.
+
+    A first run on a fresh machine would otherwise sit silent for seconds; the command line shows these lines.
+    """
+    logger.info("%s (once per robot; cached in %s)", work, where.parent)
 
 
 def _untrusted(where: Path, why: str) -> None:

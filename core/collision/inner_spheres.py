@@ -12,7 +12,6 @@ import coal
 import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
-from scipy.spatial import ConvexHull, QhullError
 
 from . import _cache as disk_cache
 from .sphere_fit import SphereSet
@@ -83,6 +82,9 @@ def _inside(geometry: coal.CollisionGeometry) -> tuple[NDArray[np.float64], NDAr
 
 def _largest_balls(points: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Return up to a few of the largest balls inside the convex hull of `points`, greedily spread."""
+    # Imported here: scipy.spatial costs ~0.4 s of start-up, and the balls are fitted once per robot.
+    from scipy.spatial import ConvexHull, QhullError
+
     try:
         equations = ConvexHull(points).equations  # rows (n, b): n . x + b <= 0 inside, |n| = 1
     except QhullError:

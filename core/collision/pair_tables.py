@@ -61,6 +61,7 @@ def pair_tables(
         path = disk_cache.path(f"pairs-{key[:32]}.pickle")
         tables = disk_cache.read(path, tuple)
         if tables is None:
+            disk_cache.announce(f"tabulating distances of wrist link pairs for {model.name}", path)
             by_joints: dict[tuple[int, ...], list[tuple[str, str]]] = {}
             for upper, lower, joints in _tabulable(model, hulls, disabled):
                 by_joints.setdefault(joints, []).append((upper, lower))

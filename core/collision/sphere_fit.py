@@ -63,6 +63,7 @@ def robot_spheres(model: pin.Model, geometry: pin.GeometryModel, urdf: str) -> S
     path = disk_cache.path(f"spheres-{key[:32]}.pickle")
     spheres = disk_cache.read(path, SphereSet)
     if spheres is None:
+        disk_cache.announce(f"fitting collision spheres for {model.name}", path)
         objects = geometry.geometryObjects
         owners = [str(model.frames[obj.parentFrame].name) for obj in objects]
         surfaces = [None if isinstance(obj.geometry, coal.Sphere | coal.Capsule) else _surface(obj.geometry)

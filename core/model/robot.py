@@ -112,10 +112,13 @@ class Robot:
     def tf_samples(self, times_s: npt.ArrayLike, values: NDArray[np.float64], base: NDArray[np.float64]) -> TfSamples:
         """Return `parent_T_child` of every moving URDF joint for group values (M, dof) at `times_s`."""
         moving = [j for j in self.config.urdf_joints.values() if j.type != "fixed"]
+        pairs = [(self.model.getFrameId(j.parent), self.model.getFrameId(j.child)) for j in moving]
         rows = np.empty((len(values), len(moving), 4, 4))
+        frames = self.data.oMf
+        # pinocchio's own inverse and product, not numpy's: a plan file is the same to the last bit.
         for k, q in enumerate(self.configurations(np.asarray(values, dtype=float), base).T):
             pin.framesForwardKinematics(self.model, self.data, q)
-            rows[k] = [self._relative(j.parent, j.child) for j in moving]
+            rows[k] = [(frames[parent].inverse() * frames[child]).homogeneous for parent, child in pairs]
         return TfSamples(times_s, tuple(j.parent for j in moving), tuple(j.child for j in moving), rows)
 
     def _relative(self, parent: str, child: str) -> NDArray[np.float64]:

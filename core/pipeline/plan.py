@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import time
 from importlib.metadata import version
 from pathlib import Path
 
@@ -18,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..bag import write_plan
-from ..collision.motion import MotionChecker, exact_checks, scene_checks
+from ..collision.motion import MotionChecker, exact_checks
 from ..config import JointGoal, NamedGoal, RobotConfig, StartFrom, load_robot_config, load_task
 from ..config.limits import DEFAULT_ACCELERATION
 from ..errors import InputError, MoveplanError, StartInCollision, StartOutsideLimits, UnknownName, UsageError
@@ -31,6 +32,7 @@ from ..planning.goals import check_limits, joint_target
 from ..planning.search import seed_planner
 from ..trajectory import sample
 from ..types import Plan, StepResult, TfSamples
+from .checks import FILTER_AFTER_STATES, problem_checks
 from .request import PlanFlags, PlanRequest, resolve_request
 from .step import plan_step
 
@@ -49,7 +51,7 @@ def plan_to_file(task: Path | None, flags: PlanFlags, output: Path, ros_distro: 
     _refuse_replacing_inputs(output, request, config)
     if (request.group or config.planning["group"]) in config.srdf.groups:
         _warn_default_accelerations(config, request.group or config.planning["group"])
-    result = plan(request, config)
+    result = plan(request, config, filter_after=FILTER_AFTER_STATES)
     write_plan(output, result, ros_distro)
     return result
 
@@ -71,14 +73,18 @@ def _refuse_replacing_inputs(output: Path, request: PlanRequest, config: RobotCo
             raise UsageError(f"-o '{output}': is also {what} ({path}); an output must not replace an input")
 
 
-def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: bool = False) -> Plan:
+def plan(
+    request: PlanRequest, config: RobotConfig | None = None, exact_check: bool = False, filter_after: int = 0
+) -> Plan:
     """Return the timed, collision-free plan for every step of `request`, in order.
 
     `config` is the loaded `request.robot` when the caller has it (a benchmark plans many
     problems with one robot); a config loaded here also warns about the group's joints that
     plan with the default acceleration limit (limits.DEFAULT_ACCELERATION). With `exact_check`,
     each step's `stats["exact_valid"]` says whether its trajectory is free under the URDF's
-    exact meshes, checked independently of the planner's geometry (1.0 or 0.0).
+    exact meshes, checked independently of the planner's geometry (1.0 or 0.0), and
+    `stats["exact_check_s"]` how long that took [s]. The sphere filter
+    is built after `filter_after` checked states (core/pipeline/checks.py): 0, now.
 
     Raises:
         MoveplanError: Any error while planning a step carries the step's name (`step`).
@@ -95,7 +101,7 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
     base, current = _start_values(request, robot, scene)
     if request.motion_request is not None:  # objects the request's start state carries
         scene = attach_request_objects(scene, request.motion_request, robot, robot.configuration(current, base))
-    checks = scene_checks(robot, scene, config.planning["collision"], base)
+    checks = problem_checks(robot, scene, config.planning["collision"], base, filter_after)
     pair = checks.colliding_pair(current)
     if pair:
         raise StartInCollision(pair)
@@ -103,7 +109,9 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, exact_check: b
     if exact_check:
         referee = exact_checks(checks, scene)
         for step in steps:
+            began = time.perf_counter()
             step.stats["exact_valid"] = float(referee.first_collision_on_trajectory(step.trajectory) is None)
+            step.stats["exact_check_s"] = time.perf_counter() - began
     return _assemble(request, config, robot, scene, base, steps)
 
 

@@ -27,6 +27,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
+from ..collision import setup_clock
 from ..config.planners import PLANNERS
 from ..errors import PlanningFailed, PlanningTimeExceeded, UsageError, known
 from ..types import frozen_array
@@ -100,6 +101,7 @@ class _Work:
         self.time_s = time_s
         self.budget = max(1, math.ceil(time_s * _CHECKS_PER_S))
         self.deadline = time.perf_counter() + time_s
+        self.set_up_before = setup_clock.spent()
         self.used = 0
 
     def until(self, checks: int) -> ob.PlannerTerminationCondition:
@@ -107,8 +109,8 @@ class _Work:
         return ob.PlannerTerminationCondition(lambda: self.used >= checks or self.out_of_time())
 
     def out_of_time(self) -> bool:
-        """Return True once the wall-clock cap is reached."""
-        return time.perf_counter() > self.deadline
+        """Return True once the wall-clock cap is reached, not counting set-up done meanwhile (setup_clock)."""
+        return time.perf_counter() - (setup_clock.spent() - self.set_up_before) > self.deadline
 
     def failure(self, planner: str, status: object) -> PlanningFailed:
         """Return the error for a search that found no path, naming what ended it."""

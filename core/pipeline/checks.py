@@ -1,0 +1,140 @@
+"""A problem's collision checks, built once per robot and scene; the sphere filter only once it pays for itself.
+
+The sphere filter (core/collision/sphere_filter.py) clears a state in microseconds, but building
+it imports numba and loads its compiled kernels: 0.5-1.5 s on a warm machine, and a compilation
+of tens of seconds on a fresh one. A plan of a few steps checks a few thousand states, which the
+robot's convex hulls judge in ~14 us each: tens of milliseconds. So a one-shot command starts
+with coal alone and builds the filter once the states asked about pass `after` (a rent-or-buy
+rule: by then the hull checks have cost about what the filter's set-up does). A build inside a
+step is kept off the search's planning-time cap (core/collision/setup_clock.py). A process that
+has built one filter has the kernels loaded, and builds the next at once.
+
+Every verdict is the same either way: a state the spheres clear is free under the hulls, and
+one they find colliding collides under them (core/collision/motion.py). What changes is only
+how fast it is reached; a plan is byte for byte the same with or without the filter.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..collision import CollisionChecker, MotionChecker, SphereFilter, UnsupportedJoint, setup_clock
+from ..collision.checker import GeometryMode
+from ..collision.sphere_filter import MAYBE
+from ..errors import ConfigError
+from ..model.robot import Robot
+from ..model.scene import Scene
+from ..trajectory import interpolate
+
+__all__ = ["FILTER_AFTER_STATES", "problem_checks"]
+
+logger = logging.getLogger(__name__)
+
+FILTER_AFTER_STATES = 20_000
+"""States a one-shot command checks with coal alone before it builds the sphere filter (~0.3 s of hull checks)."""
+
+_kernels_loaded = False  # set once a filter is built: later ones cost no numba start-up
+
+
+def problem_checks(
+    robot: Robot, scene: Scene, geometry: GeometryMode, base: NDArray[np.float64], after: int = 0
+) -> MotionChecker:
+    """Return the checks of `robot` (other joints at `base`) in `scene`; the sphere filter comes after `after` states.
+
+    With `after` 0 the filter is built now, as a benchmark wants (its set-up outside the timed steps).
+    """
+    checker = CollisionChecker(robot, scene.objects, scene.source, geometry=geometry, allowed=scene.allowed)
+    hulls = _hull_checker(robot, checker, scene)
+
+    def build() -> SphereFilter | None:
+        global _kernels_loaded
+        try:
+            spheres = SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed, base,
+                                   (hulls or checker).robot_geometry)
+        except UnsupportedJoint as exc:
+            logger.info("no sphere filter (%s): every state is checked by coal", exc)
+            return None
+        _kernels_loaded = True
+        return spheres
+
+    spheres = OnDemandSpheres(robot, base, build, 0 if _kernels_loaded else after)
+    return MotionChecker(robot, checker, base, spheres, hulls)
+
+
+class OnDemandSpheres:
+    """The sphere filter, built on first need; until then every state is unsure (MAYBE) and goes to coal."""
+
+    def __init__(
+        self, robot: Robot, base: NDArray[np.float64], build: Callable[[], SphereFilter | None], after: int
+    ) -> None:
+        """Answer for `robot` (other joints at `base`); call `build` once more than `after` states were asked."""
+        self._robot, self._base, self._build = robot, base, build
+        self._after = self._left = after
+        self._filter: SphereFilter | None = None
+        self._pending = True
+        if after <= 0:
+            self._left = -1
+            self.settle()
+
+    def classify(self, values: NDArray[np.float64], stop: bool = False) -> tuple[
+            NDArray[np.int8], NDArray[np.float64]]:
+        """Return per group state (rows of `values`) CLEAR, MAYBE or COLLIDES, and the configurations (k, nq)."""
+        values = np.atleast_2d(values)
+        spheres = self._spheres(len(values))
+        if spheres is not None:
+            return spheres.classify(values, stop)
+        q = self._robot.configurations(values, self._base).T
+        return np.full(len(q), MAYBE, dtype=np.int8), q
+
+    def edge(self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, stop: bool = False) -> tuple[
+            int, NDArray[np.int8], NDArray[np.float64]]:
+        """Return the worst verdict on the edge's states (`b` included, `a` not), and those not CLEAR."""
+        states = interpolate(a, b, resolution)[1:]
+        spheres = self._spheres(len(states))
+        if spheres is not None:
+            return spheres.edge(a, b, resolution, stop)
+        return MAYBE, np.full(len(states), MAYBE, dtype=np.int8), self._robot.configurations(states, self._base).T
+
+    def certify(self, states: NDArray[np.float64], travel: NDArray[np.float64]) -> tuple[
+            NDArray[np.int8], NDArray[np.float64]]:
+        """Return the filter's verdicts on a motion's states (its own walk when it has one), and the configurations."""
+        spheres = self._spheres(len(states))
+        if spheres is None:
+            return np.full(len(states), MAYBE, dtype=np.int8), self._robot.configurations(states, self._base).T
+        walk = getattr(spheres, "certify", None)
+        return walk(states, travel) if walk is not None else spheres.classify(states)
+
+    def settle(self) -> None:
+        """Build the filter now if enough states were asked about, its time kept off any search's cap."""
+        if self._pending and self._left < 0:
+            self._pending = False
+            logger.debug("building the sphere filter after %d states checked by coal alone", self._after)
+            began = time.perf_counter()
+            self._filter = self._build()
+            setup_clock.add(time.perf_counter() - began)
+
+    def _spheres(self, count: int) -> SphereFilter | None:
+        """Return the filter once built, else None; count the states asked about until then, then build it."""
+        if self._pending:
+            self._left -= count
+            self.settle()
+        return self._filter
+
+
+def _hull_checker(robot: Robot, checker: CollisionChecker, scene: Scene) -> CollisionChecker | None:
+    """Return a checker of the robot's meshes as convex hulls in `scene` when `checker` has meshes, else None."""
+    # As core/collision/motion.py scene_checks builds it; kept here until scene_checks takes the filter's timing.
+    # coal's object type by name: coal itself is the collision district's to import.
+    meshes = any(obj.geometry.getObjectType().name == "OT_BVH" for obj in checker.robot_geometry.geometryObjects)
+    if checker.mode != "exact" or not meshes:
+        return None  # the hulls would be the checker's own shapes, checked twice
+    try:
+        return CollisionChecker(robot, scene.objects, scene.source, geometry="convex", allowed=scene.allowed)
+    except ConfigError as exc:
+        logger.info("no hull stage (%s): states the spheres cannot clear go to the meshes", exc)
+        return None

@@ -1,0 +1,57 @@
+"""Start-up: what `moveplan` imports before it works, and the notice of one-time work on a cold cache."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _run(code: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+    """Return a fresh interpreter's run of `code`."""
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
+                          env={**os.environ, **(env or {})}, timeout=300)
+
+
+def test_help_imports_no_numba_pinocchio_or_scipy() -> None:
+    result = _run("import sys\nfrom moveplan.cli.app import app\nfrom typer.testing import CliRunner\n"
+                  "assert CliRunner().invoke(app, ['--help']).exit_code == 0\n"
+                  "print(sorted(m for m in ('numba', 'pinocchio', 'scipy', 'ompl', 'mcap') if m in sys.modules))")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "[]"
+
+
+def test_single_joint_goal_plan_imports_neither_numba_nor_scipy(tmp_path: Path) -> None:
+    code = ("import sys\nsys.argv = ['moveplan', 'plan', '--robot', 'ur10e', '--start-named', 'home', '--joints',\n"
+            f"            '0.5,-1.2,-1.8,0,1.57,0', '-o', {str(tmp_path / 'plan.mcap')!r}, '-q']\n"
+            "from moveplan.cli.app import main\ntry:\n    main()\nexcept SystemExit as exc:\n    assert not exc.code\n"
+            "print(sorted(m for m in ('numba', 'scipy') if m in sys.modules))")
+    result = _run(code)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "[]"
+    assert (tmp_path / "plan.mcap").stat().st_size > 0
+
+
+def test_cold_cache_announces_sphere_fitting_once(tmp_path: Path) -> None:
+    cache = tmp_path / "cache"
+    command = [sys.executable, "-m", "moveplan.cli.app", "plan", "samples/panda_shelf_bays.yaml",
+               "-o", str(tmp_path / "plan.mcap")]
+    env = {**os.environ, "MOVEPLAN_CACHE_DIR": str(cache)}
+    cold = subprocess.run(command, capture_output=True, text=True, cwd=ROOT, env=env, timeout=600)
+    assert cold.returncode == 0, cold.stderr
+    assert f"moveplan: fitting collision spheres for panda (once per robot; cached in {cache})" in cold.stderr
+    warm = subprocess.run(command, capture_output=True, text=True, cwd=ROOT, env=env, timeout=600)
+    assert warm.returncode == 0, warm.stderr
+    assert "fitting collision spheres" not in warm.stderr
+
+
+def test_quiet_cold_cache_prints_no_notice(tmp_path: Path) -> None:
+    command = [sys.executable, "-m", "moveplan.cli.app", "plan", "samples/panda_shelf_bays.yaml",
+               "-o", str(tmp_path / "plan.mcap"), "-q"]
+    env = {**os.environ, "MOVEPLAN_CACHE_DIR": str(tmp_path / "cache")}
+    result = subprocess.run(command, capture_output=True, text=True, cwd=ROOT, env=env, timeout=600)
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == ""
