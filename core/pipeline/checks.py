@@ -62,24 +62,27 @@ def problem_checks(
         _kernels_loaded = True
         return spheres
 
-    spheres = OnDemandSpheres(robot, base, build, 0 if _kernels_loaded else after)
-    return MotionChecker(robot, checker, base, spheres, hulls)
+    if after <= 0 or _kernels_loaded:
+        return MotionChecker(robot, checker, base, build(), hulls)
+    motion = MotionChecker(robot, checker, base, None, hulls)
+    # Once built, the filter replaces the stand-in: a search calls it thousands of times, each call through
+    # the stand-in a Python call more.
+    motion.spheres = OnDemandSpheres(robot, base, build, after, lambda built: setattr(motion, "spheres", built))
+    return motion
 
 
 class OnDemandSpheres:
     """The sphere filter, built on first need; until then every state is unsure (MAYBE) and goes to coal."""
 
     def __init__(
-        self, robot: Robot, base: NDArray[np.float64], build: Callable[[], SphereFilter | None], after: int
+        self, robot: Robot, base: NDArray[np.float64], build: Callable[[], SphereFilter | None], after: int,
+        built: Callable[[SphereFilter | None], None],
     ) -> None:
-        """Answer for `robot` (other joints at `base`); call `build` once more than `after` states were asked."""
-        self._robot, self._base, self._build = robot, base, build
+        """Answer for `robot` (joints outside the group at `base`); past `after` states, `build` and hand to `built`."""
+        self._robot, self._base, self._build, self._built = robot, base, build, built
         self._after = self._left = after
         self._filter: SphereFilter | None = None
         self._pending = True
-        if after <= 0:
-            self._left = -1
-            self.settle()
 
     def classify(self, values: NDArray[np.float64], stop: bool = False) -> tuple[
             NDArray[np.int8], NDArray[np.float64]]:
@@ -117,6 +120,7 @@ class OnDemandSpheres:
             began = time.perf_counter()
             self._filter = self._build()
             setup_clock.add(time.perf_counter() - began)
+            self._built(self._filter)
 
     def _spheres(self, count: int) -> SphereFilter | None:
         """Return the filter once built, else None; count the states asked about until then, then build it."""
