@@ -32,7 +32,7 @@ from . import certify
 from .checker import CollisionChecker, GeometryMode
 from .sphere_filter import CLEAR, COLLIDES, MAYBE, SphereFilter, UnsupportedJoint
 
-__all__ = ["CERTIFY_STEP_M", "MotionChecker", "exact_checks", "scene_checks"]
+__all__ = ["CERTIFY_STEP_M", "MotionChecker", "exact_checks", "hull_checker", "scene_checks", "sphere_filter"]
 
 logger = logging.getLogger(__name__)
 
@@ -181,8 +181,8 @@ def scene_checks(robot: Robot, scene: Scene, geometry: GeometryMode, base: NDArr
     it leaves before the meshes do. Either stage is left out where the robot cannot have it.
     """
     checker = CollisionChecker(robot, scene.objects, scene.source, geometry=geometry, allowed=scene.allowed)
-    hulls = _hull_checker(robot, checker, scene)
-    return MotionChecker(robot, checker, base, _sphere_filter(robot, checker, hulls, scene, base), hulls)
+    hulls = hull_checker(robot, checker, scene)
+    return MotionChecker(robot, checker, base, sphere_filter(robot, checker, hulls, scene, base), hulls)
 
 
 def exact_checks(checks: MotionChecker, scene: Scene) -> MotionChecker:
@@ -193,7 +193,7 @@ def exact_checks(checks: MotionChecker, scene: Scene) -> MotionChecker:
     return MotionChecker(checks.robot, checker, checks.base)
 
 
-def _sphere_filter(
+def sphere_filter(
     robot: Robot, checker: CollisionChecker, hulls: CollisionChecker | None, scene: Scene, base: NDArray[np.float64]
 ) -> SphereFilter | None:
     """Return the fast conservative pre-check for `robot` (other joints at `base`) in `scene`, or None."""
@@ -205,7 +205,7 @@ def _sphere_filter(
         return None
 
 
-def _hull_checker(robot: Robot, checker: CollisionChecker, scene: Scene) -> CollisionChecker | None:
+def hull_checker(robot: Robot, checker: CollisionChecker, scene: Scene) -> CollisionChecker | None:
     """Return a checker of the robot's meshes as convex hulls in `scene` when `checker` has meshes, else None."""
     meshes = any(isinstance(obj.geometry, coal.BVHModelBase) for obj in checker.robot_geometry.geometryObjects)
     if checker.mode != "exact" or not meshes:

@@ -23,10 +23,10 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from ..collision import CollisionChecker, MotionChecker, SphereFilter, UnsupportedJoint, setup_clock
+from ..collision import CollisionChecker, MotionChecker, SphereFilter, setup_clock
 from ..collision.checker import GeometryMode
+from ..collision.motion import hull_checker, sphere_filter
 from ..collision.sphere_filter import MAYBE
-from ..errors import ConfigError
 from ..model.robot import Robot
 from ..model.scene import Scene
 from ..trajectory import interpolate
@@ -49,17 +49,12 @@ def problem_checks(
     With `after` 0 the filter is built now, as a benchmark wants (its set-up outside the timed steps).
     """
     checker = CollisionChecker(robot, scene.objects, scene.source, geometry=geometry, allowed=scene.allowed)
-    hulls = _hull_checker(robot, checker, scene)
+    hulls = hull_checker(robot, checker, scene)
 
     def build() -> SphereFilter | None:
         global _kernels_loaded
-        try:
-            spheres = SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed, base,
-                                   (hulls or checker).robot_geometry)
-        except UnsupportedJoint as exc:
-            logger.info("no sphere filter (%s): every state is checked by coal", exc)
-            return None
-        _kernels_loaded = True
+        spheres = sphere_filter(robot, checker, hulls, scene, base)
+        _kernels_loaded = _kernels_loaded or spheres is not None
         return spheres
 
     if after <= 0 or _kernels_loaded:
@@ -129,16 +124,3 @@ class OnDemandSpheres:
             self.settle()
         return self._filter
 
-
-def _hull_checker(robot: Robot, checker: CollisionChecker, scene: Scene) -> CollisionChecker | None:
-    """Return a checker of the robot's meshes as convex hulls in `scene` when `checker` has meshes, else None."""
-    # As core/collision/motion.py scene_checks builds it; kept here until scene_checks takes the filter's timing.
-    # coal's object type by name: coal itself is the collision district's to import.
-    meshes = any(obj.geometry.getObjectType().name == "OT_BVH" for obj in checker.robot_geometry.geometryObjects)
-    if checker.mode != "exact" or not meshes:
-        return None  # the hulls would be the checker's own shapes, checked twice
-    try:
-        return CollisionChecker(robot, scene.objects, scene.source, geometry="convex", allowed=scene.allowed)
-    except ConfigError as exc:
-        logger.info("no hull stage (%s): states the spheres cannot clear go to the meshes", exc)
-        return None
