@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import logging
 import os
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -55,3 +58,17 @@ def test_quiet_cold_cache_prints_no_notice(tmp_path: Path) -> None:
     result = subprocess.run(command, capture_output=True, text=True, cwd=ROOT, env=env, timeout=600)
     assert result.returncode == 0, result.stderr
     assert result.stderr == ""
+
+
+def test_one_time_work_of_unknown_length_is_announced_only_when_slow(caplog: pytest.LogCaptureFixture) -> None:
+    """Kernels load from numba's cache in a blink but compile for many seconds: only the slow case speaks."""
+    import time
+
+    from moveplan.core.collision._cache import announced_if_slow
+
+    with caplog.at_level(logging.INFO, logger="moveplan.core.collision._cache"):
+        with announced_if_slow("quick work", after_s=0.5):
+            pass
+        with announced_if_slow("slow work", after_s=0.05):
+            time.sleep(0.3)
+    assert [r.getMessage() for r in caplog.records] == ["slow work"]

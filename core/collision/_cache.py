@@ -20,13 +20,16 @@ import logging
 import os
 import pickle
 import tempfile
+import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import pinocchio as pin
 
-__all__ = ["FORMAT", "announce", "digest", "path", "read", "write"]
+__all__ = ["FORMAT", "announce", "announced_if_slow", "digest", "path", "read", "write"]
 
 logger = logging.getLogger(__name__)
 
@@ -82,6 +85,22 @@ def announce(work: str, where: Path) -> None:
     A first run on a fresh machine would otherwise sit silent for seconds; the command line shows these lines.
     """
     logger.info("%s (once per robot; cached in %s)", work, where.parent)
+
+
+@contextmanager
+def announced_if_slow(work: str, after_s: float = 1.0) -> Iterator[None]:
+    """Run the block, logging `work` at INFO if it is still running after `after_s` seconds; yield None.
+
+    For one-time work whose cost is unknown beforehand: numba loads cached kernels in a fraction of
+    a second but compiles them in tens of seconds on a fresh machine.
+    """
+    timer = threading.Timer(after_s, logger.info, args=(work,))
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
 
 
 def _untrusted(where: Path, why: str) -> None:

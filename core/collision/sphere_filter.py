@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 from ..errors import UnsupportedJoint
 from ..model.robot import Robot
 from ..types import CollisionObject
+from ._cache import announced_if_slow
 from ._verdicts import CLEAR, COLLIDES, MAYBE
 from .inner_spheres import inner_spheres
 from .pair_tables import PairTable, pair_tables
@@ -101,8 +102,11 @@ class SphereFilter:
         self._nq = model.nq
         # Reused by every `edge` call: returning fresh arrays from compiled code costs more than judging a state.
         self._verdicts, self._unclear = np.empty(64, dtype=np.int8), np.empty((64, model.nq))
-        self.classify(robot.values(base)[None, :])  # compile (or load) the kernels now, not mid-search
-        self.edge(robot.values(base), robot.values(base), 1.0)
+        # Compile (or load) the kernels now, not mid-search.
+        with announced_if_slow("compiling the collision kernels (once per install; numba caches them)"):
+            self.classify(robot.values(base)[None, :])
+            self.edge(robot.values(base), robot.values(base), 1.0)
+            self.certify(robot.values(base)[None, :], np.zeros(1))
 
     def classify(
         self, values: NDArray[np.float64], stop: bool = False
