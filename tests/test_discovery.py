@@ -344,6 +344,23 @@ def test_the_workspace_comes_after_package_path_flags_and_before_ros_package_pat
     assert workspace_src(tmp_path / "ws") is None
 
 
+@pytest.mark.parametrize("layout", ["isolated", "merged"])
+def test_a_config_in_an_unsourced_install_folder_finds_its_sibling_packages(
+    cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, layout: str
+) -> None:
+    """`colcon build` without `source install/setup.bash`: the packages lie beside each other in install/."""
+    for name in ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH"):
+        monkeypatch.delenv(name, raising=False)
+    install = tmp_path / "ws" / "install"
+    for package in ("ur10e_moveit_config", "ur10e_description"):
+        share = install / package / "share" if layout == "isolated" else install / "share"
+        shutil.copytree(ROOT / "tests" / "data" / package, share / package)
+    (install / "local_setup.sh").write_text("# written by colcon\n")
+    config = (install / "ur10e_moveit_config" / "share" if layout == "isolated" else install / "share")
+    result = cli("plan", "--robot", config / "ur10e_moveit_config", "--named", "home", "-o", tmp_path / "p.mcap")
+    assert result.exit_code == 0, result.stderr
+
+
 def test_packages_are_found_as_colcon_finds_them(tmp_path: Path) -> None:
     def package(path: str, name: str) -> dict[str, str]:
         return {f"{path}/package.xml": f"<package><name>{name}</name></package>"}

@@ -56,10 +56,21 @@ def package_name(folder: Path, warn: bool = False) -> str | None:
 
 
 def workspace_src(folder: Path) -> Path | None:
-    """Return the nearest ancestor of `folder` named `src` (a colcon workspace's source folder), or None."""
+    """Return the workspace folder `folder` lies in, whose packages it may use, or None.
+
+    In a colcon workspace's sources, the nearest ancestor named `src`. In a built but unsourced
+    workspace, the install folder: a package installs to `install/<pkg>/share/<pkg>` (or
+    `install/share/<pkg>` merged), and colcon writes `local_setup.sh` at the install folder's top.
+    """
     for parent in folder.resolve().parents:
         if parent.name == "src":
             return parent
+        if parent.name == "share":
+            prefix = parent.parent
+            for install in (prefix.parent, prefix):  # isolated, then merged
+                if (install / "local_setup.sh").is_file():
+                    return install
+            return None
     return None
 
 

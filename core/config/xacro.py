@@ -81,6 +81,9 @@ class PackagePath:
         if package_name(folder) == package or folder.name == package:
             return folder
         if (folder / package).is_dir():
+            installed = folder / package / "share" / package  # a colcon install prefix: the package is in share/
+            if not (folder / package / "package.xml").is_file() and (installed / "package.xml").is_file():
+                return installed
             return folder / package
         return packages_under(folder).get(package)
 
