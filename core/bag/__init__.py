@@ -10,11 +10,18 @@ execution_file, jointstates (with sample_store: decoded samples kept on disk, so
 reading a recording takes the same memory for an hour as for a minute).
 """
 
-from .execution_file import EXECUTION_RESULT_TOPIC, ExecutedStep, write_execution
-from .jointstates import JointStateStore, open_joint_states, read_joint_states
-from .plan_file import PlanFile, PlanStepRecord, plan_urdf, read_plan
-from .plan_writer import write_plan
-from .summary import BagSummary, TopicSummary, summarize
+from importlib import import_module
+from typing import Any
+
+# Loaded on first use (PEP 562): writing a plan needs none of the readers (sqlite3, the linear
+# MCAP scan, the sample store), and every command pays for what its imports load.
+_HOME = {
+    "EXECUTION_RESULT_TOPIC": "execution_file", "ExecutedStep": "execution_file", "write_execution": "execution_file",
+    "JointStateStore": "jointstates", "open_joint_states": "jointstates", "read_joint_states": "jointstates",
+    "PlanFile": "plan_file", "PlanStepRecord": "plan_file", "plan_urdf": "plan_file", "read_plan": "plan_file",
+    "write_plan": "plan_writer",
+    "BagSummary": "summary", "TopicSummary": "summary", "summarize": "summary",
+}
 
 __all__ = [
     "EXECUTION_RESULT_TOPIC",
@@ -32,3 +39,11 @@ __all__ = [
     "write_execution",
     "write_plan",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """Return the exported name `name`, importing the module that defines it."""
+    if name not in _HOME:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(import_module(f".{_HOME[name]}", __name__), name)
+
