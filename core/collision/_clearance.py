@@ -100,6 +100,7 @@ def certify(values: Any, travel: Any, cap: float, floats: Any, ints: Any, head: 
                np.empty(len(owners[2]), dtype=np.bool_))
     covered, judged = -1.0, 0  # states with travel below `covered` are free under the spheres
     for k in range(len(values)):
+        # Written out as in _kernels.judge: a helper per state costs more than the work (its docstring).
         q = qs[k]
         q[:] = base
         for i in range(len(group)):
