@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PLAN = [sys.executable, "-m", "moveplan.cli.app", "plan", "--robot", str(ROOT / "configs/ur10e"),
         "--scene", str(ROOT / "samples/ur10e_table_scene.yaml"), "--start-named", "home",
         "--joints", "0.5,-1.2,-1.8,0,1.57,0"]
-FLOOR = [sys.executable, "-c", "import pinocchio, coal, ompl, toppra"]
+FLOOR = [sys.executable, "-c", "import numpy, pinocchio, coal, ompl"]
 HELP = [sys.executable, "-m", "moveplan.cli.app", "--help"]
 
 

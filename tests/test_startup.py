@@ -27,11 +27,11 @@ def test_help_imports_no_numba_pinocchio_or_scipy() -> None:
     assert result.stdout.strip() == "[]"
 
 
-def test_single_joint_goal_plan_imports_neither_numba_nor_scipy(tmp_path: Path) -> None:
+def test_single_joint_goal_plan_imports_no_numba_scipy_or_pydantic(tmp_path: Path) -> None:
     code = ("import sys\nsys.argv = ['moveplan', 'plan', '--robot', 'ur10e', '--start-named', 'home', '--joints',\n"
             f"            '0.5,-1.2,-1.8,0,1.57,0', '-o', {str(tmp_path / 'plan.mcap')!r}, '-q']\n"
             "from moveplan.cli.app import main\ntry:\n    main()\nexcept SystemExit as exc:\n    assert not exc.code\n"
-            "print(sorted(m for m in ('numba', 'scipy') if m in sys.modules))")
+            "print(sorted(m for m in ('numba', 'scipy', 'pydantic') if m in sys.modules))")
     result = _run(code)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "[]"
