@@ -38,7 +38,14 @@ def test_single_joint_goal_plan_imports_no_numba_scipy_or_pydantic(tmp_path: Pat
     assert (tmp_path / "plan.mcap").stat().st_size > 0
 
 
+def _compile_kernels() -> None:
+    """Have numba compile (or load) the filter's kernels into its cache: a benchmark builds the filter at once."""
+    subprocess.run([sys.executable, "-m", "moveplan.cli.app", "benchmark", "tests/data/mbm/problems", "--robot",
+                    "tests/data/mbm/panda_robot", "--count", "1", "-q"], check=True, cwd=ROOT, timeout=600)
+
+
 def test_cold_cache_announces_sphere_fitting_once(tmp_path: Path) -> None:
+    _compile_kernels()  # else the plan stays with coal and fits no spheres (next test)
     cache = tmp_path / "cache"
     command = [sys.executable, "-m", "moveplan.cli.app", "plan", "samples/panda_shelf_bays.yaml",
                "-o", str(tmp_path / "plan.mcap")]
@@ -49,6 +56,24 @@ def test_cold_cache_announces_sphere_fitting_once(tmp_path: Path) -> None:
     warm = subprocess.run(command, capture_output=True, text=True, cwd=ROOT, env=env, timeout=600)
     assert warm.returncode == 0, warm.stderr
     assert "fitting collision spheres" not in warm.stderr
+
+
+def test_fresh_machine_plans_without_compiling_the_kernels(tmp_path: Path) -> None:
+    """Empty numba and moveplan caches: a plan that checks far fewer states than a compilation is worth stays
+    with coal, says nothing, imports no numba, and writes the same file as a machine with everything cached."""
+    _compile_kernels()
+    warm = tmp_path / "warm.mcap"
+    subprocess.run([sys.executable, "-m", "moveplan.cli.app", "plan", "samples/panda_shelf_bays.yaml", "-o", str(warm)],
+                   check=True, cwd=ROOT, capture_output=True, timeout=600)
+    cold = tmp_path / "cold.mcap"
+    code = ("import sys\nsys.argv = ['moveplan', 'plan', 'samples/panda_shelf_bays.yaml', '-o', "
+            f"{str(cold)!r}]\nfrom moveplan.cli.app import main\ntry:\n    main()\nexcept SystemExit as exc:\n"
+            "    assert not exc.code\nprint(sorted(m for m in ('numba', 'scipy') if m in sys.modules))")
+    result = _run(code, {"NUMBA_CACHE_DIR": str(tmp_path / "numba"), "MOVEPLAN_CACHE_DIR": str(tmp_path / "cache")})
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip().splitlines()[-1] == "[]"
+    assert result.stderr == ""
+    assert cold.read_bytes() == warm.read_bytes()
 
 
 def test_quiet_cold_cache_prints_no_notice(tmp_path: Path) -> None:

@@ -5,9 +5,12 @@ it imports numba and loads its compiled kernels: 0.5-1.5 s on a warm machine, an
 of tens of seconds on a fresh one. A plan of a few steps checks a few thousand states, which the
 robot's convex hulls judge in ~14 us each: tens of milliseconds. So a one-shot command starts
 with coal alone and builds the filter once the states asked about pass `after` (a rent-or-buy
-rule: by then the hull checks have cost about what the filter's set-up does). A build inside a
-step is kept off the search's planning-time cap (core/collision/setup_clock.py). A process that
-has built one filter has the kernels loaded, and builds the next at once.
+rule: by then the hull checks have cost about what the filter's set-up does). Where numba has
+not compiled the kernels yet (a fresh install), the set-up costs a compilation, so the rule waits
+correspondingly longer: a first plan on a fresh machine costs what it costs warm unless it is
+one that would pay for the compilation anyway. A build inside a step is kept off the search's
+planning-time cap (core/collision/setup_clock.py). A process that has built one filter has the
+kernels loaded, and builds the next at once.
 
 Every verdict is the same either way: a state the spheres clear is free under the hulls, and
 one they find colliding collides under them (core/collision/motion.py). What changes is only
@@ -25,20 +28,28 @@ from numpy.typing import NDArray
 
 from ..collision import CollisionChecker, MotionChecker, SphereFilter, setup_clock
 from ..collision.checker import GeometryMode
+from ..collision.kernel_cache import kernels_cached
 from ..collision.motion import hull_checker, sphere_filter
 from ..collision.sphere_filter import MAYBE
 from ..model.robot import Robot
 from ..model.scene import Scene
 from ..trajectory import interpolate
 
-__all__ = ["FILTER_AFTER_STATES", "problem_checks"]
+__all__ = ["FILTER_AFTER_STATES", "FILTER_AFTER_STATES_UNCOMPILED", "filter_threshold", "problem_checks"]
 
 logger = logging.getLogger(__name__)
 
 FILTER_AFTER_STATES = 20_000
 """States a one-shot command checks with coal alone before it builds the sphere filter (~0.3 s of hull checks)."""
+FILTER_AFTER_STATES_UNCOMPILED = 1_000_000
+"""The same when numba has yet to compile the kernels: ~15 s of hull checks, what the compilation costs."""
 
 _kernels_loaded = False  # set once a filter is built: later ones cost no numba start-up
+
+
+def filter_threshold() -> int:
+    """Return how many states a one-shot command checks with coal before it builds the sphere filter."""
+    return FILTER_AFTER_STATES if _kernels_loaded or kernels_cached() else FILTER_AFTER_STATES_UNCOMPILED
 
 
 def problem_checks(

@@ -12,6 +12,7 @@ import json
 import logging
 import os
 import time
+from dataclasses import dataclass
 from importlib.metadata import version
 from pathlib import Path
 
@@ -32,18 +33,30 @@ from ..planning.goals import check_limits, joint_target
 from ..planning.search import seed_planner
 from ..trajectory import sample
 from ..types import Plan, StepResult, TfSamples
-from .checks import FILTER_AFTER_STATES, problem_checks
+from .checks import filter_threshold, problem_checks
 from .request import PlanFlags, PlanRequest, resolve_request
+from .state import RobotState, robot_state
 from .step import plan_step
 
-__all__ = ["PlanFlags", "PlanRequest", "plan", "plan_to_file", "resolve_request"]
+__all__ = ["PlanFlags", "PlanRequest", "PlanResult", "plan", "plan_to_file", "resolve_request"]
 
 logger = logging.getLogger(__name__)
 
 _TF_RATE_HZ = 30.0
 
 
-def plan_to_file(task: Path | None, flags: PlanFlags, output: Path, ros_distro: str = "jazzy") -> Plan:
+@dataclass(frozen=True)
+class PlanResult(Plan):
+    """A plan, with where each step ends: its group joint values and the tip's pose in the planning frame.
+
+    Attributes:
+        end_states: One per step, in order (joints outside the group as the plan starts).
+    """
+
+    end_states: tuple[RobotState, ...] = ()
+
+
+def plan_to_file(task: Path | None, flags: PlanFlags, output: Path, ros_distro: str = "jazzy") -> PlanResult:
     """Plan what a task file (if any) and the flags ask for, write it to `output` for `ros_distro`, return it."""
     request = resolve_request(load_task(task) if task is not None else None, flags)
     config = load_robot_config(request.robot, request.package_paths, request.xacro_args, urdf=request.urdf,
@@ -51,7 +64,7 @@ def plan_to_file(task: Path | None, flags: PlanFlags, output: Path, ros_distro: 
     _refuse_replacing_inputs(output, request, config)
     if (request.group or config.planning["group"]) in config.srdf.groups:
         _warn_default_accelerations(config, request.group or config.planning["group"])
-    result = plan(request, config, filter_after=FILTER_AFTER_STATES)
+    result = plan(request, config, filter_after=filter_threshold())
     write_plan(output, result, ros_distro)
     return result
 
@@ -75,7 +88,7 @@ def _refuse_replacing_inputs(output: Path, request: PlanRequest, config: RobotCo
 
 def plan(
     request: PlanRequest, config: RobotConfig | None = None, exact_check: bool = False, filter_after: int = 0
-) -> Plan:
+) -> PlanResult:
     """Return the timed, collision-free plan for every step of `request`, in order.
 
     `config` is the loaded `request.robot` when the caller has it (a benchmark plans many
@@ -97,6 +110,9 @@ def plan(
     robot = _robot(request, config)
     if loaded_here:
         _warn_default_accelerations(config, robot.group.name)
+    for goal in (request.start, *(spec.goal for spec in request.steps)):
+        if isinstance(goal, JointGoal):  # degrees without their unit, before any planning
+            goal.check_units(config, robot.joint_names)
     scene = load_scene(request.scene, robot) if request.scene else empty_scene()
     base, current = _start_values(request, robot, scene)
     if request.motion_request is not None:  # objects the request's start state carries
@@ -243,9 +259,9 @@ def _plan_steps(
 def _assemble(
     request: PlanRequest, config: RobotConfig, robot: Robot, scene: Scene, base: NDArray[np.float64],
     steps: list[StepResult],
-) -> Plan:
-    """Return the plan of the planned steps, with what replaying and checking it needs."""
-    return Plan(
+) -> PlanResult:
+    """Return the plan of the planned steps, with what replaying and checking it needs, and where each step ends."""
+    return PlanResult(
         robot_name=config.name,
         group=robot.group.name,
         planning_frame=robot.root_link,
@@ -262,6 +278,8 @@ def _assemble(
         metadata={"seed": str(request.seed), "moveplan_version": version("moveplan"),
                   "planners": ",".join(s.planner for s in steps),
                   "limit_sources": json.dumps({j: config.limits[j].source for j in robot.joint_names}, sort_keys=True)},
+        end_states=tuple(robot_state(robot, scene, robot.configuration(step.trajectory.positions[-1], base))
+                         for step in steps),
     )
 
 
