@@ -15,6 +15,7 @@ trajectory's start (a MoveIt goal has header.stamp 0, "start now").
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,7 +25,7 @@ from numpy.typing import NDArray
 from .types import JointTrajectory, frozen_array
 
 __all__ = [
-    "PointBefore", "interpolate", "peak_rates", "quintic_peak_rates", "sample", "shortest_angular_distance",
+    "PointBefore", "interpolate", "peak_rates", "quintic_peak_rates", "sample", "sampler", "shortest_angular_distance",
     "straight_states",
 ]
 
@@ -108,6 +109,19 @@ def sample(
         has_a = np.concatenate(([point_before.accelerations is not None and has_v[0]], has_a))
     t = np.atleast_1d(np.asarray(times_s, dtype=np.float64))
     return _sample_points(knots, positions, velocities, accelerations, has_v, has_a, t, derivatives)
+
+
+def sampler(trajectory: JointTrajectory) -> Callable[[NDArray[np.float64], int], Samples]:
+    """Return `sample` of `trajectory` (every field present, no point before) as a function of times and derivatives.
+
+    The segments' coefficients are computed once: a certification samples one trajectory twice.
+    """
+    knots, p, v, a = trajectory.times_s, trajectory.positions, trajectory.velocities, trajectory.accelerations
+    if len(knots) == 1:
+        return lambda t, derivatives=2: _hold(p[0], v[0], a[0], len(t))
+    every = np.ones(len(knots), dtype=bool)
+    coefficients = _coefficients(knots, p, v, a, every, every)
+    return lambda t, derivatives=2: _evaluate(knots, coefficients, p, v, a, t, derivatives)
 
 
 def peak_rates(trajectory: JointTrajectory) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -242,12 +256,24 @@ def _sample_points(
     derivatives: int = 2,
 ) -> Samples:
     """Return samples of the spline through the points; `has_v`/`has_a`: fields each point has."""
-    count, n = p.shape
-    if count == 1:
+    if len(p) == 1:
         return _hold(p[0], v[0], a[0], len(t))
-    seg = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, count - 2)
+    return _evaluate(knots, _coefficients(knots, p, v, a, has_v, has_a), p, v, a, t, derivatives)
+
+
+def _evaluate(
+    knots: NDArray[np.float64],
+    coefficients: NDArray[np.float64],
+    p: NDArray[np.float64],
+    v: NDArray[np.float64],
+    a: NDArray[np.float64],
+    t: NDArray[np.float64],
+    derivatives: int,
+) -> Samples:
+    """Return samples at `t` of the spline with these segment `coefficients` (6, segments, n) through the points."""
+    seg = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, len(knots) - 2)
     # np.take copies rows contiguously; fancy indexing on axis 1 left strided arrays (2x slower).
-    c0, c1, c2, c3, c4, c5 = np.take(_coefficients(knots, p, v, a, has_v, has_a), seg, axis=1)
+    c0, c1, c2, c3, c4, c5 = np.take(coefficients, seg, axis=1)
     h = (knots[seg + 1] - knots[seg])[:, None]
     x = np.clip(t[:, None] - knots[seg][:, None], 0.0, h)
     pos = _horner((c0, c1, c2, c3, c4, c5), x)

@@ -15,7 +15,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ..model.robot import Robot
-from ..trajectory import peak_rates, sample, straight_states
+from ..trajectory import peak_rates, sample, sampler, straight_states
 from ..types import JointTrajectory
 
 __all__ = [
@@ -113,11 +113,12 @@ def trajectory_states(
     if len(knots) == 1:
         return np.asarray(trajectory.positions), np.zeros(1)
     peak_v, peak_a = peak_rates(trajectory)
+    at = sampler(trajectory)
     speed, duration = float(peak_v @ reach_m), float(knots[-1] - knots[0])  # [m/s], bounds every point's speed
     pieces = max(1, int(np.ceil(speed * duration / (_PIECE * step_m))))
     h = duration / pieces
     ends = np.linspace(knots[0], knots[-1], pieces + 1)
-    rate = np.abs(sample(trajectory, ends, derivatives=1)[1]) @ reach_m  # [m/s] at the pieces' ends
+    rate = np.abs(at(ends, 1)[1]) @ reach_m  # [m/s] at the pieces' ends
     motion = np.minimum((rate[:-1] + rate[1:] + float(peak_a @ reach_m) * h) / 2, speed) * h  # per piece [m]
     covered = np.concatenate(([0.0], np.cumsum(motion)))
     count = max(1, int(np.ceil(covered[-1] / step_m)))
@@ -126,8 +127,7 @@ def trajectory_states(
     into = np.divide(travel - covered[piece], motion[piece], out=np.zeros(count + 1), where=motion[piece] > 0.0)
     times = ends[piece] + np.clip(into, 0.0, 1.0) * h
     times[0], times[-1] = knots[0], knots[-1]
-    positions, _, _ = sample(trajectory, times, derivatives=0)
-    return positions, travel
+    return at(times, 0)[0], travel
 
 
 def uniform_states(
