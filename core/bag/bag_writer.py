@@ -13,13 +13,13 @@ import secrets
 import stat
 from collections.abc import Iterable, Iterator, Mapping
 from contextlib import contextmanager, suppress
-from importlib.metadata import version
 from pathlib import Path
 from typing import BinaryIO
 
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 
 from ..errors import InputError, UsageError
+from ..version import moveplan_version
 from .qos import offered_qos_profiles
 
 __all__ = ["BagStream", "atomic_file", "open_bag", "output_problem", "write_bag"]
@@ -176,7 +176,7 @@ def _create_beside(path: Path) -> tuple[Path, BinaryIO]:
 @contextmanager
 def _atomic_writer(path: Path) -> Iterator[Writer]:
     """Yield a started mcap Writer on a temporary file beside `path`; finish, then rename (`atomic_file`)."""
-    library = f"moveplan {version('moveplan')}; {LIBRARY_IDENTIFIER}"
+    library = f"moveplan {moveplan_version()}; {LIBRARY_IDENTIFIER}"
     with atomic_file(path) as stream:
         writer = Writer(stream, compression=CompressionType.ZSTD, enable_data_crcs=True)
         writer.start(profile="ros2", library=library)
