@@ -63,6 +63,22 @@ _ROBOT_HELP = ("Robot config: a moveplan.yaml or its folder, a MoveIt config pac
                "or a shipped name.")
 
 
+def _print_version(value: bool) -> None:
+    if value:
+        from moveplan.core.version import moveplan_version
+
+        typer.echo(f"moveplan {moveplan_version()}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    version: Annotated[bool, typer.Option(
+        "--version", callback=_print_version, is_eager=True, help="Print moveplan's version and exit.")] = False,
+) -> None:
+    """MoveIt-style planning and ros2_control execution checks from one command line: files in, files out."""
+
+
 class _Format(logging.Formatter):
     """`moveplan: LEVEL: message`, and `moveplan: message` for a notice of one-time work (INFO)."""
 
@@ -167,6 +183,8 @@ def execute(
     controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml overriding the plan's.")] = None,
     seed: Annotated[int, typer.Option(min=0, max=MAX_SEED, help="Seed for plant noise.")] = 0,
     ros_distro: Annotated[str, typer.Option(help="Controller-state layout to write: jazzy or humble.")] = "jazzy",
+    plot: Annotated[Path | None, typer.Option(metavar="FILE.png", help=(
+        "Write a PNG: per joint reference and actual, the error against the tolerances, violations."))] = None,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
     verbose: VerboseOpt = False,
@@ -178,10 +196,15 @@ def execute(
 
         if not fake:
             raise UsageError("only fake execution exists yet: add --fake to replay through a simulated controller")
-        check_outputs({"-o": output}, {"PLAN": plan_file, "--controllers": controllers})
+        check_outputs({"-o": output, "--plot": plot}, {"PLAN": plan_file, "--controllers": controllers})
         from moveplan.cli import render
         from moveplan.core.pipeline.execute import ExecuteRequest
         from moveplan.core.pipeline.execute import execute as run
+
+        if plot is not None:
+            from moveplan.core.pipeline import plots
+
+            plots.check_plot_path(plot)
 
         request = ExecuteRequest(
             plan=plan_file, plant=plant, plant_params=parse_params(plant_param or [], "--plant-param"),
@@ -189,7 +212,9 @@ def execute(
             start_joints=parse_joint_values(start_joints, "--start-joints") if start_joints else None,
             controllers=controllers, seed=seed,
         )
-        if output is None:
+        if plot is not None:
+            outcome = plots.execute_plotted(request, plot, output, ros_distro)
+        elif output is None:
             outcome = run(request)
         else:
             from moveplan.core.pipeline.report import execute_to_file
@@ -208,6 +233,9 @@ def check_tolerances(
     controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml overriding the plan's.")] = None,
     start: Annotated[str, typer.Option(help="auto, a time [s] from the recording's start, or all.")] = "auto",
     time_source: Annotated[str, typer.Option(help="header (message stamps) or log (receive times).")] = "header",
+    plot: Annotated[Path | None, typer.Option(metavar="FILE.png", help=(
+        "Write a PNG: per joint reference and actual, the error against the tolerances, violations "
+        "(with --start all: the first failing cycle, else the first)."))] = None,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
     verbose: VerboseOpt = False,
@@ -226,7 +254,16 @@ def check_tolerances(
         if time_source not in ("header", "log"):
             raise UsageError(f"--time-source: expected header or log, got '{time_source}'")
         when: str | float = start if start in ("auto", "all") else parse_time(start, "--start (auto, all or seconds)")
-        report = check(CheckRequest(plan_file, recording_file, topic, controllers, when, time_source))
+        request = CheckRequest(plan_file, recording_file, topic, controllers, when, time_source)
+        if plot is None:
+            report = check(request)
+        else:
+            from moveplan.core.pipeline import plots
+
+            check_outputs({"--plot": plot}, {"PLAN": plan_file, "RECORDING": recording_file,
+                                             "--controllers": controllers})
+            plots.check_plot_path(plot)
+            report = plots.check_plotted(request, plot)
     render.check_summary(report, recording_file, as_json, quiet)
     # Cut off before any verdict: the check could not be done on this recording (bad input).
     raise typer.Exit(0 if report.ok else 5 if report.complete else 3)
@@ -254,9 +291,54 @@ def robot_info(
 
 
 @app.command()
+def state(
+    robot: Annotated[Path | None, typer.Option(help=_ROBOT_HELP + " Not needed with --from.")] = None,
+    group: Annotated[str | None, typer.Option(help="Planning group (default: the config's, or the plan's).")] = None,
+    joints: Annotated[str | None, typer.Option(help="Joint values: 'q1,...,qn' or 'elbow_joint=-90deg,...'.")] = None,
+    named: Annotated[str | None, typer.Option(help="An SRDF group_state.")] = None,
+    from_plan: Annotated[Path | None, typer.Option("--from", help="A plan file: the state where it ends.")] = None,
+    step: Annotated[str | None, typer.Option(help="With --from: where this step ends.")] = None,
+    at: Annotated[str | None, typer.Option(help="With --from: seconds from the plan's (or --step's) start.")] = None,
+    link: Annotated[str | None, typer.Option(help="Link whose pose to give (default: the group's tip).")] = None,
+    frame: Annotated[str | None, typer.Option(help="Frame of the pose (default: the planning frame).")] = None,
+    scene: Annotated[Path | None, typer.Option(help="Scene file, for its frames (default with --from: "
+                                                    "the scene the plan embeds).")] = None,
+    package_path: PackagePathOpt = None,
+    xacro_arg: XacroArgOpt = None,
+    urdf: UrdfOpt = None,
+    srdf: SrdfOpt = None,
+    strict_limits: StrictLimitsOpt = False,
+    as_json: JsonOpt = False,
+    quiet: QuietOpt = False,
+) -> None:
+    """Show a robot state: the group's joint values and a link's pose in a frame (lookup_transform)."""
+    _logging(False, quiet)
+    with exit_codes(as_json):
+        from moveplan.cli import render
+        from moveplan.core.pipeline.state import StateRequest
+        from moveplan.core.pipeline.state import state as robot_state
+
+        given = {"--package-path": package_path, "--xacro-arg": xacro_arg, "--urdf": urdf, "--srdf": srdf,
+                 "--strict-limits": strict_limits}
+        if robot is None and (flags := [name for name, value in given.items() if value]):
+            from moveplan.core.errors import UsageError
+
+            raise UsageError(f"{flags[0]} completes --robot: give --robot too (with --from alone, the plan's "
+                             "embedded config is used as it is)")
+        source = None if robot is None else _robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits)
+        result = robot_state(StateRequest(
+            robot=source, group=group, joints=parse_optional(parse_joints, joints, "--joints"), named=named,
+            plan=from_plan, step=step, at_s=parse_optional(parse_time, at, "--at"), link=link, frame=frame, scene=scene,
+        ))
+    render.state_summary(result, as_json, quiet)
+
+
+@app.command()
 def inspect(
     file: Annotated[Path, typer.Argument(
         help="Any ROS 2 bag (.mcap, .db3 or a bag folder); plan files get a per-step summary.")],
+    plot: Annotated[Path | None, typer.Option(metavar="FILE.png", help=(
+        "Plan files: write a PNG of each joint's position, velocity and acceleration against its limits."))] = None,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
 ) -> None:
@@ -266,7 +348,14 @@ def inspect(
         from moveplan.cli import render
         from moveplan.core.pipeline.inspection import inspect_file
 
+        if plot is not None:
+            from moveplan.core.pipeline import plots
+
+            check_outputs({"--plot": plot}, {"FILE": file})
+            plots.check_plot_path(plot)
         inspection = inspect_file(file)
+        if plot is not None:
+            plots.write_plan_plot(inspection.plan, file, plot)
     render.inspect_summary(inspection, as_json, quiet)
 
 
@@ -313,6 +402,51 @@ def benchmark(
         if plot is not None:
             bench.plot(runs, plot)
     render.benchmark_summary(runs, bench.summarize(runs), as_json, quiet)
+
+
+@app.command("tune-pid")
+def tune_pid(
+    plan_file: Annotated[Path, typer.Argument(metavar="PLAN", help="Plan file written by moveplan plan.")],
+    output: Annotated[Path, typer.Option("--output", "-o", help="Controllers file to write, gains tuned (.yaml).")],
+    controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml to tune (else the plan's).")] = None,
+    joints: Annotated[str | None, typer.Option(help="Joints to tune, comma-separated (default: all).")] = None,
+    plant_param: Annotated[list[str] | None, typer.Option(help="pid plant parameter k=v, as for execute.")] = None,
+    oscillations: Annotated[int, typer.Option(min=0, help="Oscillations wanted as I is raised (stage 4).")] = 0,
+    recording: Annotated[Path | None, typer.Option(
+        metavar="REC.mcap", help="The robot following this plan: fit the plant to it first.")] = None,
+    topic: Annotated[str, typer.Option(help="JointState topic in --recording.")] = "/joint_states",
+    plot: Annotated[Path | None, typer.Option(metavar="FILE.png", help="Write a PNG of the responses.")] = None,
+    seed: Annotated[int, typer.Option(min=0, max=MAX_SEED, help="Seed for plant noise.")] = 0,
+    as_json: JsonOpt = False,
+    quiet: QuietOpt = False,
+    verbose: VerboseOpt = False,
+) -> None:
+    """Tune PID gains joint by joint on the simulated pid plant; write them into a copy of the controllers file.
+
+    Exit 0 when executing the plan with the tuned gains passes without a ringing joint, 5 when it does not
+    (the file is written either way).
+    """
+    _logging(verbose, quiet)
+    with exit_codes(as_json):
+        check_outputs({"-o": output, "--plot": plot},
+                      {"PLAN": plan_file, "--controllers": controllers, "--recording": recording})
+        from moveplan.cli.render_tuning import tuning_summary
+        from moveplan.core.pipeline.tune import TuneRequest, tune
+
+        if plot is not None:
+            from moveplan.core.pipeline.plots import check_plot_path
+
+            check_plot_path(plot)
+        names = tuple(j.strip() for j in (joints or "").split(",") if j.strip())
+        result = tune(TuneRequest(plan_file, output, controllers, names,
+                                  parse_params(plant_param or [], "--plant-param"), oscillations, recording, topic,
+                                  seed))
+        if plot is not None:
+            from moveplan.core.pipeline.tune_plot import write_tuning_plot
+
+            write_tuning_plot(result, plot)
+    tuning_summary(result, plot, as_json, quiet)
+    raise typer.Exit(0 if result.ok else 5)
 
 
 def _robot_source(

@@ -1,13 +1,13 @@
-"""Flag values as core's typed values: numbers with pi expressions, joints, poses; errors are usage errors (exit 2).
+"""Flag values as core's typed values: numbers, angles, joints, poses; errors are usage errors (exit 2).
 
 Only the spelling of one flag is checked here; rules between flags and ranges of values are core's.
+Numbers and angles are read by core/config/fields.py, as task files' are: pi expressions, and a
+`deg` suffix on angles.
 """
 
 from __future__ import annotations
 
-import ast
 import math
-import operator
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -17,8 +17,9 @@ if TYPE_CHECKING:  # imported where used: `moveplan --help` loads no config code
     from moveplan.core.config.goals import JointGoal, PoseGoal, ShiftGoal
 
 __all__ = [
-    "MAX_EXPRESSION_LENGTH", "MAX_SEED", "MAX_SEEDS", "parse_disturbance", "parse_joint_values", "parse_joints",
-    "parse_number", "parse_optional", "parse_params", "parse_pose", "parse_seeds", "parse_shift", "parse_time",
+    "MAX_SEED", "MAX_SEEDS", "parse_angle", "parse_disturbance", "parse_joint_values",
+    "parse_joints", "parse_number", "parse_optional", "parse_params", "parse_pose", "parse_pose_angle", "parse_seeds",
+    "parse_shift", "parse_time",
 ]
 
 _T = TypeVar("_T")
@@ -29,54 +30,32 @@ kept here so that `moveplan --help` imports no config code)."""
 MAX_SEEDS = 10_000
 """Seeds one benchmark may run per planner and problem."""
 
-_BINARY: dict[type, Callable[[float, float], float]] = {
-    ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
-}
-
-
-MAX_EXPRESSION_LENGTH = 100
-"""Characters of one number or pi expression: `-pi/2+0.25` is 10, a double written in full 25."""
-
-
 def parse_number(text: str, what: str) -> float:
     """Return the number `text` spells: a decimal, or an expression of numbers and pi.
 
     Raises:
-        UsageError: Not such an expression, longer than MAX_EXPRESSION_LENGTH characters, or a
+        UsageError: Not such an expression, longer than fields.MAX_EXPRESSION_LENGTH characters, or a
             value (or an intermediate value) beyond MAX_MAGNITUDE: no flag needs more than a
             million radians, metres or seconds, and beyond it a typo must not reach the planner.
+            A `deg` suffix, which only angles take (parse_angle).
     """
-    from moveplan.core.config.fields import MAX_MAGNITUDE
+    from moveplan.core.config.fields import expression
 
-    text = text.strip()
-    shown = f"'{text}'" if len(text) <= 40 else f"'{text[:20]}...{text[-10:]}' ({len(text)} characters)"
-    if len(text) > MAX_EXPRESSION_LENGTH:
-        raise UsageError(f"{what}: {shown} is longer than {MAX_EXPRESSION_LENGTH} characters, "
-                         "the longest number or pi expression moveplan reads")
+    return expression(text, what, UsageError)
 
-    def bounded(result: float) -> float:
-        if not abs(result) <= MAX_MAGNITUDE:  # NaN and inf fail this too
-            raise OverflowError
-        return result
 
-    def value(node: ast.AST) -> float:
-        if isinstance(node, ast.Constant) and isinstance(node.value, int | float) and not isinstance(node.value, bool):
-            return bounded(float(node.value))
-        if isinstance(node, ast.Name) and node.id == "pi":
-            return math.pi
-        if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
-            return -value(node.operand) if isinstance(node.op, ast.USub) else value(node.operand)
-        if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
-            return bounded(_BINARY[type(node.op)](value(node.left), value(node.right)))
-        raise ValueError
+def parse_angle(text: str, what: str) -> tuple[float, bool]:
+    """Return an angle in [rad] from radians, a pi expression or degrees (`90deg`), and whether it was in degrees."""
+    from moveplan.core.config.fields import angle
 
-    try:
-        return value(ast.parse(text, mode="eval").body)
-    except (SyntaxError, ValueError, ZeroDivisionError, RecursionError, MemoryError):
-        raise UsageError(f"{what}: expected a number or an expression like pi/2, got {shown}") from None
-    except OverflowError:
-        raise UsageError(f"{what}: {shown} is out of range; values are limited to "
-                         f"|value| <= {MAX_MAGNITUDE:,.0f} (rad, m or s)") from None
+    return angle(text, what, UsageError)
+
+
+def parse_pose_angle(text: str, what: str) -> float:
+    """Return a pose's roll, pitch or yaw in [rad] (as parse_angle reads it); a unitless one beyond 2*pi is refused."""
+    from moveplan.core.config.fields import pose_angle
+
+    return pose_angle(text, what, UsageError)
 
 
 def parse_time(text: str, what: str) -> float:
@@ -95,18 +74,20 @@ def parse_optional(parse: Callable[[str, str], _T], text: str | None, what: str)
 
 
 def parse_joints(text: str, what: str) -> JointGoal:
-    """Return a joints goal from "q1,...,qn" (all joints) or "name=value,..." (some joints)."""
+    """Return a joints goal from "q1,...,qn" (all joints) or "name=value,..." (some joints), in [rad], [m] or `deg`."""
     from moveplan.core.config.goals import JointGoal
 
     items = [item.strip() for item in text.split(",")]
     if not text.strip() or any(not item for item in items):
         raise UsageError(f"{what}: expected comma-separated values like '0,-1.57,...' or 'elbow_joint=1.2'")
     if all("=" in item for item in items):
-        pairs = [item.split("=", 1) for item in items]
-        return JointGoal.by_name({name.strip(): parse_number(v, f"{what} {name.strip()}") for name, v in pairs})
+        pairs = [(name.strip(), value) for name, value in (item.split("=", 1) for item in items)]
+        read = {name: parse_angle(value, f"{what} {name}") for name, value in pairs}
+        return JointGoal.by_name({name: v for name, (v, _) in read.items()}, [d for _, d in read.values()], what)
     if any("=" in item for item in items):
         raise UsageError(f"{what}: give either all values or name=value pairs, not a mix")
-    return JointGoal(tuple(parse_number(item, what) for item in items))
+    values = [parse_angle(item, what) for item in items]
+    return JointGoal(tuple(v for v, _ in values), degrees=tuple(d for _, d in values), source=what)
 
 
 def parse_joint_values(text: str, what: str) -> dict[str, float]:
@@ -118,27 +99,31 @@ def parse_joint_values(text: str, what: str) -> dict[str, float]:
 
 
 def parse_pose(text: str, what: str) -> PoseGoal:
-    """Return a pose goal from "x,y,z", "x,y,z,roll,pitch,yaw" or "x,y,z,qx,qy,qz,qw" (frame and link unset)."""
+    """Return a pose goal from "x,y,z", "x,y,z,roll,pitch,yaw" or "x,y,z,qx,qy,qz,qw" (frame and link unset).
+
+    Positions in [m]; roll, pitch and yaw in [rad] or `deg`, a unitless one beyond 2*pi refused.
+    """
     from moveplan.core.config.goals import PoseGoal
 
-    values = [parse_number(item, what) for item in text.split(",")] if text.strip() else []
-    if len(values) not in (3, 6, 7):
+    items = text.split(",") if text.strip() else []
+    if len(items) not in (3, 6, 7):
         raise UsageError(f"{what}: expected 'x,y,z', 'x,y,z,roll,pitch,yaw' or 'x,y,z,qx,qy,qz,qw', "
-                         f"got {len(values)} values")
-    x, y, z, *orientation = values
-    if len(orientation) == 3:
-        roll, pitch, yaw = orientation
+                         f"got {len(items)} values")
+    x, y, z = (parse_number(item, what) for item in items[:3])
+    if len(items) == 6:
+        roll, pitch, yaw = (parse_pose_angle(item, f"{what} {axis}") for axis, item in
+                            zip(("roll", "pitch", "yaw"), items[3:], strict=True))
         return PoseGoal(xyz=(x, y, z), rpy=(roll, pitch, yaw))
-    if len(orientation) == 4:
-        if math.fsum(v * v for v in orientation) < 1e-12:
+    if len(items) == 7:
+        qx, qy, qz, qw = (parse_number(item, what) for item in items[3:])
+        if math.fsum(v * v for v in (qx, qy, qz, qw)) < 1e-12:
             raise UsageError(f"{what}: the quaternion (qx,qy,qz,qw) has zero norm; it is not a rotation")
-        qx, qy, qz, qw = orientation
         return PoseGoal(xyz=(x, y, z), quat=(qx, qy, qz, qw))
     return PoseGoal(xyz=(x, y, z))
 
 
 def parse_shift(text: str, what: str) -> ShiftGoal:
-    """Return a shift of the tip from "z=0.1" or "x=0.05,yaw=0.3" (metres and radians), along the tool's axes."""
+    """Return a shift of the tip from "z=0.1" or "x=0.05,yaw=30deg" ([m]; [rad] or `deg`), along the tool's axes."""
     from moveplan.core.config.goals import SHIFT_AXES, ShiftGoal
 
     offsets: dict[str, float] = {}
@@ -148,7 +133,8 @@ def parse_shift(text: str, what: str) -> ShiftGoal:
         if name not in SHIFT_AXES or not value.strip():
             raise UsageError(f"{what}: expected axis=value pairs with axes {', '.join(SHIFT_AXES)}, "
                              f"got '{item.strip()}'")
-        offsets[name] = parse_number(value, f"{what} {name}")
+        read = parse_number if name in ("x", "y", "z") else parse_pose_angle
+        offsets[name] = read(value, f"{what} {name}")
     return ShiftGoal.of(offsets)
 
 

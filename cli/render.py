@@ -15,7 +15,11 @@ import numpy as np
 from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-from rich.table import Table
+
+from moveplan.cli.tables import console as _console
+from moveplan.cli.tables import emit as _emit
+from moveplan.cli.tables import number as _number
+from moveplan.cli.tables import show, table
 
 if TYPE_CHECKING:  # each command imports only the core modules it runs
     from moveplan.core.config.robot_config import RobotConfig
@@ -23,30 +27,27 @@ if TYPE_CHECKING:  # each command imports only the core modules it runs
     from moveplan.core.pipeline.benchmark import Run
     from moveplan.core.pipeline.execute import PlanExecution
     from moveplan.core.pipeline.inspection import Inspection
-    from moveplan.core.types import Plan
+    from moveplan.core.pipeline.plan import PlanResult
+    from moveplan.core.pipeline.state import RobotState, StateResult
 
 __all__ = [
     "benchmark_progress", "benchmark_summary", "check_summary", "execution_summary", "inspect_summary", "plan_summary",
-    "robot_summary",
+    "robot_summary", "state_summary",
 ]
 
-_console = Console()
 logger = logging.getLogger("moveplan")
 
 
-def _emit(document: dict[str, Any]) -> None:
-    print(json.dumps(document, indent=2))
-
-
-def plan_summary(plan: Plan, output: Path, as_json: bool, quiet: bool) -> None:
-    """Print what was planned: one row per step, or the plan JSON document."""
+def plan_summary(plan: PlanResult, output: Path, as_json: bool, quiet: bool) -> None:
+    """Print what was planned: one row per step and where each ends, or the plan JSON document."""
     steps = [
         {
             "name": s.name, "status": "ok", "goal": s.goal, "planner": s.planner,
             "planning_time_s": round(s.planning_time_s, 6), "duration_s": round(s.trajectory.duration_s, 6),
             "fraction": s.fraction, "residual": s.residual, "points": len(s.trajectory.times_s),
+            "end_state": end.as_dict(),
         }
-        for s in plan.steps
+        for s, end in zip(plan.steps, plan.end_states, strict=True)
     ]
     if as_json:
         _emit({"ok": True, "output": str(output), "robot": plan.robot_name, "group": plan.group,
@@ -54,13 +55,33 @@ def plan_summary(plan: Plan, output: Path, as_json: bool, quiet: bool) -> None:
         return
     if quiet:
         return
-    table = Table(title=f"{plan.robot_name} / {plan.group} -> {output}")
-    for column in ("step", "goal", "planner", "planning [ms]", "duration [s]", "points"):
-        table.add_column(column)
+    rows = table(f"{plan.robot_name} / {plan.group} -> {output}",
+                 ("step", "goal", "planner", "planning [ms]", "duration [s]", "points"), left=3)
     for s in steps:
-        table.add_row(s["name"], _short(s["goal"]), s["planner"], f"{1e3 * s['planning_time_s']:.1f}",
-                      f"{s['duration_s']:.3f}", str(s["points"]))
-    _console.print(table)
+        rows.add_row(s["name"], _short(s["goal"]), s["planner"], f"{1e3 * s['planning_time_s']:.1f}",
+                     f"{s['duration_s']:.3f}", str(s["points"]))
+    show(rows)
+    if plan.end_states:
+        _end_poses([s.name for s in plan.steps], plan.end_states)
+
+
+def _end_poses(names: list[str], states: tuple[RobotState, ...]) -> None:
+    """Print one row per step: where its end puts the tip, in the planning frame."""
+    pose = states[0].pose
+    rows = table(f"end of each step: {pose.link} in {pose.frame}", ("step", "position [m]", "rpy [rad]"))
+    for name, state in zip(names, states, strict=True):
+        rows.add_row(name, _triple(state.pose.position, ".4f"), _triple(state.pose.rpy, ".4f"))
+    show(rows)
+
+
+def _triple(values: tuple[float, ...], spec: str) -> str:
+    """Return values as `[a, b, c]`, each formatted by `spec`."""
+    return "[" + ", ".join(_unsigned_zero(format(v, spec)) for v in values) + "]"
+
+
+def _unsigned_zero(text: str) -> str:
+    """Return a formatted number, without the sign of a value that rounds to zero ("-0.0000")."""
+    return text[1:] if text.startswith("-") and float(text) == 0 else text
 
 
 def _short(goal: dict[str, Any]) -> str:
@@ -110,14 +131,13 @@ def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
     _console.print(f"[bold]{config.name}[/bold]  ({config.root})")
     for name, group in config.srdf.groups.items():
         _console.print(f"group [bold]{name}[/bold]: {group.base} -> {group.tip}, joints {', '.join(group.joints)}")
-    joints = Table(title="joints")
-    for column in ("joint", "lower", "upper", "max vel", "max acc", "position from", "velocity from", "accel from"):
-        joints.add_column(column)
+    joints = table("joints; limits in rad or m, and per s, per s^2", ("joint", "lower", "upper", "max vel", "max acc",
+                                                                      "position from", "velocity from", "accel from"))
     for name, lim in config.limits.items():
         joints.add_row(name, f"{lim.lower:.4g}", f"{lim.upper:.4g}", f"{lim.max_velocity:.4g}",
                        f"{lim.max_acceleration:.4g}", lim.source["position"], lim.source["velocity"],
                        lim.source["acceleration"])
-    _console.print(joints)
+    show(joints)
     for group, states in document["named_states"].items():
         for name, values in states.items():
             _console.print(f"named state {group}/{name}: {values}")
@@ -134,10 +154,34 @@ def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
                        f"{DEFAULT_ACCELERATION:g} rad/s^2 (m/s^2 for prismatic joints)")
 
 
+def state_summary(result: StateResult, as_json: bool, quiet: bool) -> None:
+    """Print a robot state: a table of joint values, then the link's pose in the frame; or its JSON document."""
+    state, pose = result.state, result.state.pose
+    if as_json:
+        _emit({"ok": True, "robot": result.robot, "group": result.group, "source": result.source,
+               **state.as_dict(), "error": None})
+        return
+    if quiet:
+        return
+    joints = table(f"{result.robot} / {result.group}: {result.source}", ("joint", "value [rad]", "value [deg]"))
+    for name, value in state.joints.items():
+        if name in state.prismatic:
+            joints.add_row(name, f"{_unsigned_zero(format(value, '.6f'))} m", "-")
+        else:
+            joints.add_row(name, _unsigned_zero(format(value, ".6f")), _unsigned_zero(format(np.degrees(value), ".4f")))
+    show(joints)
+    pose_table = table(f"{pose.link} in {pose.frame}", [""] * 5, show_header=False)
+    for label, values in (("position [m]", pose.position), ("rpy [rad]", pose.rpy),
+                          ("quaternion [x, y, z, w]", pose.quaternion)):
+        pose_table.add_row(escape(label), *(_unsigned_zero(format(v, ".6f")) for v in values))
+    show(pose_table)
+
+
 def inspect_summary(inspection: Inspection, as_json: bool, quiet: bool) -> None:
-    """Print topics of any bag, and for a plan file each step's duration and peak rates."""
+    """Print topics of any bag, and for a plan file each step's duration, peak rates and end state."""
     path, summary, plan = inspection.path, inspection.summary, inspection.plan
-    steps = [asdict(step) for step in inspection.steps]
+    ends = [state.as_dict() for state in inspection.end_states] or [None] * len(inspection.steps)
+    steps = [{**asdict(step), "end_state": end} for step, end in zip(inspection.steps, ends, strict=True)]
     document = {
         "file": str(path), "profile": summary.profile, "library": summary.library,
         "duration_s": summary.duration_s,
@@ -151,20 +195,20 @@ def inspect_summary(inspection: Inspection, as_json: bool, quiet: bool) -> None:
         return
     if quiet:
         return
-    topics = Table(title=f"{path}  ({summary.profile}, {summary.duration_s:.3f} s)")
-    for column in ("topic", "type", "count", "durability"):
-        topics.add_column(column)
+    topics = table(f"{path}  ({summary.profile}, {summary.duration_s:.3f} s)",
+                   ("topic", "type", "count", "durability"), left=2)
     for t in summary.topics:
         topics.add_row(t.topic, t.type, str(t.count), t.qos_durability)
-    _console.print(topics)
+    show(topics)
     if steps:
-        table = Table(title=f"plan: {plan.robot_name if plan else ''}")
-        for column in ("step", "start [s]", "duration [s]", "points", "peak vel / limit", "peak acc / limit"):
-            table.add_column(column)
+        rows = table(f"plan: {plan.robot_name if plan else ''}",
+                     ("step", "start [s]", "duration [s]", "points", "peak vel / limit", "peak acc / limit"))
         for s in steps:
-            table.add_row(s["name"], f"{s['start_s']:.3f}", f"{s['duration_s']:.3f}", str(s["points"]),
-                          f"{s['peak_velocity_fraction']:.2f}", f"{s['peak_acceleration_fraction']:.2f}")
-        _console.print(table)
+            rows.add_row(s["name"], f"{s['start_s']:.3f}", f"{s['duration_s']:.3f}", str(s["points"]),
+                         f"{s['peak_velocity_fraction']:.2f}", f"{s['peak_acceleration_fraction']:.2f}")
+        show(rows)
+        if inspection.end_states:
+            _end_poses([s["name"] for s in steps], inspection.end_states)
 
 
 def execution_summary(outcome: PlanExecution, output: Path | None, as_json: bool, quiet: bool) -> None:
@@ -180,6 +224,7 @@ def execution_summary(outcome: PlanExecution, output: Path | None, as_json: bool
     if quiet:
         return
     _verdict(document, f"smallest margin to tolerance ({document['controller']})")
+    _tracking(document)
     _console.print(f"executed {len(document['steps'])} of {len(outcome.plan.steps)} steps in "
                    f"{_number(document['duration_s'], '.3f')} s")
 
@@ -202,6 +247,7 @@ def check_summary(report: CheckReport, recording: Path, as_json: bool, quiet: bo
     if quiet:
         return
     _verdict(document, "smallest margin to tolerance")
+    _tracking(document)
     if "cycles" in document:
         _cycles(document)
 
@@ -225,26 +271,38 @@ def _verdict(document: dict[str, Any], margins_title: str) -> None:
     colour = "green" if document["ok"] else "yellow" if result["name"] == "INCOMPLETE" else "red"
     _console.print(f"[{colour}]{result['name']}[/{colour}] ({result['code']}): {result['message']}")
     if document["violations"]:
-        table = Table(title="violations")
-        for column in ("step", "check", "joint", "time [s]", "reference", "actual", "error", "tolerance"):
-            table.add_column(column)
+        rows = table("violations; positions in rad or m", ("step", "check", "joint", "time [s]", "reference",
+                                                           "actual", "error", "tolerance"), left=3)
         for v in document["violations"]:
-            table.add_row(v["step"], v["check"], v["joint"], _number(v["time_s"], ".3f"),
-                          *(_number(v[key], ".4f") for key in ("reference", "actual", "error", "tolerance")))
-        _console.print(table)
+            rows.add_row(v["step"], v["check"], v["joint"], _number(v["time_s"], ".3f"),
+                         *(_number(v[key], ".4f") for key in ("reference", "actual", "error", "tolerance")))
+        show(rows)
     if document["margins"]:
-        table = Table(title=margins_title)
-        table.add_column("joint")
-        table.add_column("margin [rad]")
+        rows = table(margins_title, ("joint", "margin [rad]"))
         for joint, margin in document["margins"].items():
             colour = "red" if margin is None or margin < 0 else "green"
-            table.add_row(joint, f"[{colour}]{_number(margin, '.4f')}[/]")
-        _console.print(table)
+            rows.add_row(joint, f"[{colour}]{_number(margin, '.4f')}[/]")
+        show(rows)
 
 
-def _number(value: float | None, spec: str) -> str:
-    """Return a document's number formatted, or "inf/nan" for its null: not finite (a diverged plant)."""
-    return "inf/nan" if value is None else format(value, spec)
+def _tracking(document: dict[str, Any]) -> None:
+    """Print per joint how it tracked (worst over the steps), and name the joints that ring, whatever the verdict."""
+    tracking = document.get("tracking") or {}
+    if not tracking:
+        return
+    cycle = document.get("tracking_cycle")
+    of_cycle = f" of cycle {cycle}" if cycle is not None else ""
+    title = f"tracking [rad], worst over the steps{of_cycle}; osc: error sign changes after the stop"
+    rows = table(title, ("joint", "peak err", "overshoot", "settle [s]", "osc", "final err"))
+    for joint, t in tracking.items():
+        settling = "-" if t["settling_time_s"] is None else f"{t['settling_time_s']:.3f}"
+        oscillations = f"[red]{t['oscillations']}[/]" if t["ringing"] else str(t["oscillations"])
+        rows.add_row(joint, _number(t["peak_error"], ".2e"), _number(t["overshoot"], ".2e"), settling, oscillations,
+                     _number(t["final_error"], ".2e"))
+    show(rows)
+    ringing = [f"{joint} ({t['oscillations']})" for joint, t in tracking.items() if t["ringing"]]
+    if ringing:
+        _console.print(f"[yellow]ringing[/yellow] (error sign changes after the stop): {', '.join(ringing)}")
 
 
 @contextmanager
@@ -271,11 +329,10 @@ def benchmark_summary(runs: list[Run], rows: list[dict[str, Any]], as_json: bool
         return
     if quiet:
         return
-    table = Table(title=f"{len(runs)} runs; times in ms (median / p95); total = search + simplify + certify + timing; "
-                        "whole call = set-up to written file, config loaded")
-    for column in ("scenario", "planner", "solved", "search", "simplify", "certify", "timing", "total",
-                   "whole call", "path [rad]", "duration [s]", "exact-valid"):
-        table.add_column(escape(column), justify="left" if column in ("scenario", "planner") else "right")
+    rows_table = table(f"{len(runs)} runs; times in ms (median / p95); total = search + simplify + certify + timing; "
+                       "whole call = set-up to written file, config loaded",
+                       ("scenario", "planner", "solved", "search", "simplify", "certify", "timing", "total",
+                        "whole call", "path [rad]", "duration [s]", "exact-valid"), left=2)
 
     def ms(row: dict[str, Any], key: str) -> str:
         median, p95 = row[f"{key}_median_s"], row[f"{key}_p95_s"]
@@ -285,9 +342,9 @@ def benchmark_summary(runs: list[Run], rows: list[dict[str, Any]], as_json: bool
         return "-" if value is None else f"{value:.{digits}f}"
 
     for row in sorted(rows, key=lambda r: (r["scenario"] == "all", r["scenario"], r["planner"])):
-        table.add_row(row["scenario"], row["planner"], f"{row['succeeded']}/{row['runs']}",
+        rows_table.add_row(row["scenario"], row["planner"], f"{row['succeeded']}/{row['runs']}",
                       *(ms(row, stage) for stage in ("search", "simplify", "certify", "timing", "total", "whole_call")),
-                      number(row["path_length_median"], 2),
-                      number(row["duration_median_s"], 2), f"{row['exact_valid']}/{row['succeeded']}")
-    # Piped to a file, rich would fold the table into 80 columns.
-    (_console if _console.is_terminal else Console(width=200)).print(table)
+                           number(row["path_length_median"], 2),
+                           number(row["duration_median_s"], 2), f"{row['exact_valid']}/{row['succeeded']}")
+    # Piped to a file, the whole table: a log or a CI artifact is read in an editor, not at 80 columns.
+    show(rows_table, _console if _console.is_terminal else Console(width=200))

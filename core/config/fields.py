@@ -5,16 +5,18 @@ Shared by every parser of a configuration file: robot config, scene, task and Mo
 
 from __future__ import annotations
 
+import ast
 import itertools
 import math
+import operator
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-from ..errors import ConfigError, known
+from ..errors import ConfigError, MoveplanError, known
 
 try:
     from yaml.cyaml import CParser as _CParser  # libyaml's parser, where PyYAML has it
@@ -22,14 +24,31 @@ except ImportError:  # a PyYAML built without libyaml
     _CParser = None
 
 __all__ = [
-    "MAX_ALIAS_EXPANSION", "MAX_MAGNITUDE", "MAX_YAML_BYTES", "MAX_YAML_EVENTS", "boolean", "check_keys", "coordinate",
-    "load_yaml", "mapping", "number", "parse_yaml", "string_list",
+    "DEGREES", "MAX_ALIAS_EXPANSION", "MAX_EXPRESSION_LENGTH", "MAX_MAGNITUDE", "MAX_YAML_BYTES", "MAX_YAML_EVENTS",
+    "TURN", "angle", "beyond_a_turn", "boolean", "check_keys", "coordinate", "expression", "load_yaml", "mapping",
+    "more_than_a_turn", "number", "parse_yaml", "pose_angle", "pose_angles", "string_list",
 ]
 
 
 MAX_MAGNITUDE = 1e6
 """Largest |value| of a position in [rad] or [m] or a time in [s] from a flag or a task: a million
 radians, a thousand kilometres, eleven days. Beyond it, a typo (1e308) must not reach the planner."""
+
+MAX_EXPRESSION_LENGTH = 100
+"""Characters of one number or pi expression: `-pi/2+0.25` is 10, a double written in full 25."""
+
+TURN = 2.0 * math.pi
+"""One full turn in [rad]. A pose angle, or a revolute joint value outside its limits, given without a unit
+beyond it is refused: it reads as degrees (`180` for pi)."""
+
+DEGREES = "deg"
+"""The suffix of an angle given in degrees: `90deg`."""
+
+_TURN_SLACK = 1e-4  # [rad]: 6.2832, 2*pi rounded by hand, is still a turn
+
+_BINARY: dict[type, Callable[[float, float], float]] = {
+    ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
+}
 
 MAX_ALIAS_EXPANSION = 100_000
 """Values YAML aliases may add to a file once expanded: ROS files reuse a joint list or a block of
@@ -176,6 +195,105 @@ def number(value: Any, where: str, positive: bool = False, bound: float | None =
 def coordinate(value: Any, where: str) -> float:
     """Return a position in [rad] or [m] or a time in [s], checked to be finite and within MAX_MAGNITUDE."""
     return number(value, where, bound=MAX_MAGNITUDE)
+
+
+def expression(text: str, where: str, error: type[MoveplanError] = ConfigError) -> float:
+    """Return the number `text` spells: a decimal, or an expression of numbers and pi (`-pi/2+0.25`).
+
+    Raises:
+        error: Not such an expression, longer than MAX_EXPRESSION_LENGTH characters, a value (or an
+            intermediate value) beyond MAX_MAGNITUDE, or a deg suffix, which only angles take.
+    """
+    text = text.strip()
+    shown = _shown_text(text)
+    if text.endswith(DEGREES):
+        raise error(f"{where}: {shown}: a '{DEGREES}' suffix is for angles (pose roll, pitch, yaw and revolute "
+                    "joint values), not for this value")
+    return _evaluate(text, where, error, shown, "a number or an expression like pi/2")
+
+
+def angle(value: Any, where: str, error: type[MoveplanError] = ConfigError) -> tuple[float, bool]:
+    """Return an angle in [rad], and whether it was written in degrees.
+
+    `value` is a number in [rad] (from YAML), or text: a number or pi expression in [rad]
+    (`pi/2`), or degrees with a deg suffix (`90deg`, `-45 deg`). `error` is raised for text
+    that is none of these (UsageError for a flag; a YAML value is always a ConfigError).
+    """
+    if not isinstance(value, str):
+        return coordinate(value, where), False
+    text = value.strip()
+    expected = "a number in radians (1.57, pi/2) or degrees (90deg)"
+    if text.endswith(DEGREES):
+        body = text[: -len(DEGREES)].strip()
+        return math.radians(_evaluate(body, where, error, _shown_text(text), expected)), True
+    return _evaluate(text, where, error, _shown_text(text), expected), False
+
+
+def pose_angle(value: Any, where: str, error: type[MoveplanError] = ConfigError) -> float:
+    """Return a pose's roll, pitch or yaw in [rad] (as `angle` reads it); a unitless value beyond a turn is refused.
+
+    Raises:
+        error: As `angle`, and for a value in [rad] beyond 2*pi: degrees written without their unit.
+    """
+    radians, in_degrees = angle(value, where, error)
+    if not in_degrees and more_than_a_turn(radians):
+        raise error(f"{where}: {beyond_a_turn(radians)}")
+    return radians
+
+
+def pose_angles(value: Any, where: str) -> tuple[float, float, float]:
+    """Return a YAML file's `rpy: [roll, pitch, yaw]` in [rad], each read by `pose_angle`."""
+    if not isinstance(value, list | tuple) or len(value) != 3:
+        raise ConfigError(f"{where}: expected a list of 3 angles, got {_shown(value)}")
+    roll, pitch, yaw = (pose_angle(v, f"{where}[{i}]") for i, v in enumerate(value))
+    return roll, pitch, yaw
+
+
+def more_than_a_turn(radians: float) -> bool:
+    """Return whether |radians| exceeds a full turn, beyond rounding (6.2832 for 2*pi is still one)."""
+    return abs(radians) > TURN + _TURN_SLACK
+
+
+def beyond_a_turn(radians: float, limits: str = "") -> str:
+    """Return why a unitless angle beyond 2*pi is refused, and how to write it; `limits` is said after the turn."""
+    return (f"{radians:g} rad is more than a full turn (2*pi){limits}: angles are in radians (pi, -pi/2) "
+            f"or, with a unit, in degrees ({radians:g}{DEGREES})")
+
+
+def _evaluate(text: str, where: str, error: type[MoveplanError], shown: str, expected: str) -> float:
+    """Return the value of a number or pi expression; `shown` and `expected` word the error."""
+    if len(text) > MAX_EXPRESSION_LENGTH:
+        raise error(f"{where}: {shown} is longer than {MAX_EXPRESSION_LENGTH} characters, "
+                    "the longest number or pi expression moveplan reads")
+
+    def bounded(result: float) -> float:
+        if not abs(result) <= MAX_MAGNITUDE:  # NaN and inf fail this too
+            raise OverflowError
+        return result
+
+    def value(node: ast.AST) -> float:
+        if isinstance(node, ast.Constant) and isinstance(node.value, int | float) and not isinstance(node.value, bool):
+            return bounded(float(node.value))
+        if isinstance(node, ast.Name) and node.id == "pi":
+            return math.pi
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
+            return -value(node.operand) if isinstance(node.op, ast.USub) else value(node.operand)
+        if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
+            return bounded(_BINARY[type(node.op)](value(node.left), value(node.right)))
+        raise ValueError
+
+    try:
+        return value(ast.parse(text, mode="eval").body)
+    except (SyntaxError, ValueError, ZeroDivisionError, RecursionError, MemoryError):
+        raise error(f"{where}: expected {expected}, got {shown}") from None
+    except OverflowError:
+        raise error(f"{where}: {shown} is out of range; values are limited to "
+                    f"|value| <= {MAX_MAGNITUDE:,.0f} (rad, m or s)") from None
+
+
+def _shown_text(text: str) -> str:
+    """Return `text` quoted, or its two ends and its length when longer than 40 characters."""
+    return f"'{text}'" if len(text) <= 40 else f"'{text[:20]}...{text[-10:]}' ({len(text)} characters)"
 
 
 def _shown(value: Any) -> str:

@@ -7,8 +7,8 @@ reports it: {"joints": ...}, {"named": ...}, {"pose": ...} or {"shift": ...}.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -29,22 +29,32 @@ class JointGoal:
             else one per joint of `joints`.
         joints: Names of the joints a partial goal sets (the others keep their start
             values); None for a complete goal.
+        degrees: Per value, whether it was written in degrees (`90deg`; `values` holds it in
+            [rad]); empty when none was.
+        source: Where the values were written, for messages: a flag (`--joints`) or a file's
+            key path (`task.yaml: steps[0].joints`); "" for values from a MoveIt message or a
+            plan file, which are in [rad] by convention (pipeline/state.py check_joint_units
+            checks the others against the robot's joints).
     """
 
     kind: ClassVar[str] = "joints"
     values: tuple[float, ...]
     joints: tuple[str, ...] | None = None
+    degrees: tuple[bool, ...] = field(default=(), compare=False)
+    source: str = field(default="", compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "values", tuple(self.values))
+        object.__setattr__(self, "degrees", tuple(self.degrees))
         if self.joints is not None:
             object.__setattr__(self, "joints", tuple(self.joints))
             assert len(self.joints) == len(self.values), "one value per named joint"
+        assert not self.degrees or len(self.degrees) == len(self.values), "one unit flag per value"
 
     @classmethod
-    def by_name(cls, values: Mapping[str, float]) -> JointGoal:
+    def by_name(cls, values: Mapping[str, float], degrees: Sequence[bool] = (), source: str = "") -> JointGoal:
         """Return a partial goal setting each named joint to its value."""
-        return cls(tuple(values.values()), tuple(values))
+        return cls(tuple(values.values()), tuple(values), tuple(degrees), source)
 
     @property
     def named_values(self) -> dict[str, float] | None:

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from .fields import MAX_MAGNITUDE, check_keys, coordinate, load_yaml, mapping, number
+from .fields import MAX_MAGNITUDE, angle, check_keys, coordinate, load_yaml, mapping, number, pose_angle
 from .goals import GOAL_KINDS, SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
 
 __all__ = [
@@ -91,14 +91,20 @@ def parse_goal(entry: dict[str, Any], where: str) -> Goal:
             raise ConfigError(f"{where}.named: expected a group_state name, got {value!r}")
         return NamedGoal(value)
     if isinstance(value, list):
-        return JointGoal(tuple(coordinate(v, f"{where}.joints[{i}]") for i, v in enumerate(value)))
+        read = [angle(v, f"{where}.joints[{i}]") for i, v in enumerate(value)]
+        return JointGoal(tuple(v for v, _ in read), degrees=tuple(d for _, d in read), source=f"{where}.joints")
     if isinstance(value, dict):
-        return JointGoal.by_name({str(k): coordinate(v, f"{where}.joints.{k}") for k, v in value.items()})
+        named = {str(k): angle(v, f"{where}.joints.{k}") for k, v in value.items()}
+        return JointGoal.by_name({k: v for k, (v, _) in named.items()}, [d for _, d in named.values()],
+                                 f"{where}.joints")
     raise ConfigError(f"{where}.joints: expected a list of values or a mapping joint: value, got {value!r}")
 
 
 def parse_pose(entry: dict[str, Any], where: str) -> PoseGoal:
-    """Return a pose goal of `link` in `frame` (xyz, rpy | quat), numbers checked; missing keys are None."""
+    """Return a pose goal of `link` in `frame` (xyz, rpy | quat), numbers checked; missing keys are None.
+
+    Angles of `rpy` are radians, pi expressions or degrees (`90deg`); a unitless one beyond 2*pi is refused.
+    """
     check_keys(entry, _POSE_KEYS, where)
     names = {key: entry.get(key) for key in ("frame", "link")}
     for key, name in names.items():
@@ -111,7 +117,8 @@ def parse_pose(entry: dict[str, Any], where: str) -> PoseGoal:
             continue
         if not isinstance(value, list) or len(value) != size:
             raise ConfigError(f"{where}.{key}: expected a list of {size} numbers, got {value!r}")
-        read = coordinate if key != "quat" else number  # a quaternion is normalised: any scale is fine
+        # A quaternion is normalised: any scale is fine.
+        read = coordinate if key == "xyz" else pose_angle if key == "rpy" else number
         vectors[key] = tuple(read(v, f"{where}.{key}[{i}]") for i, v in enumerate(value))
     if "rpy" in vectors and "quat" in vectors:
         raise ConfigError(f"{where}: give rpy or quat, not both")
@@ -121,9 +128,10 @@ def parse_pose(entry: dict[str, Any], where: str) -> PoseGoal:
 
 
 def parse_shift(entry: dict[str, Any], where: str) -> ShiftGoal:
-    """Return a shift goal: displacement per axis (x, y, z in [m]; roll, pitch, yaw in [rad]) and frame."""
+    """Return a shift goal: displacement per axis (x, y, z in [m]; roll, pitch, yaw in [rad] or `deg`) and frame."""
     check_keys(entry, {*SHIFT_AXES, "frame"}, where)
-    offsets = {axis: coordinate(entry[axis], f"{where}.{axis}") for axis in SHIFT_AXES if axis in entry}
+    offsets = {axis: (coordinate if axis in ("x", "y", "z") else pose_angle)(entry[axis], f"{where}.{axis}")
+               for axis in SHIFT_AXES if axis in entry}
     if not offsets:
         raise ConfigError(f"{where}: give at least one of {', '.join(SHIFT_AXES)}")
     frame = entry.get("frame", "tool")

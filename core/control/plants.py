@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -21,7 +21,8 @@ from ..config.controllers import ControllerConfig
 from ..errors import UsageError, known
 from .tolerances import position_error
 
-__all__ = ["PLANTS", "FrozenPlant", "LagPlant", "MirrorPlant", "PidPlant", "Plant", "make_plant"]
+__all__ = ["PLANTS", "FrozenPlant", "LagPlant", "MirrorPlant", "PidPlant", "Plant", "make_plant", "pid_gains",
+           "pid_interface", "pid_parameters"]
 
 State = tuple[NDArray[np.float64], NDArray[np.float64]]
 Run = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
@@ -178,7 +179,10 @@ class PidPlant(Plant):
     period ahead, the desired state of this cycle is the previous command, which is what the
     plant keeps. Through `effort`, u is a torque (acceleration = u / inertia, saturated at
     max_effort); through `velocity`, the drive reaches the velocity u (saturated at
-    max_velocity) as fast as max_effort allows.
+    max_velocity) as fast as max_effort allows. Two additions model a real drive: `load` is
+    added to u (a torque such as gravity through effort, a velocity offset such as a leaking
+    valve through velocity), and the drive applies u through a first-order lag of time
+    constant `drive_tau` [s] (0: at once). Every parameter is a scalar or one value per joint.
     """
 
     def __init__(
@@ -186,18 +190,27 @@ class PidPlant(Plant):
         gains: Mapping[str, NDArray[np.float64]],
         interface: str,
         *,
-        max_velocity: float = math.inf,
-        max_effort: float = math.inf,
-        inertia: float = 1.0,
-        noise: float = 0.0,
+        max_velocity: npt.ArrayLike = math.inf,
+        max_effort: npt.ArrayLike = math.inf,
+        inertia: npt.ArrayLike = 1.0,
+        noise: npt.ArrayLike = 0.0,
         continuous: npt.ArrayLike | None = None,
+        drive_tau: npt.ArrayLike = 0.0,
+        load: npt.ArrayLike = 0.0,
     ) -> None:
         self._p, self._i, self._d = gains["p"], gains["i"], gains["d"]
         self._i_clamp, self._ff = gains["i_clamp"], gains["ff_velocity_scale"]
         super().__init__(len(self._p))
         self.interface = interface
-        self._max_velocity, self._max_effort, self._inertia = max_velocity, max_effort, inertia
-        self._noise = noise
+        self._max_velocity, self._max_effort = _limit(max_velocity), _limit(max_effort)
+        self._inertia = np.asarray(inertia, dtype=np.float64)
+        self._max_acceleration = _limit(np.asarray(max_effort, dtype=np.float64) / self._inertia)
+        self._noise = np.asarray(noise, dtype=np.float64)
+        self._drive_tau = np.asarray(drive_tau, dtype=np.float64)
+        self._load = np.asarray(load, dtype=np.float64)
+        self._lags = bool(np.any(self._drive_tau > 0.0))
+        self._dt, self._follow = math.nan, np.ones(1)
+        self._drive = np.zeros_like(self._p)
         mask = np.asarray(False if continuous is None else continuous, dtype=bool)
         self._continuous = mask if mask.any() else None
         self._integrates = bool(np.any((self._i != 0.0) & (self._i_clamp > 0.0)))
@@ -212,6 +225,7 @@ class PidPlant(Plant):
         state = super().reset(positions)
         self.last_output = np.zeros_like(self._q)
         self._integral = np.zeros_like(self._q)
+        self._drive = np.zeros_like(self._q)
         # The first cycle's desired state: a MoveIt trajectory starts where the robot is.
         self._desired = (self._q, np.zeros_like(self._q))
         return state
@@ -224,17 +238,29 @@ class PidPlant(Plant):
         dt: float,
     ) -> State:
         """Return the measured state after one cycle of PID output applied to the joints."""
-        output = self._pid(command_velocities, dt)
+        output = self._applied(self._pid(command_velocities, dt), dt)
         self._desired = (command_positions, command_velocities)
         if self.interface == "effort":
             acceleration = _saturate(output, self._max_effort) / self._inertia
         else:
             target = _saturate(output, self._max_velocity)
-            acceleration = _saturate((target - self._qd) / dt, self._max_effort / self._inertia)
+            acceleration = _saturate((target - self._qd) / dt, self._max_acceleration)
         # Exact for an acceleration held over the period (zero-order hold of the output).
         self._q = self._q + (self._qd + 0.5 * dt * acceleration) * dt
         self._qd = _saturate(self._qd + acceleration * dt, self._max_velocity)
         return self._measure()
+
+    def _applied(self, output: NDArray[np.float64], dt: float) -> NDArray[np.float64]:
+        """Return what the drive applies this cycle: the PID output plus the load, through its lag."""
+        if self._load.any():
+            output = output + self._load
+        if not self._lags:
+            return output
+        if dt != self._dt:
+            # Exact for an output held over the period, as the position update is.
+            self._dt, self._follow = dt, -np.expm1(-dt / np.maximum(self._drive_tau, 1e-300))
+        self._drive = self._drive + (output - self._drive) * self._follow
+        return self._drive
 
     def _pid(self, command_velocities: NDArray[np.float64], dt: float) -> NDArray[np.float64]:
         """Return JTC's PID adapter output for this cycle and remember it as `last_output`."""
@@ -255,20 +281,28 @@ class PidPlant(Plant):
 
     def _measure(self) -> State:
         positions = self._q
-        if self._noise > 0.0:
-            positions = positions + self._rng.normal(0.0, self._noise, len(positions))
+        if self._noise.any():
+            positions = positions + self._rng.normal(0.0, 1.0, len(positions)) * self._noise
         self._measured = (positions, self._qd)
         return self._measured
 
 
-def _saturate(values: NDArray[np.float64], limit: float) -> NDArray[np.float64]:
+def _limit(value: npt.ArrayLike) -> float | NDArray[np.float64]:
+    """Return a saturation limit: a float when one value holds for every joint (the common case)."""
+    array = np.asarray(value, dtype=np.float64)
+    return float(array.flat[0]) if array.size == 1 or np.all(array == array.flat[0]) else array
+
+
+def _saturate(values: NDArray[np.float64], limit: float | NDArray[np.float64]) -> NDArray[np.float64]:
     """Return `values` limited to +-limit; cheap for an infinite limit, the common case."""
-    if math.isinf(limit):
+    if isinstance(limit, float) and math.isinf(limit):
         return values
     return np.minimum(np.maximum(values, -limit), limit)
 
 
-_PID_PARAMS = ("inertia", "max_effort", "max_velocity", "noise")
+_PID_PARAMS = {"inertia": 1.0, "max_effort": math.inf, "max_velocity": math.inf, "noise": 0.0,
+               "drive_tau": 0.0, "load": 0.0}
+"""pid's parameters and their defaults; each also per joint, `name.<joint>`."""
 _GAINS = ("p", "i", "d", "i_clamp", "ff_velocity_scale")
 
 
@@ -283,7 +317,9 @@ def make_plant(
     mirror takes no parameters; lag takes `tau` [s] for all joints and `tau.<joint>` for one
     (default 0.05 s); both follow the sampled position command whatever the controller's
     command interfaces. pid takes max_velocity [rad]/[s], max_effort [N m], inertia
-    [kg m^2], noise (standard deviation of measured positions [rad]) and the gains of
+    [kg m^2], noise (standard deviation of measured positions [rad]), drive_tau (the drive's
+    lag [s]) and load (added to the PID output: [N m] through effort, [rad]/[s] through
+    velocity), each for all joints or as `name.<joint>` for one, and the gains of
     `controller`, which must command velocity or effort alone. Raises UsageError for an
     unknown plant or parameter, naming the valid ones.
     """
@@ -296,20 +332,38 @@ def make_plant(
         default = _positive(params, "tau", 0.05)
         return LagPlant([_positive(params, f"tau.{j}", default) for j in joints])
     if name == "pid":
-        _check_params(name, params, _PID_PARAMS)
-        noise = float(params.get("noise", 0.0))
-        if not noise >= 0.0:
-            raise UsageError(f"plant parameter 'noise' must be >= 0, got {noise}")
-        return PidPlant(
-            _gains(controller),
-            _pid_interface(controller),
-            max_velocity=_positive(params, "max_velocity", math.inf),
-            max_effort=_positive(params, "max_effort", math.inf),
-            inertia=_positive(params, "inertia", 1.0),
-            noise=noise,
-            continuous=[j in set(continuous_joints) for j in joints],
-        )
+        values = pid_parameters(params, joints)
+        return PidPlant(pid_gains(controller), pid_interface(controller),
+                        continuous=[j in set(continuous_joints) for j in joints], **values)
     raise UsageError(f"unknown plant '{name}'; known: {known(PLANTS)}")
+
+
+def pid_parameters(params: Mapping[str, float], joints: Sequence[str]) -> dict[str, NDArray[np.float64]]:
+    """Return pid's parameters per joint (arrays in the order of `joints`), defaults filled in.
+
+    Raises:
+        UsageError: An unknown parameter (the message lists the valid ones), or a value out
+            of range: inertia, max_effort and max_velocity must be positive, noise and
+            drive_tau >= 0.
+    """
+    for key in params:
+        if key not in _PID_PARAMS and key.split(".", 1) not in ([k, j] for k in _PID_PARAMS for j in joints):
+            raise UsageError(f"plant 'pid' has no parameter '{key}'; known: {known(_PID_PARAMS)}, "
+                             f"each also as NAME.<joint> for one of {known(joints)}")
+    values = {}
+    for key, default in _PID_PARAMS.items():
+        common = float(params.get(key, default))
+        values[key] = np.array([float(params.get(f"{key}.{j}", common)) for j in joints])
+        rule, holds = _RANGES[key]
+        for which, value in zip([key, *(f"{key}.{j}" for j in joints)], [common, *values[key]], strict=True):
+            if not holds(value):
+                raise UsageError(f"plant parameter '{which}' must be {rule}, got {value}")
+    return values
+
+
+_RANGES = {key: (">= 0", lambda v: v >= 0.0) for key in ("noise", "drive_tau")} | {
+    key: ("positive", lambda v: v > 0.0) for key in ("inertia", "max_effort", "max_velocity")} | {
+    "load": ("a finite number", math.isfinite)}
 
 
 def _check_params(name: str, params: Mapping[str, float], valid: Iterable[str]) -> None:
@@ -326,7 +380,7 @@ def _positive(params: Mapping[str, float], key: str, default: float) -> float:
     return value
 
 
-def _pid_interface(controller: ControllerConfig) -> str:
+def pid_interface(controller: ControllerConfig) -> str:
     """Return the interface JTC's PID adapter drives: velocity or effort, alone."""
     commands = controller.command_interfaces
     if commands in (("velocity",), ("effort",)):
@@ -337,7 +391,7 @@ def _pid_interface(controller: ControllerConfig) -> str:
     )
 
 
-def _gains(controller: ControllerConfig) -> dict[str, NDArray[np.float64]]:
+def pid_gains(controller: ControllerConfig) -> dict[str, NDArray[np.float64]]:
     """Return each PID gain as an array over the controller's joints (missing: 0, as in JTC)."""
     return {
         gain: np.array([controller.gains.get(j, {}).get(gain, 0.0) for j in controller.joints])

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+from .quality import JointTracking
 
 __all__ = [
     "GOAL_TOLERANCE_VIOLATED",
@@ -91,12 +93,14 @@ class ToleranceReport:
         margins: Per joint with a nonzero position tolerance, the smallest tolerance - |error|
             in [rad]: over all path-checked cycles, and of the goal check on the final cycle.
         end_index: Index of the cycle on which it ended.
+        tracking: Per joint how it tracked its reference (quality.tracking), where computed.
     """
 
     result: ExecutionResult
     violations: tuple[Violation, ...]
     margins: dict[str, float]
     end_index: int
+    tracking: dict[str, JointTracking] = field(default_factory=dict)
 
     @property
     def ok(self) -> bool:
@@ -117,6 +121,7 @@ class ExecutionSummary:
         joint_names: The controller's joints, in its order.
         cycles: Control cycles run; 0 if it never started.
         output_interface: The command interface the plant was driven through.
+        tracking: Per joint how it tracked its reference (quality.tracking), where computed.
     """
 
     ok: bool
@@ -127,3 +132,4 @@ class ExecutionSummary:
     joint_names: tuple[str, ...]
     cycles: int
     output_interface: str = "position"
+    tracking: dict[str, JointTracking] = field(default_factory=dict)

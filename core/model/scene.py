@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config.fields import MAX_MAGNITUDE, check_keys, mapping, number
+from ..config.fields import MAX_MAGNITUDE, check_keys, mapping, number, pose_angles
 from ..errors import ConfigError, FrameNotFound
 from ..types import CollisionObject, Frame, Shape
 from .poses import pose_matrix, vector
@@ -200,7 +200,7 @@ def moveplan_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
         for key in ("name", "parent"):
             if not isinstance(entry.get(key), str):
                 raise ConfigError(f"{where}: '{key}' must be a frame name")
-        transform = pose_matrix(entry.get("xyz"), entry.get("rpy"), entry.get("quat"), where)
+        transform = _pose(entry, where)
         frames.append(Frame(entry["name"], entry["parent"], transform))
     anchors = resolve_frames(frames, robot, source)
 
@@ -218,8 +218,7 @@ def moveplan_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
         if robot.model.frames[robot.model.getFrameId(link)].parentJoint != 0:
             raise ConfigError(f"{where}: frame '{frame}' moves with link '{link}'; "
                               "put objects carried by the robot under 'attached'")
-        root_T_object = robot.frame_pose(root_q, link) @ link_T_frame @ pose_matrix(
-            entry.get("xyz"), entry.get("rpy"), entry.get("quat"), where)
+        root_T_object = robot.frame_pose(root_q, link) @ link_T_frame @ _pose(entry, where)
         objects.append(CollisionObject(name, _shape(entry, where, path.parent), root_T_object))
     for k, entry in enumerate(_entries(top, "attached", source)):
         where = f"{source}: attached[{k}]"
@@ -231,11 +230,18 @@ def moveplan_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
         if link not in robot.link_names:
             raise FrameNotFound(link, where, robot.link_names)
         touch = tuple(str(t) for t in entry.get("touch_links") or [])
-        transform = pose_matrix(entry.get("xyz"), entry.get("rpy"), entry.get("quat"), where)
+        transform = _pose(entry, where)
         objects.append(CollisionObject(name, _shape(entry, where, path.parent), transform, link, touch))
     if (twice := first_repeated(o.name for o in objects)) is not None:
         raise ConfigError(f"{source}: object name '{twice}' is used twice")
     return Scene(source, tuple(frames), tuple(objects), anchors)
+
+
+def _pose(entry: dict[str, Any], where: str) -> NDArray[np.float64]:
+    """Return the transform of a scene entry's xyz and rpy or quat; rpy angles are read as task files read them."""
+    rpy = entry.get("rpy")
+    return pose_matrix(entry.get("xyz"), None if rpy is None else list(pose_angles(rpy, f"{where}.rpy")),
+                       entry.get("quat"), where)
 
 
 def check_shape_count(count: int, source: str) -> None:

@@ -12,7 +12,7 @@ import logging
 import tempfile
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import AbstractContextManager, ExitStack
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
@@ -25,10 +25,12 @@ from ..config.controllers import ControllerConfig, ExecutionConfig, default_cont
 from ..config.robot_config import RobotConfig, load_robot_config
 from ..config.sources import CONFIG_FILE
 from ..control.check_report import CheckReport
-from ..control.checking import check_recording, uses_velocities
+from ..control.checking import SampleSource, check_recording, uses_velocities
 from ..control.goal_validation import validate_goal
 from ..control.margins import merged_margins
+from ..control.quality import JointTracking, merged_tracking
 from ..control.results import ExecutionResult, ExecutionSummary, Violation
+from ..control.step_tracking import recorded_tracking, simulated_tracking
 from ..errors import ConfigError, InputError, UnknownName
 from ..types import TfSamples
 
@@ -40,8 +42,8 @@ if TYPE_CHECKING:
 _TF_RATE_HZ = 30.0
 
 __all__ = [
-    "CheckRequest", "ExecuteRequest", "OpenRecorder", "PlanExecution", "StepExecution", "StepRecorder", "check",
-    "execute", "pick_controller", "plan_config", "read_valid_plan",
+    "CheckRequest", "CheckedRecording", "ExecuteRequest", "OpenRecorder", "PlanExecution", "StepExecution",
+    "StepRecorder", "check", "execute", "pick_controller", "plan_config", "plan_controller", "read_valid_plan",
 ]
 
 _LOG = logging.getLogger(__name__)
@@ -111,9 +113,29 @@ class PlanExecution:
         return merged_margins(step.report.margins for step in self.steps)
 
     @property
+    def tracking(self) -> dict[str, JointTracking]:
+        """Return per joint the worst tracking figures over all steps."""
+        # A step built by hand around a whole ExecutionReport carries no tracking figures.
+        return merged_tracking([getattr(step.report, "tracking", {}) for step in self.steps])
+
+    @property
     def duration_s(self) -> float:
         """Return the simulated time of all executed steps in [s]."""
         return sum(s.report.duration_s for s in self.steps)
+
+
+@dataclass(frozen=True)
+class CheckedRecording:
+    """A check's verdict with what it was made from: the plan, controller and recorded samples (still open).
+
+    `continuous` names the URDF continuous joints; `samples` are read by row ranges.
+    """
+
+    report: CheckReport
+    plan: recording.PlanFile
+    controller: ControllerConfig
+    continuous: tuple[str, ...]
+    samples: SampleSource
 
 
 class StepRecorder(Protocol):
@@ -181,13 +203,16 @@ def pick_controller(
     return min(fitting, key=lambda c: len(c.joints))
 
 
-def execute(request: ExecuteRequest, record: OpenRecorder | None = None) -> PlanExecution:
+def execute(
+    request: ExecuteRequest, record: OpenRecorder | None = None, *, link_poses: bool = True
+) -> PlanExecution:
     """Return what executing the plan through the simulated controller did; `record` gets each step as it runs.
 
     Each step is simulated, handed to the recorder `record` opens (its link poses, then
     its report) and dropped: the execution keeps per step only its summary, so memory does
     not grow with the number of steps or the update rate (one step's samples are the most
-    it holds). report.execute_to_file records into an executed file.
+    it holds). report.execute_to_file records into an executed file. With `link_poses`
+    False the recorder gets no link poses (a plot needs none; no kinematics are loaded).
 
     Raises:
         InputError: The plan is unreadable or invalid; and whatever the recorder raises.
@@ -203,7 +228,7 @@ def execute(request: ExecuteRequest, record: OpenRecorder | None = None) -> Plan
     plant = make_plant(request.plant, dict(request.plant_params or {}), controller, continuous)
     reports = _simulated_steps(request, plan, controller, config.execution, plant, continuous)
     robot = None
-    if record is not None:
+    if record is not None and link_poses:
         # pinocchio is imported here, not at the top: check-tolerances shares this module and needs no kinematics.
         from ..model.robot import Robot
 
@@ -212,17 +237,18 @@ def execute(request: ExecuteRequest, record: OpenRecorder | None = None) -> Plan
     with ExitStack() as stack:
         recorder: StepRecorder | None = None
         offset_s = 0.0
-        for name, report in reports:
-            if record is not None and robot is not None:
+        for name, report, figures in reports:
+            if record is not None:
                 if recorder is None:
                     # Link poses come when the first step ran at all: a refused step is the last one.
-                    recorder = stack.enter_context(record(controller, plan, len(report.times_s) > 0))
-                tf = _step_tf(robot, report, offset_s)
+                    poses = robot is not None and len(report.times_s) > 0
+                    recorder = stack.enter_context(record(controller, plan, poses))
+                tf = _step_tf(robot, report, offset_s) if robot is not None else None
                 if tf is not None:
                     recorder.add_tf(tf)
                 recorder.add_step(report)
             offset_s += report.duration_s
-            steps.append(StepExecution(name, report.summary()))
+            steps.append(StepExecution(name, replace(report.summary(), tracking=figures)))
             del report  # before the next step is simulated
         last = steps[-1].report
         execution = PlanExecution(last.ok, last.result, tuple(steps), controller, plan, request=request)
@@ -238,14 +264,16 @@ def _simulated_steps(
     execution: ExecutionConfig,
     plant: Plant,
     continuous: list[str],
-) -> Iterator[tuple[str, ExecutionReport]]:
-    """Yield each step's name and report as it is simulated; a failing step is the last.
+) -> Iterator[tuple[str, ExecutionReport, dict[str, JointTracking]]]:
+    """Yield each step's name, report and tracking figures as it is simulated; a failing step is the last.
 
     Each step is one goal, sent from where the simulated robot ended the one before.
     """
     from ..control.controller import Disturbance, simulate
 
     start = _start_positions(request, plan, controller)
+    goal = np.array([controller.goal_tolerance[j] for j in controller.joints])
+    wraps = np.array([j in continuous for j in controller.joints])
     for step in plan.steps:
         end = step.start_s + step.trajectory.duration_s
         last = step is plan.steps[-1]
@@ -256,7 +284,11 @@ def _simulated_steps(
         ok = report.ok
         # A copy, not a view: a view would keep the step's samples alive through the next step.
         start = report.actual_positions[-1].copy() if len(report.times_s) else start
-        yield step.name, report
+        # Bumps past the verdict land in the hold, where the last step is observed on.
+        held = [(b.time_s, controller.joints.index(b.joint), b.delta) for b in bumps
+                if last and b.time_s > report.duration_s]
+        figures = simulated_tracking(report, plant, step.trajectory.duration_s, goal, wraps, held)
+        yield step.name, report, figures
         del report
         if not ok:
             return
@@ -289,8 +321,12 @@ def _start_positions(
     return np.array([start[j] for j in controller.joints if j in start])
 
 
-def check(request: CheckRequest) -> CheckReport:
-    """Return the verdict of the controller's and MoveIt's rules on a recorded execution of a plan."""
+def check(request: CheckRequest, then: Callable[[CheckedRecording], None] | None = None) -> CheckReport:
+    """Return the verdict of the controller's and MoveIt's rules on a recorded execution of a plan.
+
+    `then`, if given, gets the verdict with what it was made from while the recording is
+    still open (plots.check_plotted draws from it).
+    """
     plan = read_valid_plan(request.plan)
     config = plan_config(plan, request.plan)
     controller = _controller(config, plan, request.plan, request.controllers)
@@ -299,7 +335,19 @@ def check(request: CheckRequest) -> CheckReport:
     with open_joint_states(request.recording, request.topic, joints=controller.joints,
                            time_source=request.time_source,
                            velocities=uses_velocities(plan, controller)) as recorded:
-        return check_recording(plan, recorded, controller, config.execution, continuous, request.start)
+        report = check_recording(plan, recorded, controller, config.execution, continuous, request.start)
+        report = recorded_tracking(report, [s.trajectory for s in plan.steps], recorded, controller,
+                                   np.array([j in continuous for j in controller.joints]))
+        if then is not None:
+            then(CheckedRecording(report, plan, controller, tuple(continuous), recorded))
+        return report
+
+
+def plan_controller(
+    config: RobotConfig, plan: recording.PlanFile, path: Path, override: Path | None
+) -> ControllerConfig:
+    """Return the controller that executes the plan at `path`: from `override` (--controllers), else its own config."""
+    return _controller(config, plan, path, override)
 
 
 def _controller(config: RobotConfig, plan: recording.PlanFile, path: Path, override: Path | None) -> ControllerConfig:

@@ -1,20 +1,28 @@
-"""What `moveplan inspect` shows of a bag: its topics and, for a plan file, each step's peak rates.
+"""What `moveplan inspect` shows of a bag: its topics and, for a plan file, each step's peak rates and end state.
 
 A bag is an MCAP file, a rosbag2 sqlite3 (.db3) file, or a bag folder; a plan file is MCAP.
 """
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..bag import BagSummary, PlanFile, summarize
+from ..errors import InputError
 from ..trajectory import peak_rates
-from .execute import read_valid_plan
+from .execute import plan_config, read_valid_plan
 
-__all__ = ["Inspection", "StepPeaks", "inspect_file", "step_peaks"]
+if TYPE_CHECKING:  # kinematics is loaded for plan files only
+    from .state import RobotState
+
+__all__ = ["Inspection", "StepPeaks", "end_states", "inspect_file", "step_peaks"]
+
+logger = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -41,12 +49,16 @@ class StepPeaks:
 
 @dataclass(frozen=True)
 class Inspection:
-    """A bag's summary, and for a plan file the plan and its steps' peak rates (else None and ())."""
+    """A bag's summary, and for a plan file the plan, its steps' peak rates and end states (else None and ()).
+
+    `end_states` is empty also when the plan's embedded robot config does not load (a warning says why).
+    """
 
     path: Path
     summary: BagSummary
     plan: PlanFile | None
     steps: tuple[StepPeaks, ...] = ()
+    end_states: tuple[RobotState, ...] = ()
 
 
 def inspect_file(path: Path) -> Inspection:
@@ -60,7 +72,33 @@ def inspect_file(path: Path) -> Inspection:
     if "moveplan" not in summary.metadata or not path.is_file():
         return Inspection(path, summary, None)
     plan = read_valid_plan(path)
-    return Inspection(path, summary, plan, step_peaks(plan))
+    return Inspection(path, summary, plan, step_peaks(plan), end_states(plan, path))
+
+
+def end_states(plan: PlanFile, path: Path) -> tuple[RobotState, ...]:
+    """Return where each step ends: group joints and the tip's pose in the planning frame, by the embedded config.
+
+    Joints outside the plan's trajectories are at the config's initial positions. A plan whose
+    config does not load gives () and a warning: the rest of the summary stands without it.
+    """
+    # Imported here: a bag that is no plan file needs no kinematics (pinocchio).
+    from ..model.robot import Robot
+    from ..model.scene import empty_scene
+    from .state import robot_state
+
+    try:
+        robot = Robot(plan_config(plan, path), plan.group)
+    except InputError as exc:
+        logger.warning("%s: no end states: %s", path, exc)
+        return ()
+    states = []
+    for step in plan.steps:
+        trajectory = step.trajectory
+        q = robot.neutral()
+        for joint, value in zip(trajectory.joint_names, trajectory.positions[-1], strict=True):
+            q = robot.set_joint(q, joint, float(value))
+        states.append(robot_state(robot, empty_scene(), q))
+    return tuple(states)
 
 
 def step_peaks(plan: PlanFile) -> tuple[StepPeaks, ...]:

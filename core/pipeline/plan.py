@@ -13,7 +13,6 @@ import logging
 import os
 import time
 from dataclasses import dataclass
-from importlib.metadata import version
 from pathlib import Path
 
 import numpy as np
@@ -33,12 +32,13 @@ from ..planning.goals import check_limits, joint_target
 from ..planning.search import seed_planner
 from ..trajectory import sample
 from ..types import Plan, StepResult, TfSamples
+from ..version import moveplan_version
 from .checks import filter_threshold, problem_checks
 from .request import PlanFlags, PlanRequest, resolve_request
-from .state import RobotState, robot_state
+from .state import RobotState, check_joint_units, robot_state
 from .step import plan_step
 
-__all__ = ["PlanFlags", "PlanRequest", "PlanResult", "plan", "plan_to_file", "resolve_request"]
+__all__ = ["PlanFlags", "PlanRequest", "PlanResult", "assemble", "plan", "plan_to_file", "resolve_request"]
 
 logger = logging.getLogger(__name__)
 
@@ -112,7 +112,7 @@ def plan(
         _warn_default_accelerations(config, robot.group.name)
     for goal in (request.start, *(spec.goal for spec in request.steps)):
         if isinstance(goal, JointGoal):  # degrees without their unit, before any planning
-            goal.check_units(config, robot.joint_names)
+            check_joint_units(goal, config, robot.joint_names)
     scene = load_scene(request.scene, robot) if request.scene else empty_scene()
     base, current = _start_values(request, robot, scene)
     if request.motion_request is not None:  # objects the request's start state carries
@@ -128,7 +128,7 @@ def plan(
             began = time.perf_counter()
             step.stats["exact_valid"] = float(referee.first_collision_on_trajectory(step.trajectory) is None)
             step.stats["exact_check_s"] = time.perf_counter() - began
-    return _assemble(request, config, robot, scene, base, steps)
+    return assemble(request, config, robot, scene, base, steps)
 
 
 def _robot(request: PlanRequest, config: RobotConfig) -> Robot:
@@ -256,7 +256,7 @@ def _plan_steps(
     return steps
 
 
-def _assemble(
+def assemble(
     request: PlanRequest, config: RobotConfig, robot: Robot, scene: Scene, base: NDArray[np.float64],
     steps: list[StepResult],
 ) -> PlanResult:
@@ -275,7 +275,7 @@ def _assemble(
                     "max_acceleration": float(robot.max_acceleration[i])}
                 for i, j in enumerate(robot.joint_names)},
         attachments=_attachments(config, request),
-        metadata={"seed": str(request.seed), "moveplan_version": version("moveplan"),
+        metadata={"seed": str(request.seed), "moveplan_version": moveplan_version(),
                   "planners": ",".join(s.planner for s in steps),
                   "limit_sources": json.dumps({j: config.limits[j].source for j in robot.joint_names}, sort_keys=True)},
         end_states=tuple(robot_state(robot, scene, robot.configuration(step.trajectory.positions[-1], base))

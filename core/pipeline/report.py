@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Iterator, Mapping
 from contextlib import contextmanager
+from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
 from .. import bag as recording
@@ -18,6 +19,7 @@ from ..bag.execution_file import ExecutedStep, ExecutionWriter, execution_writer
 from ..config.controllers import ControllerConfig
 from ..control.controller import ExecutionReport
 from ..control.published import controller_states
+from ..control.quality import JointTracking, merged_tracking
 from ..control.results import ExecutionSummary
 from ..errors import InputError
 from ..types import TfSamples
@@ -31,7 +33,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "ExecutionRecorder", "check_document", "execute_to_file", "execution_document", "execution_recorder", "finite",
-    "write_execution",
+    "finite_numbers", "tracking_document", "write_execution",
 ]
 
 
@@ -146,7 +148,8 @@ def execution_document(execution: PlanExecution) -> dict[str, Any]:
     Keys: ok, result {code, name, message}, violations (each with its step: step, check,
     joint, time_s, reference, actual, error, tolerance; times from the step's start),
     margins {joint: margin}, then controller, duration_s and steps (name, ok, result,
-    start_s and duration_s on the execution's timeline). Non-finite numbers are null.
+    start_s and duration_s on the execution's timeline, tracking) and tracking (per joint, the
+    worst over the steps: core.control.quality). Non-finite numbers are null.
     """
     steps, start_ns = [], 0
     for step in execution.steps:
@@ -158,6 +161,7 @@ def execution_document(execution: PlanExecution) -> dict[str, Any]:
                 "result": report.result.name,
                 "start_s": start_ns / 1e9,
                 "duration_s": report.duration_s,
+                "tracking": tracking_document(getattr(report, "tracking", {})),
             }
         )
         start_ns += msgs.seconds_to_ns(report.duration_s)
@@ -166,6 +170,7 @@ def execution_document(execution: PlanExecution) -> dict[str, Any]:
         "controller": execution.controller.name,
         "duration_s": start_ns / 1e9,
         "steps": steps,
+        "tracking": tracking_document(execution.tracking),
     })
 
 
@@ -179,7 +184,8 @@ def check_document(report: CheckReport, recording: Path) -> dict[str, Any]:
     could not be done on this recording (bad input). With `start="all"` also cycles
     [{index, start_s, ok, result, worst_margin}], failing_cycles and incomplete_cycles.
     "ok" of a step or cycle is null when the recording cuts it off before a verdict
-    (INCOMPLETE). Non-finite numbers are null.
+    (INCOMPLETE). tracking, per joint, over the steps (each step's under steps); with
+    `start="all"` over the steps of the cycle tracking_cycle names. Non-finite numbers are null.
     """
     error = None
     if not report.complete:
@@ -190,19 +196,29 @@ def check_document(report: CheckReport, recording: Path) -> dict[str, Any]:
         "duration_s": report.duration_s,
         "start_s": report.start_s,
         "steps": [{"name": s.name, "ok": s.ok if s.complete else None, "result": s.report.result.name,
-                   "start_s": s.start_s, "duration_s": s.duration_s, "aligned_by": s.aligned_by}
+                   "start_s": s.start_s, "duration_s": s.duration_s, "aligned_by": s.aligned_by,
+                   "tracking": tracking_document(s.report.tracking)}
                   for s in report.steps],
         "gaps": [{"start_s": start, "length_s": length} for start, length in report.gaps],
         "warnings": list(report.warnings),
         "error": error,
     }
+    tracked = [c for c in report.cycles if any(step.report.tracking for step in c.steps)]
+    steps = tracked[0].steps if tracked else report.steps
+    document["tracking"] = tracking_document(merged_tracking([step.report.tracking for step in steps]))
     if report.cycles:
+        document["tracking_cycle"] = tracked[0].index if tracked else None
         document["cycles"] = [{"index": c.index, "start_s": c.start_s, "ok": c.ok if c.complete else None,
                                "result": _result(c.result), "worst_margin": c.worst_margin}
                               for c in report.cycles]
         document["failing_cycles"] = list(report.failing_cycles)
         document["incomplete_cycles"] = list(report.incomplete_cycles)
     return _finite_numbers(document)
+
+
+def tracking_document(figures: Mapping[str, JointTracking]) -> dict[str, dict[str, Any]]:
+    """Return tracking figures by joint as JSON: peak_error, overshoot, settling_time_s, oscillations, ..."""
+    return {joint: asdict(each) for joint, each in figures.items()}
 
 
 def finite(value: float) -> float | None:
@@ -237,6 +253,11 @@ def _verdict(
 
 def _result(result: ExecutionResult) -> dict[str, Any]:
     return {"code": result.code, "name": result.name, "message": result.message}
+
+
+def finite_numbers(value: Any) -> Any:
+    """Return `value` with every float in it, at any depth, made `finite` (JSON null if not): strict JSON."""
+    return _finite_numbers(value)
 
 
 def _finite_numbers(value: Any) -> Any:

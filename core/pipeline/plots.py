@@ -1,0 +1,371 @@
+"""Plots of a plan (`inspect --plot`) and of an execution or a checked recording (`execute`, `check-tolerances --plot`).
+
+One PNG per command, one row of panels per joint, written atomically. The samples are
+decimated to about POINTS_PER_SERIES per joint and series, each kept sample standing for
+its bucket with the smallest and largest error in it, so memory stays bounded for long
+recordings and no excursion between kept samples is hidden. plot_figures and tracking_figure
+draw; they import matplotlib (Agg) only when drawing: a plain plan, execute or check never loads it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..bag import PlanFile
+from ..control.check_samples import SCAN_ROWS, SampleSource
+from ..control.results import Violation
+from ..control.tolerances import in_controller_order, position_error
+from ..errors import InputError, UsageError
+from ..trajectory import PointBefore, peak_rates, sample
+from .execute import (
+    CheckedRecording,
+    CheckRequest,
+    ExecuteRequest,
+    PlanExecution,
+    StepRecorder,
+    check,
+    execute,
+    plan_config,
+)
+from .plot_figures import PlanCurves, plan_figure, write_png
+from .tracking_figure import TrackedStep, Tracking, ViolationMark, tracking_figure
+
+if TYPE_CHECKING:
+    from ..config.controllers import ControllerConfig
+    from ..config.robot_config import RobotConfig
+    from ..control.check_report import CheckReport, StepCheck
+    from ..control.controller import ExecutionReport
+    from ..types import JointTrajectory, TfSamples
+
+__all__ = [
+    "POINTS_PER_SERIES", "check_plot_path", "check_plotted", "execute_plotted", "thinned", "write_plan_plot",
+]
+
+POINTS_PER_SERIES = 5000
+"""About how many samples per joint a plot keeps of each series, whatever the length of the run."""
+
+_MIN_STEP_POINTS = 200
+
+
+def check_plot_path(path: Path, flag: str = "--plot") -> None:
+    """Refuse a plot path before any work: it must name a .png file in an existing folder; return None.
+
+    Raises:
+        UsageError: The name does not end in .png.
+        InputError: Its folder does not exist (as -o's "cannot write", exit 3).
+
+    """
+    if path.suffix.lower() != ".png":
+        raise UsageError(f"{flag} '{path}': expected a file name ending in .png (the plot is a PNG image)")
+    if not path.parent.is_dir():
+        raise InputError(f"{flag} '{path}': cannot write: folder '{path.parent}' does not exist")
+
+
+def write_plan_plot(plan: PlanFile | None, source: Path, path: Path) -> None:
+    """Write a PNG of a plan's joints (position, velocity, acceleration against their limits) to `path`; return None.
+
+    `plan` is the plan read from `source`, None if `source` is no plan file.
+
+    Raises:
+        UsageError: `source` is not a moveplan plan file.
+        InputError: `path` cannot be written.
+
+    """
+    if plan is None:
+        raise UsageError(f"--plot: {source} is not a moveplan plan file; --plot draws the joints of a plan")
+    config = plan_config(plan, source)
+    joints = plan.steps[0].trajectory.joint_names
+    total = sum(step.trajectory.duration_s for step in plan.steps)
+    times, positions, velocities, accelerations, knots, knot_positions = [], [], [], [], [], []
+    for step in plan.steps:
+        trajectory = step.trajectory
+        count = _step_budget(trajectory.duration_s, total)
+        since = np.union1d(np.linspace(0.0, trajectory.duration_s, count), trajectory.times_s)
+        p, v, a = sample(trajectory, since)
+        times.append(step.start_s + since)
+        positions.append(p)
+        velocities.append(v)
+        accelerations.append(a)
+        knots.append(step.start_s + trajectory.times_s)
+        knot_positions.append(trajectory.positions)
+    limits = {j: dict(plan.limits.get(j, {})) for j in joints}
+    for j in joints:
+        if j in config.limits and config.limits[j].continuous:  # its ±pi bounds are no limits
+            limits[j].pop("lower", None)
+            limits[j].pop("upper", None)
+    peaks = _peak_shares(plan)
+    curves = PlanCurves(
+        title=f"moveplan inspect {source.name}: {plan.robot_name} / {plan.group}, {len(plan.steps)} steps, "
+              f"{total:.2f} s; peak velocity {peaks[0]:.0%}, acceleration {peaks[1]:.0%} of the limits",
+        joints=joints, units=_units(config, joints), steps=tuple((s.name, s.start_s, s.trajectory.duration_s)
+                                                               for s in plan.steps),
+        times_s=np.concatenate(times), positions=np.concatenate(positions), velocities=np.concatenate(velocities),
+        accelerations=np.concatenate(accelerations), knots_s=np.concatenate(knots),
+        knot_positions=np.concatenate(knot_positions), limits=limits,
+    )
+    write_png(plan_figure(curves), path)
+
+
+def _peak_shares(plan: PlanFile) -> tuple[float, float]:
+    """Return the plan's largest velocity and acceleration as shares of the joint's limit, over joints and steps."""
+    shares = [0.0, 0.0]
+    for step in plan.steps:
+        for which, peaks in enumerate(peak_rates(step.trajectory)):
+            key = ("max_velocity", "max_acceleration")[which]
+            for joint, peak in zip(step.trajectory.joint_names, peaks, strict=True):
+                limit = plan.limits.get(joint, {}).get(key, 0.0)
+                if limit > 0.0:
+                    shares[which] = max(shares[which], float(peak) / limit)
+    return shares[0], shares[1]
+
+
+def execute_plotted(
+    request: ExecuteRequest, plot: Path, output: Path | None = None, distro: str = "jazzy"
+) -> PlanExecution:
+    """Return what executing the plan did, drawn to the PNG `plot` (and written to `output` as it runs, if given).
+
+    The PNG is written when the execution has its verdict, whatever it is, before the
+    executed file is renamed into place; if anything fails, neither file is left.
+
+    Raises:
+        InputError: The plan is unreadable or invalid, or a file cannot be written.
+        UsageError: `distro` has no shipped message definitions, or an output path is refused.
+
+    """
+    from .report import execution_recorder
+
+    @contextmanager
+    def record(controller: ControllerConfig, plan: PlanFile, poses: bool) -> Iterator[StepRecorder]:
+        drawn = _ExecutionPlot(request.plan, plan, plot)
+        try:
+            if output is None:
+                yield drawn
+            else:
+                with execution_recorder(output, controller, plan, distro, poses) as written:
+                    yield _Both(drawn, written)
+        except BaseException:
+            if drawn.written:
+                plot.unlink(missing_ok=True)
+            raise
+
+    return execute(request, record, link_poses=output is not None)
+
+
+def check_plotted(request: CheckRequest, plot: Path) -> CheckReport:
+    """Return check-tolerances' verdict; one that is complete is also drawn to the PNG `plot`.
+
+    With `start="all"`, the first failing cycle is drawn, else the first complete one.
+
+    Raises:
+        InputError: As `check`, or `plot` cannot be written.
+
+    """
+
+    def draw(checked: CheckedRecording) -> None:
+        if checked.report.complete:
+            write_png(tracking_figure(_checked_tracking(checked, request)), plot)
+
+    return check(request, draw)
+
+
+class _ExecutionPlot:
+    """A StepRecorder keeping each step's samples, decimated, and drawing them when the execution ends."""
+
+    def __init__(self, source: Path, plan: PlanFile, plot: Path) -> None:
+        self._source = source
+        self._plan = plan
+        self._plot = plot
+        self._total = sum(step.trajectory.duration_s for step in plan.steps)
+        self._steps: list[TrackedStep] = []
+        self._offset_s = 0.0
+        self.written = False
+
+    def add_tf(self, tf: TfSamples) -> None:
+        """Ignore link poses: the plot draws joints; return None."""
+
+    def add_step(self, report: ExecutionReport) -> None:
+        """Keep the step's samples, decimated, on the execution's timeline; return None."""
+        step = self._plan.steps[len(self._steps)]
+        planned = step.trajectory.duration_s
+        every = _every(len(report.times_s), _step_budget(planned, self._total))
+        series = thinned(report.times_s + self._offset_s, report.reference_positions, report.actual_positions,
+                          report.error, every, last=True)
+        self._steps.append(TrackedStep(step.name, self._offset_s, planned, self._offset_s + report.duration_s,
+                                       *series, _marks(report.violations, self._offset_s)))
+        self._offset_s += report.duration_s
+
+    def finish(self, execution: PlanExecution) -> None:
+        """Draw the execution and write the PNG; return None."""
+        controller = execution.controller
+        last = execution.steps[-1]
+        title = (f"moveplan execute {self._source.name}: {execution.result.name} - executed {len(execution.steps)} "
+                 f"of {len(self._plan.steps)} steps in {execution.duration_s:.3f} s\n"
+                 f"{_shortened(execution.result.message)}" + ("" if last.report.ok else f" (step '{last.name}')"))
+        config = plan_config(self._plan, self._source)
+        write_png(tracking_figure(_tracking(title, controller, _units(config, controller.joints), self._steps)),
+                  self._plot)
+        self.written = True
+
+
+class _Both:
+    """Two StepRecorders fed together: the plot's first, so that its PNG is written before the file is renamed."""
+
+    def __init__(self, first: StepRecorder, second: StepRecorder) -> None:
+        self._recorders = (first, second)
+
+    def add_tf(self, tf: TfSamples) -> None:
+        """Hand link poses to both; return None."""
+        for recorder in self._recorders:
+            recorder.add_tf(tf)
+
+    def add_step(self, report: ExecutionReport) -> None:
+        """Hand a step's report to both; return None."""
+        for recorder in self._recorders:
+            recorder.add_step(report)
+
+    def finish(self, execution: PlanExecution) -> None:
+        """Hand the whole execution to both; return None."""
+        for recorder in self._recorders:
+            recorder.finish(execution)
+
+
+def _checked_tracking(checked: CheckedRecording, request: CheckRequest) -> Tracking:
+    """Return a checked execution's samples against the plan, and how to title it."""
+    report, controller, plan = checked.report, checked.controller, checked.plan
+    steps, which = _drawn_steps(report)
+    samples = checked.samples
+    columns = np.array([samples.names.index(j) for j in controller.joints], dtype=np.intp)
+    continuous = np.array([j in checked.continuous for j in controller.joints])
+    origin = steps[0].start_s if steps else 0.0
+    total = sum(s.duration_s for s in steps) or 1.0
+    tracked = []
+    # The steps checked are the plan's, in order, from its first.
+    for step, planned in zip(steps, plan.steps, strict=False):
+        trajectory = in_controller_order(planned.trajectory, controller)
+        tracked.append(_recorded_step(samples, columns, continuous, step, trajectory, origin,
+                                      _step_budget(step.duration_s, total)))
+    verdict = "within tolerances" if report.ok else report.result.name
+    title = (f"moveplan check-tolerances {request.plan.name} {request.recording.name}: {verdict}{which}; "
+             f"t = 0 is {round(origin, 3) + 0.0:.3f} s into the recording\n{_shortened(report.result.message)}")
+    config = plan_config(plan, request.plan)
+    return _tracking(title, controller, _units(config, controller.joints), tracked)
+
+
+def _drawn_steps(report: CheckReport) -> tuple[Sequence[StepCheck], str]:
+    """Return the steps drawn and, for a recording of many cycles, which cycle they are (for the title)."""
+    if not report.cycles:
+        return report.steps, ""
+    failing = [c for c in report.cycles if c.index in report.failing_cycles]
+    if failing:
+        cycle, why = failing[0], "the first that failed"
+    else:
+        cycle = next((c for c in report.cycles if c.steps and c.complete), report.cycles[0])
+        why = "none failed: the first"
+    return cycle.steps, f" - cycle {cycle.index} of {len(report.cycles)} drawn ({why})"
+
+
+def _recorded_step(
+    samples: SampleSource, columns: NDArray[np.intp], continuous: NDArray[np.bool_], step: StepCheck,
+    trajectory: JointTrajectory, origin_s: float, budget: int,
+) -> TrackedStep:
+    """Return one checked step's recorded samples, decimated, against the plan sampled at their times."""
+    begin = _search(samples, step.start_s, "left")
+    end = max(_search(samples, step.start_s + step.duration_s, "right"), begin)
+    every = _every(end - begin, budget)
+    before = None
+    if trajectory.times_s[0] > 0.0:  # JTC blends from the state it read when the goal came
+        at_send = max(begin - 1, 0)
+        before = PointBefore(samples.read_positions(at_send, at_send + 1)[0, columns])
+    parts = []
+    block = every * max(1, SCAN_ROWS // every)
+    for at in range(begin, end, block):
+        stop = min(at + block, end)
+        since = samples.read_times(at, stop) - step.start_s
+        actual = samples.read_positions(at, stop)[:, columns]
+        reference = sample(trajectory, since, point_before=before, continuous=continuous, derivatives=0)[0]
+        error = position_error(reference, actual, continuous)
+        parts.append(thinned(since + step.start_s - origin_s, reference, actual, error, every, last=stop == end))
+    n = len(columns)
+    series = [np.concatenate([p[i] for p in parts]) if parts else np.zeros((0, n) if i else 0) for i in range(6)]
+    start = step.start_s - origin_s
+    return TrackedStep(step.name, start, trajectory.duration_s, start + step.duration_s, *series,
+                       _marks(step.report.violations, start))
+
+
+def _search(samples: SampleSource, time_s: float, side: Literal["left", "right"]) -> int:
+    """Return where `time_s` [s] would go among the sample times (np.searchsorted), reading a few of them."""
+    low, high = 0, samples.count
+    while low < high:
+        middle = (low + high) // 2
+        value = float(samples.read_times(middle, middle + 1)[0])
+        if value < time_s or (side == "right" and value == time_s):
+            low = middle + 1
+        else:
+            high = middle
+    return low
+
+
+def _every(count: int, budget: int) -> int:
+    """Return k: keeping every k-th of `count` samples keeps at most `budget`."""
+    return max(1, math.ceil(count / max(budget, 1)))
+
+
+def _step_budget(duration_s: float, total_s: float) -> int:
+    """Return the samples a step of `duration_s` [s] keeps: its share of POINTS_PER_SERIES, never very few."""
+    share = duration_s / total_s if total_s > 0.0 else 1.0
+    return max(_MIN_STEP_POINTS, int(POINTS_PER_SERIES * share))
+
+
+def thinned(
+    times: NDArray[np.float64], reference: NDArray[np.float64], actual: NDArray[np.float64],
+    error: NDArray[np.float64], every: int, last: bool,
+) -> tuple[NDArray[np.float64], ...]:
+    """Return every `every`-th row (and the final one if `last`): times, reference, actual, error, error min, max.
+
+    The min and max are over the rows each kept row stands for, so a peak between kept rows still shows.
+    """
+    count = len(times)
+    if not count:
+        n = reference.shape[1]
+        return np.zeros(0), np.zeros((0, n)), np.zeros((0, n)), np.zeros((0, n)), np.zeros((0, n)), np.zeros((0, n))
+    rows = np.arange(0, count, every)
+    low, high = np.fmin.reduceat(error, rows, axis=0), np.fmax.reduceat(error, rows, axis=0)
+    if last and rows[-1] != count - 1:
+        rows = np.append(rows, count - 1)
+        low, high = np.vstack((low, error[-1:])), np.vstack((high, error[-1:]))
+    return times[rows], reference[rows], actual[rows], error[rows], low, high
+
+
+def _marks(violations: Sequence[Violation], start_s: float) -> tuple[ViolationMark, ...]:
+    """Return a step's violations on the plot's timeline (the step starts at `start_s` [s])."""
+    return tuple(ViolationMark(start_s + v.time_s, v.joint, v.check, v.actual, v.error) for v in violations)
+
+
+def _tracking(title: str, controller: ControllerConfig, units: Sequence[str], steps: Sequence[TrackedStep]) -> Tracking:
+    """Return what tracking_figure draws: the steps, with the controller's tolerances per joint."""
+    joints = controller.joints
+    return Tracking(
+        title=title, joints=joints, units=tuple(units), steps=tuple(steps),
+        path_tolerance=np.array([controller.trajectory_tolerance.get(j, 0.0) for j in joints]),
+        goal_tolerance=np.array([controller.goal_tolerance.get(j, 0.0) for j in joints]),
+        goal_time_s=controller.goal_time_s,
+        period_s=1.0 / controller.update_rate_hz,
+    )
+
+
+def _units(config: RobotConfig, joints: Sequence[str]) -> tuple[str, ...]:
+    """Return per joint its position unit: m for a prismatic joint, else rad."""
+    kinds = config.urdf_joints
+    return tuple("m" if j in kinds and kinds[j].type == "prismatic" else "rad" for j in joints)
+
+
+def _shortened(message: str, length: int = 150) -> str:
+    """Return `message` cut to `length` characters: a title line, not a report."""
+    return message if len(message) <= length else message[: length - 3] + "..."

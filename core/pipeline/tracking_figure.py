@@ -1,0 +1,269 @@
+"""The figure of a tracked execution (execute and check-tolerances --plot): reference, actual, error, tolerances.
+
+Per joint, three panels: the plan's reference and the actual position; the tracking error
+against the path tolerance band and the goal window; and that goal window zoomed, scaled to
+the goal tolerance. matplotlib is imported inside plot_figures' functions, when drawing.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..types import frozen_array
+from .plot_figures import blended, corner_note, finite_or_nan, grid, legend_line, step_lines
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["TrackedStep", "Tracking", "ViolationMark", "tracking_figure"]
+
+_REFERENCE, _ACTUAL, _PATH, _GOAL, _VIOLATION = "0.15", "C0", "C2", "C1", "red"
+_LEAST_SPAN = 0.01  # [rad] or [m]: a position panel is never narrower
+# Checks whose numbers are positions: their violation is a point on the position and error panels.
+_POSITION_CHECKS = ("path", "goal", "start_tolerance")
+
+
+@dataclass(frozen=True)
+class ViolationMark:
+    """A violation on the plot's timeline: time [s], joint ("" for the time checks), check, actual and error."""
+
+    time_s: float
+    joint: str
+    check: str
+    actual: float
+    error: float
+
+
+@dataclass(frozen=True)
+class TrackedStep:
+    """One step's samples on the plot's timeline, decimated; arrays (m, n) in the plot's joint order.
+
+    Attributes:
+        name: The step's name.
+        start_s: When its goal was sent, in [s] on the plot's timeline.
+        planned_s: The trajectory's duration in [s] (its path tolerance holds until then).
+        end_s: When it was decided, in [s] on the plot's timeline.
+        times_s: Times of the kept samples in [s], shape (m,).
+        reference, actual, error: Reference and actual positions and reference - actual.
+        error_low, error_high: The smallest and largest error over the samples each kept one stands for.
+        marks: Its violations.
+
+    """
+
+    name: str
+    start_s: float
+    planned_s: float
+    end_s: float
+    times_s: NDArray[np.float64]
+    reference: NDArray[np.float64]
+    actual: NDArray[np.float64]
+    error: NDArray[np.float64]
+    error_low: NDArray[np.float64]
+    error_high: NDArray[np.float64]
+    marks: tuple[ViolationMark, ...] = ()
+
+    def __post_init__(self) -> None:
+        times = frozen_array(self.times_s, (None,), "times_s")
+        object.__setattr__(self, "times_s", times)
+        for name in ("reference", "actual", "error", "error_low", "error_high"):
+            object.__setattr__(self, name, frozen_array(getattr(self, name), (len(times), None), name))
+
+
+@dataclass(frozen=True)
+class Tracking:
+    """What `tracking_figure` draws: steps, with the controller's tolerances per joint ([rad] or [m]; 0 = unchecked).
+
+    `goal_time_s` and `period_s` (the controller's update period) are in [s].
+    """
+
+    title: str
+    joints: tuple[str, ...]
+    units: tuple[str, ...]
+    steps: tuple[TrackedStep, ...]
+    path_tolerance: NDArray[np.float64]
+    goal_tolerance: NDArray[np.float64]
+    goal_time_s: float
+    period_s: float
+
+
+def tracking_figure(tracking: Tracking) -> Figure:
+    """Return a figure of an execution: per joint, reference and actual; the error against the tolerances.
+
+    A third, narrower column zooms on the goal window of the last step drawn (the one that
+    decided), where a goal tolerance far finer than the path tolerance can be seen.
+    """
+    figure, axes = grid(len(tracking.joints), 3, tracking.title, widths=(5, 5, 2))
+    last = tracking.steps[-1] if tracking.steps else None
+    begin = min([s.start_s for s in tracking.steps], default=0.0)
+    end = max([s.end_s for s in tracking.steps], default=0.0)
+    if last is not None and last.end_s >= _window(tracking, last)[0]:  # its goal window was reached
+        end = max(end, _window(tracking, last)[1])
+    for row, joint in enumerate(tracking.joints):
+        position, error, goal = axes[row]
+        for step in tracking.steps:
+            _tolerance_bands(error, tracking, step, row, step is last)
+            position.plot(step.times_s, step.reference[:, row], color=_REFERENCE, ls="--", lw=1.2)
+            position.plot(step.times_s, finite_or_nan(step.actual[:, row]), color=_ACTUAL, lw=1.0)
+            _error_curve(error, step, row)
+        error.axhline(0.0, color="0.7", lw=0.6)
+        _error_limits(error, tracking.steps, joint, row,
+                      max(tracking.path_tolerance[row], tracking.goal_tolerance[row]))
+        _tolerance_note(error, tracking, row)
+        _least_span(position)
+        position.set_ylabel(f"{joint}\n[{tracking.units[row]}]")
+        error.set_ylabel(f"[{tracking.units[row]}]")
+        _violations((position, error), tracking.steps, joint, label=row == 0)
+        if last is not None:
+            _goal_zoom(goal, tracking, last, row)
+        for axis in (position, error):
+            axis.set_xlim(begin, end + 0.01 * (end - begin) if end > begin else begin + 1.0)
+    axes[0, 0].set_title("position: plan reference and actual", fontsize=10)
+    axes[0, 1].set_title("tracking error = reference - actual", fontsize=10)
+    axes[0, 2].set_title("goal window", fontsize=10)
+    step_lines(axes[:, :2], [(s.name, s.start_s) for s in tracking.steps])
+    figure.legend(handles=_tracking_legend(tracking), loc="outside lower center", ncol=3, fontsize=9, frameon=False)
+    return figure
+
+
+def _window(tracking: Tracking, step: TrackedStep) -> tuple[float, float]:
+    """Return where a step's goal window starts and ends, in [s] on the plot's timeline.
+
+    It starts a period before the last point (JTC checks the goal from the cycle whose command
+    reaches it) and ends goal_time after the last point, or when the step was decided if that
+    is later or goal_time is 0 (no deadline).
+    """
+    last_point = step.start_s + step.planned_s
+    deadline = last_point + tracking.goal_time_s if tracking.goal_time_s > 0.0 else last_point
+    return last_point - tracking.period_s, max(deadline, step.end_s)
+
+
+def _tolerance_bands(axis: Axes, tracking: Tracking, step: TrackedStep, row: int, last: bool) -> None:
+    """Shade the path tolerance while the step's trajectory runs and the goal tolerance after it; return None.
+
+    The goal window of the last step runs to goal_time after its last point (a dotted line),
+    the others' until they were decided; a tolerance of 0 is not checked and gets no band.
+    """
+    path, goal = tracking.path_tolerance[row], tracking.goal_tolerance[row]
+    start, end = _window(tracking, step)
+    if path > 0.0:
+        axis.fill_between((step.start_s, min(start, step.end_s)), -path, path, color=_PATH, alpha=0.15, lw=0)
+    if step.end_s < start:
+        return
+    if not last:
+        end = step.end_s
+    elif tracking.goal_time_s > 0.0:
+        axis.axvline(step.start_s + step.planned_s + tracking.goal_time_s, color=_GOAL, ls=":", lw=1.5)
+    if goal > 0.0:
+        axis.fill_between((start, end), -goal, goal, color=_GOAL, alpha=0.3, lw=0)
+
+
+def _goal_zoom(axis: Axes, tracking: Tracking, step: TrackedStep, row: int) -> None:
+    """Draw a step's error around its goal window, scaled to the goal tolerance; return None."""
+    start = _window(tracking, step)[0]
+    if step.end_s < start:
+        axis.axis("off")
+        if row == 0:
+            axis.text(0.5, 0.9, f"not reached: step\n'{step.name}' ended\nat {step.end_s:.3f} s, before\n"
+                      f"its last point at\n{start:.3f} s", transform=axis.transAxes, ha="center", va="top",
+                      fontsize=9, color="0.3")
+        return
+    # From a little before the goal check to a little after the decision: a long goal_time would hide a quick one.
+    margin = max(0.25 * (step.end_s - start), 0.1 * step.planned_s, 5.0 * tracking.period_s)
+    if row == 0:
+        axis.text(0.02, 0.97, step.name, transform=axis.transAxes, rotation=90, va="top", fontsize=7, color="0.3")
+    _tolerance_bands(axis, tracking, step, row, True)
+    _error_curve(axis, step, row)
+    axis.axhline(0.0, color="0.7", lw=0.6)
+    axis.set_xlim(start - margin, max(step.end_s, start) + margin)
+    # Scaled to what decides: the goal tolerance and the error at the decision; the approach may run off the top.
+    decided = [abs(float(step.error[-1, row]))] if len(step.times_s) else []
+    marks = [abs(m.error) for m in step.marks if m.joint == tracking.joints[row] and m.check in _POSITION_CHECKS]
+    largest = max([tracking.goal_tolerance[row], *decided, *marks])
+    if 0.0 < largest < math.inf:
+        axis.set_ylim(-1.5 * largest, 1.5 * largest)
+    _violations((axis,), [step], tracking.joints[row], label=False)
+
+
+def _error_curve(axis: Axes, step: TrackedStep, row: int) -> None:
+    """Draw a step's error, shaded between its smallest and largest where samples were decimated; return None."""
+    low, high = finite_or_nan(step.error_low[:, row]), finite_or_nan(step.error_high[:, row])
+    if not np.array_equal(low, high, equal_nan=True):
+        axis.fill_between(step.times_s, low, high, color=_ACTUAL, alpha=0.35, lw=0)
+    axis.plot(step.times_s, finite_or_nan(step.error[:, row]), color=_ACTUAL, lw=1.0)
+
+
+def _error_limits(axis: Axes, steps: Sequence[TrackedStep], joint: str, row: int, tolerance: float) -> None:
+    """Set an error panel's y range symmetric around 0, holding the errors, violations and `tolerance`; return None."""
+    largest = max([tolerance]
+                  + [float(np.nanmax(np.abs(finite_or_nan(s.error_high[:, row])), initial=0.0)) for s in steps]
+                  + [float(np.nanmax(np.abs(finite_or_nan(s.error_low[:, row])), initial=0.0)) for s in steps]
+                  + [abs(m.error) for s in steps for m in s.marks
+                     if m.joint == joint and m.check in _POSITION_CHECKS and math.isfinite(m.error)])
+    if largest > 0.0:
+        axis.set_ylim(-1.2 * largest, 1.2 * largest)
+
+
+def _least_span(axis: Axes) -> None:
+    """Widen a position panel to at least _LEAST_SPAN, without an offset: a joint at rest reads as a flat line."""
+    axis.ticklabel_format(axis="y", useOffset=False)
+    low, high = axis.get_ylim()
+    if high - low < _LEAST_SPAN:
+        middle = 0.5 * (low + high)
+        axis.set_ylim(middle - 0.5 * _LEAST_SPAN, middle + 0.5 * _LEAST_SPAN)
+
+
+def _tolerance_note(axis: Axes, tracking: Tracking, row: int) -> None:
+    """Write a joint's largest error and tolerances in a corner of its error panel (0: not checked); return None."""
+    unit = tracking.units[row]
+    largest = max([float(np.nanmax(np.abs(finite_or_nan(bound[:, row])), initial=0.0))
+                   for s in tracking.steps for bound in (s.error_low, s.error_high)], default=0.0)
+    parts = [f"largest |error| {largest:.3g} {unit}"]
+    for what, value in (("path", tracking.path_tolerance[row]), ("goal", tracking.goal_tolerance[row])):
+        parts.append(f"{what} ±{value:.3g}" if value > 0.0 else f"{what} 0: not checked")
+    corner_note(axis, ", ".join(parts))
+
+
+def _violations(axes: Sequence[Axes], steps: Sequence[TrackedStep], joint: str, label: bool) -> None:
+    """Mark a joint's violations on `axes` (position, then error panels); return None.
+
+    A position check is a red x at the actual position and at the error; another check of
+    the joint, or a time check (no joint), a red dashed line, named on top if `label`.
+    """
+    for step in steps:
+        for mark in step.marks:
+            if mark.joint == joint and mark.check in _POSITION_CHECKS:
+                values = (mark.actual, mark.error) if len(axes) == 2 else (mark.error,)
+                for axis, value in zip(axes, values, strict=True):
+                    axis.plot([mark.time_s], [value], "x", color=_VIOLATION, ms=9, mew=2, zorder=5)
+            elif mark.joint in (joint, ""):
+                for axis in axes:
+                    axis.axvline(mark.time_s, color=_VIOLATION, ls="--", lw=1.2)
+                if label or mark.joint:
+                    axes[-1].text(mark.time_s, 0.97, f"{mark.check} ", transform=blended(axes[-1]), ha="right",
+                                  va="top", fontsize=8, color=_VIOLATION)
+
+
+def _tracking_legend(tracking: Tracking) -> list[Any]:
+    """Return the legend's entries, saying how zero tolerances and goal_time are drawn."""
+    from matplotlib.patches import Patch
+
+    unchecked = "; 0: not checked, no band"
+    path_zero = unchecked if np.any(tracking.path_tolerance <= 0.0) else ""
+    goal_zero = unchecked if np.any(tracking.goal_tolerance <= 0.0) else ""
+    deadline = (f"until goal_time {tracking.goal_time_s:g} s (dotted)" if tracking.goal_time_s > 0.0
+                else "goal_time 0: no deadline")
+    return [
+        legend_line(_REFERENCE, "--", "plan reference"),
+        legend_line(_ACTUAL, "-", "actual (error: min-max band where thinned)"),
+        Patch(color=_PATH, alpha=0.3, label=f"path tolerance{path_zero}"),
+        Patch(color=_GOAL, alpha=0.45, label=f"goal tolerance, {deadline}{goal_zero}"),
+        legend_line(_VIOLATION, "", "violation (dashed: a time check)", marker="x"),
+        legend_line("0.55", "-", "step start"),
+    ]

@@ -1,0 +1,73 @@
+"""The tune-pid plot: per joint, the disturbance response each stage of the procedure chose."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..bag.bag_writer import atomic_file
+from ..control.tuning import JointTuning
+from .tune import TuneResult
+
+__all__ = ["write_tuning_plot"]
+
+
+def write_tuning_plot(result: TuneResult, path: Path) -> None:
+    """Write a PNG with one panel per tuned joint: each chosen stage's bump response over time; return None.
+
+    Raises:
+        InputError: `path` cannot be written.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")  # files only; never a window
+    from matplotlib import pyplot
+
+    rows = max(1, len(result.joints))
+    figure, axes = pyplot.subplots(rows, 1, figsize=(12, 2.6 * rows + 0.6), squeeze=False)
+    for axis, tuning in zip(axes[:, 0], result.joints, strict=False):
+        setup = tuning.setup
+        chosen = [s for s in tuning.stages if s.chosen and s.trace is not None]
+        for number, stage in enumerate(chosen):
+            assert stage.trace is not None
+            times = np.arange(len(stage.trace)) * setup.dt
+            trace = stage.trace.copy()
+            beyond = np.flatnonzero(~(np.abs(trace) <= 1.5 * setup.bump))
+            if len(beyond):
+                trace[beyond[0] + 1 :] = np.nan  # a diverging response is drawn until it leaves the panel
+            gains = stage.gains
+            final = stage.stage == "final"
+            axis.plot(times, trace * 1e3, color="black" if final else f"C{number % 10}",
+                      linewidth=2.0 if final else 1.0,
+                      label=f"{stage.stage}: p {gains.p:.4g}, i {gains.i:.4g}, d {gains.d:.4g}"
+                            + (" (diverges)" if stage.response.diverged else ""))
+        if setup.goal_tolerance > 0.0:
+            axis.axhspan(-setup.goal_tolerance * 1e3, setup.goal_tolerance * 1e3, color="green", alpha=0.08,
+                         label="goal tolerance")
+        axis.axhline(0.0, color="grey", linewidth=0.5)
+        # A diverging response (the file's gains, say) would squash the others to a line.
+        axis.set_ylim(-1.6 * setup.bump * 1e3, 1.6 * setup.bump * 1e3)
+        axis.set_title(f"{setup.joint} ({setup.interface}): bump of {setup.bump * 1e3:.3g} mrad at rest", fontsize=10)
+        axis.set_ylabel("position - setpoint [mrad]")
+        axis.set_xlim(0.0, _shown_s(tuning))
+        axis.grid(True, alpha=0.3)
+        axis.legend(fontsize="x-small", loc="upper right", ncol=2)
+    axes[-1, 0].set_xlabel("time since the bump [s]")
+    verdict = "verified" if result.ok else "NOT verified"
+    figure.suptitle(f"tune-pid {result.controller}: {verdict} ({result.verification.result.name})", fontsize=11)
+    figure.tight_layout(rect=(0.0, 0.0, 1.0, 0.98))
+    try:
+        with atomic_file(path) as stream:
+            figure.savefig(stream, format="png", dpi=100)
+    finally:
+        pyplot.close(figure)
+
+
+def _shown_s(tuning: JointTuning) -> float:
+    """Return how much of the window to show [s]: three times the slowest settling of a stage that settles."""
+    times = [s.response.settling_time_s for s in tuning.stages if s.chosen and s.trace is not None]
+    settled = [t for t in times if t is not None]
+    if not settled:
+        return tuning.setup.window_s
+    return min(tuning.setup.window_s, max(0.1, 3.0 * max(settled)))
