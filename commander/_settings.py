@@ -1,0 +1,115 @@
+"""The planning settings of a MoveGroupCommander: planning time, planner, scaling factors, goal tolerances.
+
+MoveIt's names and defaults: 5 s of planning time, the robot config's planner, and
+joint_limits.yaml's default scaling factors until set.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from moveplan.core.config.planners import PLANNERS
+from moveplan.core.config.tasks import MIN_SCALING
+from moveplan.core.errors import UsageError, known
+from moveplan.core.pipeline.request import check_planning_time
+from moveplan.core.pipeline.session import MotionSettings
+
+from ._world import World
+
+__all__ = ["PLANNING_TIME_S", "PlanningSettings"]
+
+PLANNING_TIME_S = 5.0
+"""MoveGroupCommander's default planning time in [s], MoveIt's."""
+
+_TOLERANCES = {"joint": 1e-4, "position": 1e-4, "orientation": 1e-3}  # MoveIt's goal tolerance defaults
+
+
+class PlanningSettings:
+    """How a group's motions are planned; MoveGroupCommander's setters and getters of it."""
+
+    _world: World
+
+    def __init__(self) -> None:
+        self._planning_time = PLANNING_TIME_S
+        self._planner: str | None = None
+        self._scaling: dict[str, float | None] = {"velocity": None, "acceleration": None}
+        self._tolerances = dict(_TOLERANCES)
+
+    def get_goal_tolerance(self) -> tuple[float, float, float]:
+        """Return the goal tolerances (joint, position, orientation) set; goals are reached within MoveIt's defaults."""
+        return self._tolerances["joint"], self._tolerances["position"], self._tolerances["orientation"]
+
+    def get_goal_joint_tolerance(self) -> float:
+        """Return the joint goal tolerance set, in [rad] or [m]."""
+        return self._tolerances["joint"]
+
+    def get_goal_position_tolerance(self) -> float:
+        """Return the position goal tolerance set, in [m]."""
+        return self._tolerances["position"]
+
+    def get_goal_orientation_tolerance(self) -> float:
+        """Return the orientation goal tolerance set, in [rad]."""
+        return self._tolerances["orientation"]
+
+    def set_goal_tolerance(self, value: float) -> None:
+        """Set all three goal tolerances (kept; moveplan reaches goals within 1e-4 m and 1e-3 rad); return None."""
+        self._tolerances = dict.fromkeys(self._tolerances, float(value))
+
+    def set_goal_joint_tolerance(self, value: float) -> None:
+        """Set the joint goal tolerance (kept, see set_goal_tolerance); return None."""
+        self._tolerances["joint"] = float(value)
+
+    def set_goal_position_tolerance(self, value: float) -> None:
+        """Set the position goal tolerance (kept, see set_goal_tolerance); return None."""
+        self._tolerances["position"] = float(value)
+
+    def set_goal_orientation_tolerance(self, value: float) -> None:
+        """Set the orientation goal tolerance (kept, see set_goal_tolerance); return None."""
+        self._tolerances["orientation"] = float(value)
+
+    def get_planning_time(self) -> float:
+        """Return the time a plan may search, in [s] (default 5, MoveIt's)."""
+        return self._planning_time
+
+    def set_planning_time(self, seconds: float) -> None:
+        """Set the time a plan may search, in [s]; return None."""
+        self._planning_time = check_planning_time(float(seconds), "set_planning_time")
+
+    def get_planner_id(self) -> str:
+        """Return the planner set, or the robot config's when none was."""
+        return self._planner or str(self._world.config.planning["planner"])
+
+    def set_planner_id(self, planner_id: str) -> None:
+        """Plan with an OMPL geometric planner ("RRTConnect"; MoveIt's "RRTConnectkConfigDefault" too); return None.
+
+        "" goes back to the robot config's planner.
+        """
+        name = planner_id.removeprefix("geometric::").removesuffix("kConfigDefault")
+        if name and name not in PLANNERS:
+            raise UsageError(f"set_planner_id: unknown planner '{planner_id}'; OMPL geometric planners: "
+                             f"{known(PLANNERS)}")
+        self._planner = name or None
+
+    def set_num_planning_attempts(self, num_planning_attempts: int) -> None:
+        """Accept MoveIt's number of attempts; a moveplan plan is one attempt, certified; return None."""
+
+    def set_max_velocity_scaling_factor(self, value: float) -> None:
+        """Scale the joints' velocity limits by `value` in (0, 1] (default: joint_limits.yaml's); return None."""
+        self._scaling["velocity"] = _scaling(value, "set_max_velocity_scaling_factor")
+
+    def set_max_acceleration_scaling_factor(self, value: float) -> None:
+        """Scale the joints' acceleration limits by `value` in (0, 1] (default: joint_limits.yaml's); return None."""
+        self._scaling["acceleration"] = _scaling(value, "set_max_acceleration_scaling_factor")
+
+    def _settings(self) -> MotionSettings:
+        """Return the settings a motion is planned with now."""
+        return MotionSettings(self._planner, self._planning_time, self._scaling["velocity"],
+                              self._scaling["acceleration"], self._world.seed)
+
+
+def _scaling(value: Any, where: str) -> float:
+    """Return a scaling factor checked to lie in [MIN_SCALING, 1], else raise UsageError naming `where`."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not MIN_SCALING <= value <= 1.0:
+        raise UsageError(f"{where}: expected a value in the range from {MIN_SCALING:g} to 1 for scaling factor, "
+                         f"got {value!r}")
+    return float(value)

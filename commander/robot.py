@@ -1,0 +1,130 @@
+"""RobotCommander: the robot, as moveit_commander's, loaded from a moveplan or MoveIt config instead of a ROS graph.
+
+Creating one stands in for launching move_group with the fake controllers: it loads the
+robot, sets up the planning scene and the simulated hardware, and becomes the robot that
+MoveGroupCommander, PlanningSceneInterface, tf Buffer and StaticTransformBroadcaster use
+when they are not given one (as they would talk to the one move_group of a ROS graph).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from moveplan.core.errors import UsageError
+from moveplan.core.pipeline.request import RobotSource
+from moveplan.core.pipeline.session import ExecutionSettings, check_execution
+
+from ._world import World, make_current
+from .msgs import JointState, RobotState
+
+if TYPE_CHECKING:
+    from .move_group import MoveGroupCommander
+
+__all__ = ["ROBOT_VARIABLE", "RobotCommander"]
+
+ROBOT_VARIABLE = "MOVEPLAN_ROBOT"
+"""Environment variable naming the robot when RobotCommander() is given none (what robot_description is to ROS)."""
+
+class RobotCommander:
+    """The robot: its groups, joints and links, its current state, and every motion it executed.
+
+    Args:
+        robot: A shipped config's name (`ur10e`), a moveplan.yaml or its folder, a MoveIt config
+            package, a URDF or SRDF: what `moveplan --robot` takes. None: `$MOVEPLAN_ROBOT`.
+        scene: A scene file (moveplan's or a MoveIt PlanningScene YAML): its frames, objects and
+            robot state are the planning scene's to start with.
+        package_path: Folders searched for `package://` and `$(find)` (`--package-path`).
+        urdf, srdf, xacro_args, strict_limits: As `--urdf`, `--srdf`, `--xacro-arg`, `--strict-limits`.
+        plant, plant_params, controllers: The simulated hardware motions execute on, as
+            `execute --fake --plant`, `--plant-param` and `--controllers` choose it.
+        seed: Seeds every plan (each one anew, as one `moveplan plan` run) and the plant.
+    """
+
+    def __init__(
+        self,
+        robot: str | Path | None = None,
+        scene: str | Path | None = None,
+        package_path: str | Path | Sequence[str | Path] | None = None,
+        *,
+        urdf: str | None = None,
+        srdf: str | None = None,
+        xacro_args: Mapping[str, str] | None = None,
+        strict_limits: bool = False,
+        plant: str = "mirror",
+        plant_params: Mapping[str, float] | None = None,
+        controllers: str | Path | None = None,
+        seed: int = 0,
+    ) -> None:
+        if robot is None:
+            robot = os.environ.get(ROBOT_VARIABLE) or None
+            if robot is None:
+                raise UsageError(f"RobotCommander(): no robot: give a config (RobotCommander('ur10e')) or set "
+                                 f"{ROBOT_VARIABLE}")
+        paths = [] if package_path is None else [package_path] if isinstance(package_path, str | Path) else package_path
+        source = RobotSource(robot, tuple(Path(p) for p in paths), dict(xacro_args or {}), urdf, srdf, strict_limits)
+        execution = ExecutionSettings(plant, dict(plant_params or {}), Path(controllers) if controllers else None, seed)
+        self.world = World(source, Path(scene) if scene is not None else None, execution, seed)
+        check_execution(self.world.config, self.world.robot(None).joint_names, execution)
+        make_current(self.world)
+
+    def get_planning_frame(self) -> str:
+        """Return the frame all planning is done in: the URDF's root link."""
+        return self.world.robot(None).root_link
+
+    def get_root_link(self) -> str:
+        """Return the URDF's root link."""
+        return self.world.robot(None).root_link
+
+    def get_group_names(self) -> list[str]:
+        """Return the names of the SRDF's planning groups."""
+        return list(self.world.config.srdf.groups)
+
+    def get_joint_names(self, group: str | None = None) -> list[str]:
+        """Return the movable joints of `group`, or of the whole robot for None."""
+        if group is None:
+            return self.world.joint_names()
+        return list(self.world.robot(group).joint_names)
+
+    def get_active_joint_names(self, group: str | None = None) -> list[str]:
+        """Return the active (movable) joints of `group`, or of the whole robot for None."""
+        return self.get_joint_names(group)
+
+    def get_link_names(self, group: str | None = None) -> list[str]:
+        """Return the links of the robot (for None), or the links `group`'s joints move."""
+        robot = self.world.robot(group)
+        if group is None:
+            return list(robot.link_names)
+        children = {j.name: j.child for j in self.world.config.urdf_joints.values()}
+        return [children[j] for j in robot.joint_names if j in children]
+
+    def get_current_state(self) -> RobotState:
+        """Return the robot's current state: every movable joint's position."""
+        names = self.world.joint_names()
+        return RobotState(JointState(name=names, position=[self.world.joint_value(j) for j in names]))
+
+    def get_current_variable_values(self) -> dict[str, float]:
+        """Return joint name -> current position in [rad] or [m], for every movable joint."""
+        return {j: self.world.joint_value(j) for j in self.world.joint_names()}
+
+    def get_group(self, name: str) -> MoveGroupCommander:
+        """Return a MoveGroupCommander for the group `name` of this robot."""
+        from .move_group import MoveGroupCommander
+
+        return MoveGroupCommander(name, self)
+
+    def save(self, path: str | Path, distro: str = "jazzy") -> None:
+        """Write every motion executed so far, in order, as one plan file (`moveplan inspect`, `execute` read it).
+
+        The file holds the final planning scene, and the result of each execution as the
+        "executions" metadata. Motions of one group only.
+
+        Raises:
+            UsageError: Nothing was executed yet, several groups moved, or `path` is an input file
+                (or cannot be written as one: a folder, a device).
+            InputError: `path` cannot be written.
+        """
+        self.world.save(Path(path), distro)
+
