@@ -90,12 +90,12 @@ def parse_joints(text: str, what: str) -> JointGoal:
     return JointGoal(tuple(v for v, _ in values), degrees=tuple(d for _, d in values), source=what)
 
 
-def parse_joint_values(text: str, what: str) -> dict[str, float]:
-    """Return joint -> value from "name=value,..." (the joints not named are left alone)."""
-    named = parse_joints(text, what).named_values
-    if named is None:
+def parse_joint_values(text: str, what: str) -> JointGoal:
+    """Return the joint values of "name=value,..." (the joints not named are left alone), units recorded."""
+    goal = parse_joints(text, what)
+    if goal.named_values is None:
         raise UsageError(f"{what}: give joint=value pairs")
-    return named
+    return goal
 
 
 def parse_pose(text: str, what: str) -> PoseGoal:

@@ -133,6 +133,16 @@ def test_prismatic_joint_in_degrees_names_the_joint(cli: Cli, tmp_path: Path) ->
                          "revolute joints")
 
 
+def test_execute_start_joints_refuse_degrees_on_a_prismatic_joint(cli: Cli, tmp_path: Path) -> None:
+    plan = tmp_path / "slide.mcap"
+    assert cli("plan", "--robot", ARM, "--joints", "j3=0.05", "-o", plan, "-q").exit_code == 0
+    result = cli("execute", plan, "--fake", "--start-joints", "j3=2deg")
+    assert result.exit_code == 2
+    assert one_line(result) == ("moveplan: error: --start-joints j3: 'j3' is a prismatic joint, in [m]; 'deg' is "
+                                "for revolute joints")
+    assert cli("execute", plan, "--fake", "--start-joints", "j3=0.01", "-q").exit_code in (0, 5)
+
+
 def test_continuous_joint_beyond_a_turn_is_refused_but_degrees_are_not(cli: Cli, tmp_path: Path) -> None:
     code, line = refused_plan(cli, tmp_path, "--robot", ARM, "--joints", "j4=7")
     assert code == 2
@@ -198,7 +208,8 @@ def test_flag_parsers_keep_units_apart() -> None:
     goal = parse_joints("elbow_joint=-90deg,wrist_1_joint=1", "--joints")
     assert goal.named_values == {"elbow_joint": pytest.approx(-math.pi / 2), "wrist_1_joint": 1.0}
     assert goal.degrees == (True, False) and goal.source == "--joints"
-    assert parse_joint_values("elbow_joint=30deg", "--start-joints") == {"elbow_joint": pytest.approx(math.pi / 6)}
+    assert parse_joint_values("elbow_joint=30deg", "--start-joints").named_values == {
+        "elbow_joint": pytest.approx(math.pi / 6)}
     assert parse_pose("0.6,0,0.4,180deg,0,-90deg", "--pose").rpy == pytest.approx((math.pi, 0.0, -math.pi / 2))
     assert parse_pose("0.6,0,0.4,pi,0,0", "--pose").rpy == (math.pi, 0.0, 0.0)
     assert parse_shift("yaw=30deg,z=0.1", "--shift").yaw == pytest.approx(math.pi / 6)

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 
 from .. import bag as recording
 from ..bag.jointstates import open_joint_states
+from ..config import JointGoal
 from ..config.controllers import ControllerConfig, ExecutionConfig, default_controller, parse_controllers
 from ..config.robot_config import RobotConfig, load_robot_config
 from ..config.sources import CONFIG_FILE
@@ -57,7 +58,7 @@ class ExecuteRequest:
     plant: str = "mirror"
     plant_params: Mapping[str, float] | None = None
     disturbances: Sequence[Disturbance] = ()
-    start_joints: Mapping[str, float] | None = None
+    start_joints: JointGoal | None = None
     controllers: Path | None = None
     seed: int = 0
 
@@ -223,6 +224,10 @@ def execute(
 
     plan = read_valid_plan(request.plan)
     config = plan_config(plan, request.plan)
+    if request.start_joints is not None:
+        from .state import check_joint_units  # pinocchio: check-tolerances, sharing this module, needs none
+
+        check_joint_units(request.start_joints, config, ())
     controller = _controller(config, plan, request.plan, request.controllers)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
     plant = make_plant(request.plant, dict(request.plant_params or {}), controller, continuous)
@@ -310,11 +315,11 @@ def _start_positions(
     request: ExecuteRequest, plan: recording.PlanFile, controller: ControllerConfig
 ) -> NDArray[np.float64] | None:
     """Return where the simulated robot starts, in the controller's joint order (None = plan start)."""
-    if not request.start_joints:
+    if request.start_joints is None:
         return None
     first = plan.steps[0].trajectory
     start = dict(zip(first.joint_names, first.positions[0], strict=True))
-    for joint, value in request.start_joints.items():
+    for joint, value in (request.start_joints.named_values or {}).items():
         if joint not in start:
             raise UnknownName("joint", joint, "--start-joints", start)
         start[joint] = value
