@@ -33,7 +33,7 @@ class JointGoal:
             [rad]); empty when none was.
         source: Where the values were written, for messages: a flag (`--joints`) or a file's
             key path (`task.yaml: steps[0].joints`); "" for values from a MoveIt message or a
-            plan file, which are in [rad] by convention (pipeline/state.py check_joint_units
+            plan file, which are in [rad] by convention (config/joint_units.py check_joint_units
             checks the others against the robot's joints).
     """
 

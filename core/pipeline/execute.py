@@ -23,6 +23,7 @@ from .. import bag as recording
 from ..bag.jointstates import open_joint_states
 from ..config import JointGoal
 from ..config.controllers import ControllerConfig, ExecutionConfig, default_controller, parse_controllers
+from ..config.joint_units import check_joint_units
 from ..config.robot_config import RobotConfig, load_robot_config
 from ..config.sources import CONFIG_FILE
 from ..control.check_report import CheckReport
@@ -225,8 +226,6 @@ def execute(
     plan = read_valid_plan(request.plan)
     config = plan_config(plan, request.plan)
     if request.start_joints is not None:
-        from .state import check_joint_units  # pinocchio: check-tolerances, sharing this module, needs none
-
         check_joint_units(request.start_joints, config, ())
     controller = _controller(config, plan, request.plan, request.controllers)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]

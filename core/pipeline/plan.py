@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 from ..bag import write_plan
 from ..collision.motion import MotionChecker, exact_checks
 from ..config import JointGoal, NamedGoal, RobotConfig, StartFrom, load_robot_config, load_task
+from ..config.joint_units import check_joint_units
 from ..config.limits import DEFAULT_ACCELERATION
 from ..errors import InputError, MoveplanError, StartInCollision, StartOutsideLimits, UnknownName, UsageError
 from ..model.moveit_messages import known_joints
@@ -35,7 +36,7 @@ from ..types import Plan, StepResult, TfSamples
 from ..version import moveplan_version
 from .checks import filter_threshold, problem_checks
 from .request import PlanFlags, PlanRequest, resolve_request
-from .state import RobotState, check_joint_units, robot_state
+from .state import RobotState, robot_state
 from .step import plan_step
 
 __all__ = ["PlanFlags", "PlanRequest", "PlanResult", "assemble", "plan", "plan_to_file", "resolve_request"]
