@@ -6,13 +6,26 @@ commands, so `moveplan --help` stays fast.
 
 from __future__ import annotations
 
-import logging
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
+from moveplan.cli import state_command, tune_command
 from moveplan.cli.errors import GuardedGroup, check_outputs, description_inputs, exit_codes, handle_signals
+from moveplan.cli.options import (
+    ROBOT_HELP,
+    JsonOpt,
+    PackagePathOpt,
+    QuietOpt,
+    SrdfOpt,
+    StrictLimitsOpt,
+    UrdfOpt,
+    VerboseOpt,
+    XacroArgOpt,
+    robot_source,
+    setup_logging,
+)
 from moveplan.cli.parsing import (
     MAX_SEED,
     parse_disturbance,
@@ -28,7 +41,7 @@ from moveplan.cli.parsing import (
 )
 
 if TYPE_CHECKING:  # each command imports the core it runs, so that `moveplan --help` stays fast
-    from moveplan.core.pipeline.request import PlanFlags, RobotSource
+    from moveplan.core.pipeline.request import PlanFlags
 
 __all__ = ["app", "main"]
 
@@ -46,23 +59,6 @@ app = typer.Typer(
     rich_markup_mode=None,
 )
 
-JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON document on stdout, nothing else.")]
-QuietOpt = Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors.")]
-VerboseOpt = Annotated[bool, typer.Option("--verbose", "-v", help="Log what happens to stderr.")]
-PackagePathOpt = Annotated[list[Path] | None, typer.Option(
-    help="Folder searched for $(find pkg) and package:// URIs; repeatable.")]
-XacroArgOpt = Annotated[list[str] | None, typer.Option(help="xacro argument name:=value; repeatable.")]
-UrdfOpt = Annotated[str | None, typer.Option(
-    "--urdf", metavar="FILE|package://PKG/PATH", help="URDF (or .xacro) to load, whatever the config names.")]
-SrdfOpt = Annotated[str | None, typer.Option(
-    "--srdf", metavar="FILE|package://PKG/PATH", help="SRDF (or .srdf.xacro) to load, whatever the config names.")]
-StrictLimitsOpt = Annotated[bool, typer.Option(
-    "--strict-limits", help="An acceleration limit missing in the config is an error instead of the documented "
-                            "default.")]
-_ROBOT_HELP = ("Robot config: a moveplan.yaml or its folder, a MoveIt config package, a URDF or SRDF file, "
-               "or a shipped name.")
-
-
 def _print_version(value: bool) -> None:
     if value:
         from moveplan.core.version import moveplan_version
@@ -79,29 +75,11 @@ def _options(
     """MoveIt-style planning and ros2_control execution checks from one command line: files in, files out."""
 
 
-class _Format(logging.Formatter):
-    """`moveplan: LEVEL: message`, and `moveplan: message` for a notice of one-time work (INFO)."""
-
-    def format(self, record: logging.LogRecord) -> str:
-        text = super().format(record)
-        return f"moveplan: {text}" if record.levelno == logging.INFO else f"moveplan: {record.levelname}: {text}"
-
-
-def _logging(verbose: bool, quiet: bool) -> None:
-    level = logging.DEBUG if verbose else logging.ERROR if quiet else logging.WARNING
-    logging.basicConfig(level=level)
-    for handler in logging.getLogger().handlers:
-        handler.setFormatter(_Format("%(message)s"))
-    if not quiet and not verbose:
-        # Seconds of one-time work (sphere fitting, distance tables) are announced, not left silent.
-        logging.getLogger("moveplan.core.collision._cache").setLevel(logging.INFO)
-
-
 @app.command()
 def plan(
     task: Annotated[Path | None, typer.Argument(help="Task file (docs/formats.md).", show_default=False)] = None,
     output: Annotated[Path, typer.Option("--output", "-o", help="Plan file to write (.mcap).")] = Path("plan.mcap"),
-    robot: Annotated[Path | None, typer.Option(help=_ROBOT_HELP)] = None,
+    robot: Annotated[Path | None, typer.Option(help=ROBOT_HELP)] = None,
     scene: Annotated[Path | None, typer.Option(
         help="Scene file: frames and collision objects, or a MoveIt PlanningScene YAML.")] = None,
     motion_request: Annotated[Path | None, typer.Option(
@@ -136,7 +114,7 @@ def plan(
     verbose: VerboseOpt = False,
 ) -> None:
     """Plan collision-free, time-parameterised motions and write them to MCAP."""
-    _logging(verbose, quiet)
+    setup_logging(verbose, quiet)
     with exit_codes(as_json):
         check_outputs({"-o": output}, {"TASK": task, "--robot": robot, "--scene": scene, "--request": motion_request,
                                        "--start-from": start_from, **description_inputs(urdf, srdf)})
@@ -190,7 +168,7 @@ def execute(
     verbose: VerboseOpt = False,
 ) -> None:
     """Replay a plan through a simulated JointTrajectoryController and report every tolerance violation."""
-    _logging(verbose, quiet)
+    setup_logging(verbose, quiet)
     with exit_codes(as_json):
         from moveplan.core.errors import UsageError
 
@@ -245,7 +223,7 @@ def check_tolerances(
     Exit 0 within tolerances, 5 on a violation, 3 if the recording cuts the execution (with --start all,
     every execution) off before a verdict; with --start all, cut-off cycles are INCOMPLETE and not counted.
     """
-    _logging(verbose, quiet)
+    setup_logging(verbose, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render
         from moveplan.core.errors import UsageError
@@ -271,7 +249,7 @@ def check_tolerances(
 
 @app.command("robot")
 def robot_info(
-    config: Annotated[Path, typer.Argument(help=_ROBOT_HELP)],
+    config: Annotated[Path, typer.Argument(help=ROBOT_HELP)],
     package_path: PackagePathOpt = None,
     xacro_arg: XacroArgOpt = None,
     urdf: UrdfOpt = None,
@@ -281,56 +259,13 @@ def robot_info(
     quiet: QuietOpt = False,
 ) -> None:
     """Show a robot config: groups, joints and limits with their sources, frames, named states, controllers."""
-    _logging(False, quiet)
+    setup_logging(False, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render
 
-        loaded = _robot_source(config, package_path, xacro_arg, urdf, srdf, strict_limits).load()
+        loaded = robot_source(config, package_path, xacro_arg, urdf, srdf, strict_limits).load()
         loaded.collision_meshes()  # a missing mesh is reported here too, not only when planning
     render.robot_summary(loaded, as_json, quiet)
-
-
-@app.command()
-def state(
-    robot: Annotated[Path | None, typer.Option(help=_ROBOT_HELP + " Not needed with --from.")] = None,
-    group: Annotated[str | None, typer.Option(help="Planning group (default: the config's, or the plan's).")] = None,
-    joints: Annotated[str | None, typer.Option(help="Joint values: 'q1,...,qn' or 'elbow_joint=-90deg,...'.")] = None,
-    named: Annotated[str | None, typer.Option(help="An SRDF group_state.")] = None,
-    from_plan: Annotated[Path | None, typer.Option("--from", help="A plan file: the state where it ends.")] = None,
-    step: Annotated[str | None, typer.Option(help="With --from: where this step ends.")] = None,
-    at: Annotated[str | None, typer.Option(help="With --from: seconds from the plan's (or --step's) start.")] = None,
-    link: Annotated[str | None, typer.Option(help="Link whose pose to give (default: the group's tip).")] = None,
-    frame: Annotated[str | None, typer.Option(help="Frame of the pose (default: the planning frame).")] = None,
-    scene: Annotated[Path | None, typer.Option(help="Scene file, for its frames (default with --from: "
-                                                    "the scene the plan embeds).")] = None,
-    package_path: PackagePathOpt = None,
-    xacro_arg: XacroArgOpt = None,
-    urdf: UrdfOpt = None,
-    srdf: SrdfOpt = None,
-    strict_limits: StrictLimitsOpt = False,
-    as_json: JsonOpt = False,
-    quiet: QuietOpt = False,
-) -> None:
-    """Show a robot state: the group's joint values and a link's pose in a frame (lookup_transform)."""
-    _logging(False, quiet)
-    with exit_codes(as_json):
-        from moveplan.cli import render
-        from moveplan.core.pipeline.state import StateRequest
-        from moveplan.core.pipeline.state import state as robot_state
-
-        given = {"--package-path": package_path, "--xacro-arg": xacro_arg, "--urdf": urdf, "--srdf": srdf,
-                 "--strict-limits": strict_limits}
-        if robot is None and (flags := [name for name, value in given.items() if value]):
-            from moveplan.core.errors import UsageError
-
-            raise UsageError(f"{flags[0]} completes --robot: give --robot too (with --from alone, the plan's "
-                             "embedded config is used as it is)")
-        source = None if robot is None else _robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits)
-        result = robot_state(StateRequest(
-            robot=source, group=group, joints=parse_optional(parse_joints, joints, "--joints"), named=named,
-            plan=from_plan, step=step, at_s=parse_optional(parse_time, at, "--at"), link=link, frame=frame, scene=scene,
-        ))
-    render.state_summary(result, as_json, quiet)
 
 
 @app.command()
@@ -343,7 +278,7 @@ def inspect(
     quiet: QuietOpt = False,
 ) -> None:
     """Summarise a ROS 2 bag (MCAP, .db3 or a bag folder): topics, counts; a plan's step durations and peak rates."""
-    _logging(False, quiet)
+    setup_logging(False, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render
         from moveplan.core.pipeline.inspection import inspect_file
@@ -381,7 +316,7 @@ def benchmark(
     quiet: QuietOpt = False,
 ) -> None:
     """Plan many problems with several planners and seeds; report success, times, path quality, exact validity."""
-    _logging(False, quiet)
+    setup_logging(False, quiet)
     with exit_codes(as_json):
         from moveplan.cli import render
         from moveplan.core.pipeline import benchmark as bench
@@ -392,7 +327,7 @@ def benchmark(
         seed_list = parse_seeds(seeds)
         time_s = check_planning_time(parse_number(planning_time, "--planning-time"))
         found = bench.find_problems(problems, count)
-        source = _robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits)
+        source = robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits)
         config = source.load()
         planners = [p.strip() for text in planner or [config.planning["planner"]] for p in text.split(",")]
         with render.benchmark_progress(len(found) * len(planners) * len(seed_list), quiet) as advance:
@@ -404,60 +339,8 @@ def benchmark(
     render.benchmark_summary(runs, bench.summarize(runs), as_json, quiet)
 
 
-@app.command("tune-pid")
-def tune_pid(
-    plan_file: Annotated[Path, typer.Argument(metavar="PLAN", help="Plan file written by moveplan plan.")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="Controllers file to write, gains tuned (.yaml).")],
-    controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml to tune (else the plan's).")] = None,
-    joints: Annotated[str | None, typer.Option(help="Joints to tune, comma-separated (default: all).")] = None,
-    plant_param: Annotated[list[str] | None, typer.Option(help="pid plant parameter k=v, as for execute.")] = None,
-    oscillations: Annotated[int, typer.Option(min=0, help="Oscillations wanted as I is raised (stage 4).")] = 0,
-    recording: Annotated[Path | None, typer.Option(
-        metavar="REC.mcap", help="The robot following this plan: fit the plant to it first.")] = None,
-    topic: Annotated[str, typer.Option(help="JointState topic in --recording.")] = "/joint_states",
-    plot: Annotated[Path | None, typer.Option(metavar="FILE.png", help="Write a PNG of the responses.")] = None,
-    seed: Annotated[int, typer.Option(min=0, max=MAX_SEED, help="Seed for plant noise.")] = 0,
-    as_json: JsonOpt = False,
-    quiet: QuietOpt = False,
-    verbose: VerboseOpt = False,
-) -> None:
-    """Tune PID gains joint by joint on the simulated pid plant; write them into a copy of the controllers file.
-
-    Exit 0 when executing the plan with the tuned gains passes without a ringing joint, 5 when it does not
-    (the file is written either way).
-    """
-    _logging(verbose, quiet)
-    with exit_codes(as_json):
-        check_outputs({"-o": output, "--plot": plot},
-                      {"PLAN": plan_file, "--controllers": controllers, "--recording": recording})
-        from moveplan.cli.render_tuning import tuning_summary
-        from moveplan.core.pipeline.tune import TuneRequest, tune
-
-        if plot is not None:
-            from moveplan.core.pipeline.plots import check_plot_path
-
-            check_plot_path(plot)
-        names = tuple(j.strip() for j in (joints or "").split(",") if j.strip())
-        result = tune(TuneRequest(plan_file, output, controllers, names,
-                                  parse_params(plant_param or [], "--plant-param"), oscillations, recording, topic,
-                                  seed))
-        if plot is not None:
-            from moveplan.core.pipeline.tune_plot import write_tuning_plot
-
-            write_tuning_plot(result, plot)
-    tuning_summary(result, plot, as_json, quiet)
-    raise typer.Exit(0 if result.ok else 5)
-
-
-def _robot_source(
-    robot: Path, package_path: list[Path] | None, xacro_arg: list[str] | None, urdf: str | None, srdf: str | None,
-    strict_limits: bool,
-) -> RobotSource:
-    """Return what loads the robot config: --robot and the flags that complete it, as core's typed value."""
-    from moveplan.core.config.xacro import parse_xacro_args
-    from moveplan.core.pipeline.request import RobotSource
-
-    return RobotSource(robot, tuple(package_path or ()), parse_xacro_args(xacro_arg or ()), urdf, srdf, strict_limits)
+app.command("state")(state_command.state)
+app.command("tune-pid")(tune_command.tune_pid)
 
 
 def main() -> None:
