@@ -20,7 +20,9 @@ __all__ = [
     "Frame",
     "JointStateSeries",
     "JointTrajectory",
+    "LinkPose",
     "Plan",
+    "RobotState",
     "Shape",
     "StepResult",
     "TfSamples",
@@ -322,3 +324,68 @@ class ControllerStates:
                 if value is not None
             }
             object.__setattr__(self, name, PointSeries(**checked))
+
+
+@dataclass(frozen=True)
+class LinkPose:
+    """The pose of a link in a frame, as tf2's lookup_transform(frame, link) gives it.
+
+    Attributes:
+        link: The link (or scene frame) whose pose this is.
+        frame: The frame it is expressed in.
+        position: x, y, z in [m].
+        quaternion: x, y, z, w (w >= 0), as geometry_msgs/Quaternion.
+        rpy: Roll, pitch, yaw in [rad], fixed axes X-Y-Z as in URDF and tf's euler_from_quaternion.
+    """
+
+    link: str
+    frame: str
+    position: tuple[float, float, float]
+    quaternion: tuple[float, float, float, float]
+    rpy: tuple[float, float, float]
+
+    @classmethod
+    def of(cls, link: str, frame: str, frame_T_link: NDArray[np.float64]) -> LinkPose:
+        """Return the pose a 4x4 transform `frame_T_link` holds."""
+        import pinocchio as pin  # only where a pose is computed: a plan file read back carries its poses
+
+        rotation = frame_T_link[:3, :3]
+        x, y, z, w = (float(c) for c in pin.Quaternion(rotation).normalized().coeffs())
+        sign = -1.0 if w < 0 else 1.0  # q and -q are one rotation: report the one with w >= 0
+        px, py, pz = (float(c) for c in frame_T_link[:3, 3])
+        roll, pitch, yaw = (float(a) for a in pin.rpy.matrixToRpy(rotation))
+        return cls(link, frame, (px, py, pz), (sign * x, sign * y, sign * z, sign * w), (roll, pitch, yaw))
+
+    def as_dict(self) -> dict[str, object]:
+        """Return the pose as the JSON documents give it: link, frame, position, quaternion, rpy."""
+        return {"link": self.link, "frame": self.frame, "position": list(self.position),
+                "quaternion": list(self.quaternion), "rpy": list(self.rpy)}
+
+
+@dataclass(frozen=True)
+class RobotState:
+    """The planning group's joint values and one link's pose.
+
+    Attributes:
+        joints: Group joint -> value in [rad] (revolute, continuous) or [m] (prismatic), in group order.
+        pose: The link's pose.
+        prismatic: The group's joints whose values are in [m].
+    """
+
+    joints: dict[str, float]
+    pose: LinkPose
+    prismatic: tuple[str, ...] = ()
+
+    def as_dict(self) -> dict[str, object]:
+        """Return the state as the JSON documents give it: {"joints": {...}, "pose": {...}}."""
+        return {"joints": dict(self.joints), "pose": self.pose.as_dict()}
+
+    @classmethod
+    def from_dict(cls, document: dict[str, Any], prismatic: tuple[str, ...] = ()) -> RobotState:
+        """Return the state `as_dict` gave (KeyError, TypeError or ValueError if it is not one)."""
+        pose = document["pose"]
+        position, quaternion, rpy = (tuple(float(v) for v in pose[key]) for key in ("position", "quaternion", "rpy"))
+        if (len(position), len(quaternion), len(rpy)) != (3, 4, 3):
+            raise ValueError("a pose has 3 position, 4 quaternion and 3 rpy values")
+        link_pose = LinkPose(str(pose["link"]), str(pose["frame"]), position, quaternion, rpy)  # type: ignore[arg-type]
+        return cls({str(j): float(v) for j, v in document["joints"].items()}, link_pose, prismatic)

@@ -97,3 +97,18 @@ def test_one_time_work_of_unknown_length_is_announced_only_when_slow(caplog: pyt
         with announced_if_slow("slow work", after_s=0.05):
             time.sleep(0.3)
     assert [r.getMessage() for r in caplog.records] == ["slow work"]
+
+
+def test_inspect_reads_a_plans_end_states_without_loading_kinematics(tmp_path: Path) -> None:
+    """A plan file records where each step ends: `inspect` gives them without pinocchio (start-up in CI loops)."""
+    plan = tmp_path / "plan.mcap"
+    subprocess.run([sys.executable, "-m", "moveplan.cli.app", "plan", "samples/ur10e_joint_goals.yaml", "-o", str(plan),
+                    "-q"], check=True, cwd=ROOT, timeout=300)
+    code = ("import sys, json, io, contextlib\nsys.argv = ['moveplan', 'inspect', " + repr(str(plan)) + ", '--json']\n"
+            "from moveplan.cli.app import main\nout = io.StringIO()\ntry:\n    with contextlib.redirect_stdout(out):\n"
+            "        main()\nexcept SystemExit as exc:\n    assert not exc.code\n"
+            "steps = json.loads(out.getvalue())['plan']['steps']\n"
+            "print(json.dumps([s['end_state']['pose']['link'] for s in steps]), 'pinocchio' in sys.modules)")
+    result = _run(code)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == '["tool0", "tool0", "tool0"] False'

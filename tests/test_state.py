@@ -235,3 +235,29 @@ def test_prismatic_joint_is_shown_in_metres(cli: Cli) -> None:
     result = cli("state", "--robot", ARM, "--joints", "j3=0.05,j4=90deg")
     assert result.exit_code == 0, result.stderr
     assert "0.050000 m" in result.stdout and "90.0000" in result.stdout
+
+
+def test_end_states_of_a_file_without_or_with_a_damaged_record_are_computed_from_its_config(
+    pick_plan: tuple[Path, dict[str, Any]], caplog: pytest.LogCaptureFixture
+) -> None:
+    """Files from before end states were recorded (samples/recordings) and damaged records give the same states."""
+    from dataclasses import replace
+
+    from moveplan.core.bag.plan_file import END_STATES_KEY
+    from moveplan.core.pipeline.execute import read_valid_plan
+    from moveplan.core.pipeline.inspection import end_states
+
+    path, document = pick_plan
+    plan = read_valid_plan(path)
+    recorded = end_states(plan, path)
+    assert [s.as_dict() for s in recorded] == [step["end_state"] for step in document["steps"]]
+    for metadata in ({k: v for k, v in plan.metadata.items() if k != END_STATES_KEY},
+                     {**plan.metadata, END_STATES_KEY: '[{"joints": {}}]'}):
+        computed = end_states(replace(plan, metadata=metadata), path)
+        for mine, theirs in zip(computed, recorded, strict=True):
+            assert mine.joints == pytest.approx(theirs.joints)
+            assert mine.pose.position == pytest.approx(theirs.pose.position, abs=1e-9)
+    assert "recorded end states are unreadable" in caplog.text
+    old = SAMPLES / "recordings" / "tool_up_plan.mcap"
+    assert END_STATES_KEY not in read_valid_plan(old).metadata
+    assert len(end_states(read_valid_plan(old), old)) == len(read_valid_plan(old).steps)

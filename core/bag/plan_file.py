@@ -20,6 +20,7 @@ from .mcap_scan import DAMAGE, Contents, Kept, open_mcap, scan
 from .messages import trajectory_from_message
 
 __all__ = [
+    "END_STATES_KEY",
     "PLAN_TOPICS",
     "ROBOT_DESCRIPTION",
     "STRING",
@@ -48,6 +49,10 @@ PLAN_TOPICS: dict[str, tuple[str, bool]] = {
 
 PLAN_KEYS = ("robot_name", "group", "planning_frame", "step_names", "limits", "distro")
 """The keys moveplan itself writes into a plan's "moveplan" metadata record."""
+
+END_STATES_KEY = "end_states"
+"""The "moveplan" metadata key under which a plan records where each step ends: a JSON list, one
+{"joints", "pose"} per step (RobotState.as_dict), read by `inspect` without loading the robot."""
 
 _UNREADABLE = (*DAMAGE, TypeError, IndexError, AttributeError)
 

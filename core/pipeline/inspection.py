@@ -5,20 +5,19 @@ A bag is an MCAP file, a rosbag2 sqlite3 (.db3) file, or a bag folder; a plan fi
 
 from __future__ import annotations
 
+import json
 import logging
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..bag import BagSummary, PlanFile, summarize
+from ..bag.plan_file import END_STATES_KEY
 from ..errors import InputError
 from ..trajectory import peak_rates
+from ..types import RobotState
 from .execute import plan_config, read_valid_plan
-
-if TYPE_CHECKING:  # kinematics is loaded for plan files only
-    from .state import RobotState
 
 __all__ = ["Inspection", "StepPeaks", "end_states", "inspect_file", "step_peaks"]
 
@@ -76,12 +75,23 @@ def inspect_file(path: Path) -> Inspection:
 
 
 def end_states(plan: PlanFile, path: Path) -> tuple[RobotState, ...]:
-    """Return where each step ends: group joints and the tip's pose in the planning frame, by the embedded config.
+    """Return where each step ends: group joints and the tip's pose in the planning frame.
 
-    Joints outside the plan's trajectories are at the config's initial positions. A plan whose
-    config does not load gives () and a warning: the rest of the summary stands without it.
+    As the plan file records them; a file that records none (written before moveplan did, or
+    whose record is damaged) has them computed by its embedded config, with joints outside the
+    trajectories at the config's initial positions. A plan whose config does not load gives ()
+    and a warning: the rest of the summary stands without it.
     """
-    # Imported here: a bag that is no plan file needs no kinematics (pinocchio).
+    recorded = plan.metadata.get(END_STATES_KEY)
+    if recorded is not None:
+        try:
+            states = tuple(RobotState.from_dict(entry) for entry in json.loads(recorded))
+            if len(states) == len(plan.steps):
+                return states
+        except (ValueError, TypeError, KeyError, AttributeError):
+            pass
+        logger.warning("%s: its recorded end states are unreadable; computing them from its robot config", path)
+    # Imported here: reading the recorded states needs no kinematics (pinocchio).
     from ..model.robot import Robot
     from ..model.scene import empty_scene
     from .state import robot_state

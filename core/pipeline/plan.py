@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..bag import write_plan
+from ..bag.plan_file import END_STATES_KEY
 from ..collision.motion import MotionChecker, exact_checks
 from ..config import JointGoal, NamedGoal, RobotConfig, StartFrom, load_robot_config, load_task
 from ..config.joint_units import check_joint_units
@@ -262,6 +263,7 @@ def assemble(
     steps: list[StepResult],
 ) -> PlanResult:
     """Return the plan of the planned steps, with what replaying and checking it needs, and where each step ends."""
+    ends = tuple(robot_state(robot, scene, robot.configuration(step.trajectory.positions[-1], base)) for step in steps)
     return PlanResult(
         robot_name=config.name,
         group=robot.group.name,
@@ -278,9 +280,10 @@ def assemble(
         attachments=_attachments(config, request),
         metadata={"seed": str(request.seed), "moveplan_version": moveplan_version(),
                   "planners": ",".join(s.planner for s in steps),
-                  "limit_sources": json.dumps({j: config.limits[j].source for j in robot.joint_names}, sort_keys=True)},
-        end_states=tuple(robot_state(robot, scene, robot.configuration(step.trajectory.positions[-1], base))
-                         for step in steps),
+                  "limit_sources": json.dumps({j: config.limits[j].source for j in robot.joint_names}, sort_keys=True),
+                  # `inspect` reads where each step ends from here, without loading the robot.
+                  END_STATES_KEY: json.dumps([end.as_dict() for end in ends])},
+        end_states=ends,
     )
 
 
