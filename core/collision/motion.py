@@ -171,6 +171,8 @@ class MotionChecker:
 
     def colliding_pair(self, values: NDArray[np.float64]) -> tuple[str, str] | None:
         """Return the names of a colliding pair at a group state, or None."""
+        if self.free(np.atleast_2d(values))[0]:  # the spheres clear a free state in microseconds, coal in 100
+            return None
         return self.checker.colliding_pair(self.robot.configuration(values, self.base))
 
 
