@@ -14,6 +14,7 @@ safety cap: a search that reaches it before its budget fails and says so.
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import time
@@ -220,6 +221,14 @@ def _plan(
 
 def _bounded_space(dof: int, lower: NDArray[np.float64], upper: NDArray[np.float64]) -> ob.RealVectorStateSpace:
     """Return OMPL's space of `dof` group joint values, bounded by the joint limits."""
+    return _space(dof, tuple(lower.tolist()), tuple(upper.tolist()))
+
+
+# A space holds no state of a search (samplers and their seeds come from the planner), so every
+# search of a robot shares one: making it costs a tenth of a median search.
+@functools.lru_cache(maxsize=16)
+def _space(dof: int, lower: tuple[float, ...], upper: tuple[float, ...]) -> ob.RealVectorStateSpace:
+    """Return OMPL's space of `dof` values within `lower` and `upper`, made once per bounds."""
     space = ob.RealVectorStateSpace(dof)
     bounds = ob.RealVectorBounds(dof)
     for i in range(dof):
@@ -248,18 +257,25 @@ def _checked_by(
         work.used += 1
         return validity.state_free(values(state))
 
+    def edge_free(s1: ob.State, s2: ob.State) -> bool:
+        work.used += 1
+        return validity.edge_free(values(s1), values(s2))
+
     setup.setStateValidityChecker(state_free)
-
-    class EdgeValidator(ob.MotionValidator):  # type: ignore[misc]
-        """Checks a whole edge in one call."""
-
-        def checkMotion(self, s1: ob.State, s2: ob.State, *rest: object) -> bool:  # noqa: N802 - OMPL's name
-            work.used += 1
-            return validity.edge_free(values(s1), values(s2))
-
     info = setup.getSpaceInformation()
-    info.setMotionValidator(EdgeValidator(info))
+    info.setMotionValidator(_EdgeValidator(info, edge_free))
     return info
+
+
+class _EdgeValidator(ob.MotionValidator):  # type: ignore[misc]
+    """Checks a whole edge in one call of `edge_free`."""
+
+    def __init__(self, info: ob.SpaceInformation, edge_free: Callable[[ob.State, ob.State], bool]) -> None:
+        super().__init__(info)
+        self.edge_free = edge_free
+
+    def checkMotion(self, s1: ob.State, s2: ob.State, *rest: object) -> bool:  # noqa: N802 - OMPL's name
+        return self.edge_free(s1, s2)
 
 
 def _state(space: ob.RealVectorStateSpace, point: NDArray[np.float64]) -> ob.State:
