@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 from ..errors import ConfigError
 from ..model.robot import Robot
 from ..model.scene import Scene
-from ..trajectory import interpolate
+from ..trajectory import interpolate, sampler
 from ..types import JointTrajectory
 from . import certify
 from .checker import CollisionChecker, GeometryMode
@@ -157,7 +157,9 @@ class MotionChecker:
 
     def first_collision_on_trajectory(self, trajectory: JointTrajectory) -> NDArray[np.float64] | None:
         """Return the first colliding state along the interpolated trajectory, or None if it is free."""
-        return self._first_collision(*certify.trajectory_states(trajectory, self.reach, CERTIFY_STEP_M))
+        # The built filter samples the trajectory compiled; its stand-in (checks.py), with numpy.
+        sampling = getattr(self.spheres, "sampler", sampler)
+        return self._first_collision(*certify.trajectory_states(trajectory, self.reach, CERTIFY_STEP_M, sampling))
 
     def first_collision_on_path(self, waypoints: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """Return the first colliding state along the straight segments between waypoints, or None."""

@@ -22,7 +22,9 @@ from numpy.typing import NDArray
 
 from ..errors import UnsupportedJoint
 from ..model.robot import Robot
-from ..types import CollisionObject
+from ..trajectory import Sampler, Samples, segment_coefficients
+from ..trajectory import sampler as numpy_sampler
+from ..types import CollisionObject, JointTrajectory
 from ._cache import announced_if_slow
 from ._verdicts import CLEAR, COLLIDES, MAYBE
 from .inner_spheres import inner_spheres
@@ -107,6 +109,8 @@ class SphereFilter:
             self.classify(robot.values(base)[None, :])
             self.edge(robot.values(base), robot.values(base), 1.0)
             self.certify(robot.values(base)[None, :], np.zeros(1))
+            still = np.zeros((2, robot.dof))
+            self.sampler(JointTrajectory(robot.joint_names, np.array([0.0, 1.0]), still, still, still))(np.zeros(1), 1)
 
     def classify(
         self, values: NDArray[np.float64], stop: bool = False
@@ -133,6 +137,26 @@ class SphereFilter:
         out = np.empty(len(values), dtype=np.int8)
         self._clearance.certify(_plain(values), _plain(travel), CLEARANCE_CAP_M, *self._packed, q, out)
         return out, q
+
+    def sampler(self, trajectory: JointTrajectory) -> Sampler:
+        """Return `trajectory`'s sampler compiled: core/trajectory.py `sampler`'s numbers, derivatives 0 and 1 only.
+
+        Placing a trajectory's certified states samples it at thousands of times; compiled, that
+        costs a tenth of what numpy's does, a twentieth of a median plan step.
+        """
+        knots, p, v = trajectory.times_s, trajectory.positions, trajectory.velocities
+        if len(knots) == 1:
+            return numpy_sampler(trajectory)
+        coefficients = _plain(segment_coefficients(trajectory))
+        knots, held = _plain(knots), np.stack((p[-1], v[-1], p[0]))
+
+        def at(t: NDArray[np.float64], derivatives: int = 1) -> Samples:
+            assert derivatives <= 1, "the compiled sampler gives positions and velocities"
+            pos, vel = np.empty((len(t), p.shape[1])), np.zeros((len(t), p.shape[1]))
+            self._clearance.spline(knots, coefficients, held, _plain(t), derivatives, pos, vel)
+            return pos, vel, np.zeros_like(pos)
+
+        return at
 
     def edge(
         self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, stop: bool = False
