@@ -25,13 +25,11 @@ from numpy.typing import NDArray
 from .types import JointTrajectory, frozen_array
 
 __all__ = [
-    "PointBefore", "Sampler", "Samples", "interpolate", "peak_rates", "quintic_peak_rates", "sample", "sampler",
-    "segment_coefficients", "shortest_angular_distance", "straight_states",
+    "PointBefore", "interpolate", "peak_rates", "quintic_peak_rates", "sample", "sampler", "shortest_angular_distance",
+    "straight_states",
 ]
 
 Samples = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
-Sampler = Callable[[NDArray[np.float64], int], Samples]
-"""A trajectory's `sample` as a function of times [s] and derivatives (every field present, no point before)."""
 
 
 @dataclass(frozen=True)
@@ -113,7 +111,7 @@ def sample(
     return _sample_points(knots, positions, velocities, accelerations, has_v, has_a, t, derivatives)
 
 
-def sampler(trajectory: JointTrajectory) -> Sampler:
+def sampler(trajectory: JointTrajectory) -> Callable[[NDArray[np.float64], int], Samples]:
     """Return `sample` of `trajectory` (every field present, no point before) as a function of times and derivatives.
 
     The segments' coefficients are computed once: a certification samples one trajectory twice.
@@ -121,15 +119,9 @@ def sampler(trajectory: JointTrajectory) -> Sampler:
     knots, p, v, a = trajectory.times_s, trajectory.positions, trajectory.velocities, trajectory.accelerations
     if len(knots) == 1:
         return lambda t, derivatives=2: _hold(p[0], v[0], a[0], len(t))
-    coefficients = segment_coefficients(trajectory)
+    every = np.ones(len(knots), dtype=bool)
+    coefficients = _coefficients(knots, p, v, a, every, every)
     return lambda t, derivatives=2: _evaluate(knots, coefficients, p, v, a, t, derivatives)
-
-
-def segment_coefficients(trajectory: JointTrajectory) -> NDArray[np.float64]:
-    """Return the coefficients c0..c5 of powers of time of the controller's quintics, shape (6, segments, n)."""
-    every = np.ones(len(trajectory.times_s), dtype=bool)
-    return _coefficients(trajectory.times_s, trajectory.positions, trajectory.velocities, trajectory.accelerations,
-                         every, every)
 
 
 def peak_rates(trajectory: JointTrajectory) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

@@ -1,4 +1,4 @@
-"""The certification walk's compiled kernels (numba): the trajectory's samples, clearances, and states they prove free.
+"""The certification walk's compiled kernels (numba): clearances, and states a clearance proves free.
 
 Split from _kernels.py, whose placement and table kernels they use; cached on disk the same way.
 """
@@ -13,7 +13,7 @@ import numpy as np
 from ._kernels import _inside, forward, gap, place, place_owner, tabled, unpack
 from ._verdicts import CLEAR
 
-__all__ = ["certify", "clearance", "spline"]
+__all__ = ["certify", "clearance"]
 
 
 @numba.njit(cache=True)
@@ -117,39 +117,3 @@ def certify(values: Any, travel: Any, cap: float, floats: Any, ints: Any, head: 
         if out[k] == CLEAR:
             covered = travel[k] + c
     return judged
-
-
-@numba.njit(cache=True)
-def spline(knots: Any, coefficients: Any, held: Any, t: Any, derivatives: int, pos: Any, vel: Any) -> None:
-    """Write the controller's positions (and if `derivatives` >= 1 velocities) at times `t` into `pos` (and `vel`).
-
-    As core/trajectory.py `sample` computes them, to the bit: the same segment, offset and Horner
-    steps. `coefficients` (6, segments, n) are c0..c5; `held` rows are the last point's positions and
-    velocities, held from its time on, and the first point's positions, before it (at rest).
-    """
-    last = len(knots) - 2
-    for k in range(len(t)):
-        now = t[k]
-        if now >= knots[-1] or now < knots[0]:
-            row, moving = (0, True) if now >= knots[-1] else (2, False)
-            for i in range(coefficients.shape[2]):
-                pos[k, i] = held[row, i]
-                if derivatives >= 1:
-                    vel[k, i] = held[1, i] if moving else 0.0
-            continue
-        seg = min(max(np.searchsorted(knots, now, side="right") - 1, 0), last)
-        x = min(max(now - knots[seg], 0.0), knots[seg + 1] - knots[seg])
-        for i in range(coefficients.shape[2]):
-            c1, c2, c3, c4, c5 = (coefficients[1, seg, i], coefficients[2, seg, i], coefficients[3, seg, i],
-                                  coefficients[4, seg, i], coefficients[5, seg, i])
-            r = c5 * x
-            for c in (c4, c3, c2, c1):
-                r += c
-                r *= x
-            pos[k, i] = r + coefficients[0, seg, i]
-            if derivatives >= 1:
-                r = (5 * c5) * x
-                for c in (4 * c4, 3 * c3, 2 * c2):
-                    r += c
-                    r *= x
-                vel[k, i] = r + c1

@@ -10,21 +10,20 @@ states placed by it certify a motion at a resolution given in metres, not radian
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
 from ..model.robot import Robot
-from ..trajectory import Sampler, peak_rates, sample, sampler, straight_states
+from ..trajectory import peak_rates, sample, sampler, straight_states
 from ..types import JointTrajectory
 
 __all__ = [
-    "farthest_point", "is_prismatic", "path_states", "reach", "segment_states", "trajectory_states", "uniform_states",
+    "PIECE", "farthest_point", "is_prismatic", "path_states", "reach", "segment_states", "trajectory_states",
+    "uniform_states",
 ]
 
-_PIECE = 4  # states at the peak speed per piece whose speed bound is taken from its ends
+PIECE = 4  # states at the peak speed per piece whose speed bound is taken from its ends
 
 
 def reach(robot: Robot, geometry: pin.GeometryModel) -> NDArray[np.float64]:
@@ -98,29 +97,26 @@ def path_states(
 
 
 def trajectory_states(
-    trajectory: JointTrajectory, reach_m: NDArray[np.float64], step_m: float,
-    sampling: Callable[[JointTrajectory], Sampler] = sampler,
+    trajectory: JointTrajectory, reach_m: NDArray[np.float64], step_m: float
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Return states along the interpolated trajectory, at most `step_m` of robot motion apart, and their travel.
 
     travel[k] [m] bounds how far any robot point moves from the first state to state k. States
     are spaced by the motion the joints actually cover, not by their peak speed over the whole
-    trajectory: the trajectory is cut into pieces of at most _PIECE states at the peak speed, and
+    trajectory: the trajectory is cut into pieces of at most PIECE states at the peak speed, and
     within a piece of duration h whose ends move at |v0| and |v1|, a joint whose acceleration never
     exceeds A moves no faster than min(|v0| + A t, |v1| + A (h - t)) <= (|v0| + |v1| + A h) / 2
     (A: its peak over the trajectory, exact for the controller's quintics). Summed over the
     joints with their reach, that bounds every robot point's speed in the piece; states are placed
-    at equal increments of the time integral of that bound, none larger than `step_m`. `sampling`
-    gives the trajectory's sampler (positions and velocities): the sphere filter's compiled one
-    gives the same numbers in half the time.
+    at equal increments of the time integral of that bound, none larger than `step_m`.
     """
     knots = trajectory.times_s
     if len(knots) == 1:
         return np.asarray(trajectory.positions), np.zeros(1)
     peak_v, peak_a = peak_rates(trajectory)
-    at = sampling(trajectory)
+    at = sampler(trajectory)
     speed, duration = float(peak_v @ reach_m), float(knots[-1] - knots[0])  # [m/s], bounds every point's speed
-    pieces = max(1, int(np.ceil(speed * duration / (_PIECE * step_m))))
+    pieces = max(1, int(np.ceil(speed * duration / (PIECE * step_m))))
     h = duration / pieces
     ends = np.linspace(knots[0], knots[-1], pieces + 1)
     rate = np.abs(at(ends, 1)[1]) @ reach_m  # [m/s] at the pieces' ends

@@ -20,7 +20,8 @@ from pathlib import Path
 __all__ = ["kernels_cached"]
 
 _HERE = Path(__file__).resolve().parent
-_ENTRY_POINTS = {"_kernels.py": ("classify", "edge"), "_clearance.py": ("certify", "spline")}
+_ENTRY_POINTS = {"_kernels.py": ("classify", "edge"), "_clearance.py": ("certify",),
+                 "_states.py": ("trajectory_states",)}
 """The kernels a filter calls from Python, by source file; numba caches each under its own index."""
 
 

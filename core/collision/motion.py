@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 from ..errors import ConfigError
 from ..model.robot import Robot
 from ..model.scene import Scene
-from ..trajectory import interpolate, sampler
+from ..trajectory import interpolate
 from ..types import JointTrajectory
 from . import certify
 from .checker import CollisionChecker, GeometryMode
@@ -157,9 +157,9 @@ class MotionChecker:
 
     def first_collision_on_trajectory(self, trajectory: JointTrajectory) -> NDArray[np.float64] | None:
         """Return the first colliding state along the interpolated trajectory, or None if it is free."""
-        # The built filter samples the trajectory compiled; its stand-in (checks.py), with numpy.
-        sampling = getattr(self.spheres, "sampler", sampler)
-        return self._first_collision(*certify.trajectory_states(trajectory, self.reach, CERTIFY_STEP_M, sampling))
+        # The built filter places the states compiled; its stand-in (core/pipeline/checks.py) has no numba yet.
+        place = getattr(self.spheres, "trajectory_states", certify.trajectory_states)
+        return self._first_collision(*place(trajectory, self.reach, CERTIFY_STEP_M))
 
     def first_collision_on_path(self, waypoints: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """Return the first colliding state along the straight segments between waypoints, or None."""

@@ -22,9 +22,8 @@ from numpy.typing import NDArray
 
 from ..errors import UnsupportedJoint
 from ..model.robot import Robot
-from ..trajectory import Sampler, Samples, segment_coefficients
-from ..trajectory import sampler as numpy_sampler
 from ..types import CollisionObject, JointTrajectory
+from . import certify
 from ._cache import announced_if_slow
 from ._verdicts import CLEAR, COLLIDES, MAYBE
 from .inner_spheres import inner_spheres
@@ -89,10 +88,10 @@ class SphereFilter:
         self.tabulated = tuple((t.upper, t.lower) for t in tables)
         world = [obj for obj in objects if not obj.link]
         check = _world_checks(names, owner_joint, world, allowed)
-        from . import _clearance  # numba too: the certification walk
+        from . import _clearance, _states  # numba too: the certification walk, the states it walks
         from . import _kernels as sphere_kernels  # numba: compiled once, then loaded from its disk cache
 
-        self._kernels, self._clearance = sphere_kernels, _clearance
+        self._kernels, self._clearance, self._states = sphere_kernels, _clearance, _states
         base = robot.neutral() if base is None else base
         inner = inner_spheres(model, hulls or geometry, robot.config.urdf)
         # Packed once: the kernels run thousands of times per search, and a call costs per argument.
@@ -110,7 +109,8 @@ class SphereFilter:
             self.edge(robot.values(base), robot.values(base), 1.0)
             self.certify(robot.values(base)[None, :], np.zeros(1))
             still = np.zeros((2, robot.dof))
-            self.sampler(JointTrajectory(robot.joint_names, np.array([0.0, 1.0]), still, still, still))(np.zeros(1), 1)
+            self.trajectory_states(JointTrajectory(robot.joint_names, np.array([0.0, 1.0]), still, still, still),
+                                   np.ones(robot.dof), 1.0)
 
     def classify(
         self, values: NDArray[np.float64], stop: bool = False
@@ -138,25 +138,18 @@ class SphereFilter:
         self._clearance.certify(_plain(values), _plain(travel), CLEARANCE_CAP_M, *self._packed, q, out)
         return out, q
 
-    def sampler(self, trajectory: JointTrajectory) -> Sampler:
-        """Return `trajectory`'s sampler compiled: core/trajectory.py `sampler`'s numbers, derivatives 0 and 1 only.
+    def trajectory_states(
+        self, trajectory: JointTrajectory, reach_m: NDArray[np.float64], step_m: float
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Return core/collision/certify.py `trajectory_states` (the same numbers to rounding), compiled.
 
-        Placing a trajectory's certified states samples it at thousands of times; compiled, that
-        costs a tenth of what numpy's does, a twentieth of a median plan step.
+        Placing a trajectory's certified states costs numpy a tenth of a median plan step.
         """
-        knots, p, v = trajectory.times_s, trajectory.positions, trajectory.velocities
-        if len(knots) == 1:
-            return numpy_sampler(trajectory)
-        coefficients = _plain(segment_coefficients(trajectory))
-        knots, held = _plain(knots), np.stack((p[-1], v[-1], p[0]))
-
-        def at(t: NDArray[np.float64], derivatives: int = 1) -> Samples:
-            assert derivatives <= 1, "the compiled sampler gives positions and velocities"
-            pos, vel = np.empty((len(t), p.shape[1])), np.zeros((len(t), p.shape[1]))
-            self._clearance.spline(knots, coefficients, held, _plain(t), derivatives, pos, vel)
-            return pos, vel, np.zeros_like(pos)
-
-        return at
+        if len(trajectory.times_s) == 1:
+            return certify.trajectory_states(trajectory, reach_m, step_m)
+        return self._states.trajectory_states(*(_plain(x) for x in (
+            trajectory.times_s, trajectory.positions, trajectory.velocities, trajectory.accelerations, reach_m)),
+            step_m, certify.PIECE)
 
     def edge(
         self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, stop: bool = False
