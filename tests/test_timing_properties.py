@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 import math
+import re
 
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from moveplan.core.errors import PlanningFailed
+from moveplan.core.timing import _compiled as compiled
 from moveplan.core.timing import time_parameterize
 from moveplan.core.trajectory import peak_rates, sample
 from moveplan.core.types import JointTrajectory
@@ -190,6 +192,33 @@ def test_any_polyline_within_any_limits_gives_a_valid_trajectory(case: Case) -> 
     waypoints, max_velocity, max_acceleration = case
     trajectory = time_parameterize(names(waypoints.shape[1]), waypoints, max_velocity, max_acceleration)
     assert_valid(trajectory, waypoints, max_velocity, max_acceleration)
+
+
+@settings(PROPERTIES, max_examples=300)
+@seed(20261125)
+@given(cases())
+@example(as_case(SLOW_JOINT))
+@example(as_case(REVERSAL))
+@example(as_case(SLOW_CORNER))
+@example(as_case(REPEATS))
+@example(as_case(NUDGE))
+@example(as_case(HUGE_ACCELERATION))
+@example(as_case(ROUNDING))
+@example(as_case(LONG))
+@example(as_case(CORNER_DIP))
+def test_the_compiled_speeds_give_the_same_trajectory_to_the_bit(case: Case) -> None:
+    # A plan's file must not depend on whether the sphere filter had loaded numba.
+    waypoints, max_velocity, max_acceleration = case
+    joints = names(waypoints.shape[1])
+    try:
+        reference = time_parameterize(joints, waypoints, max_velocity, max_acceleration)
+    except PlanningFailed as exc:
+        with pytest.raises(PlanningFailed, match=re.escape(str(exc))):
+            time_parameterize(joints, waypoints, max_velocity, max_acceleration, speeds=compiled.fastest_speeds)
+        return
+    twin = time_parameterize(joints, waypoints, max_velocity, max_acceleration, speeds=compiled.fastest_speeds)
+    for field in ("times_s", "positions", "velocities", "accelerations"):
+        assert np.array_equal(getattr(twin, field), getattr(reference, field)), field
 
 
 def stop_at_every_waypoint_s(waypoints: np.ndarray, max_velocity: np.ndarray, max_acceleration: np.ndarray) -> float:

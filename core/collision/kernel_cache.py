@@ -19,10 +19,10 @@ from pathlib import Path
 
 __all__ = ["kernels_cached"]
 
-_HERE = Path(__file__).resolve().parent
-_ENTRY_POINTS = {"_kernels.py": ("classify", "edge"), "_clearance.py": ("certify",),
-                 "_states.py": ("trajectory_states",)}
-"""The kernels a filter calls from Python, by source file; numba caches each under its own index."""
+_CORE = Path(__file__).resolve().parent.parent
+_ENTRY_POINTS = {"collision/_kernels.py": ("classify", "edge"), "collision/_clearance.py": ("certify",),
+                 "collision/_states.py": ("trajectory_states",), "timing/_compiled.py": ("_speeds",)}
+"""The kernels a filter loads, called from Python, by source file under core/; numba caches each under its own index."""
 
 
 @cache
@@ -32,13 +32,13 @@ def kernels_cached() -> bool:
     False where it cannot tell (numba's user-wide cache, an unreadable index): the caller then
     treats the kernels as uncompiled, which costs speed, never a wrong answer.
     """
-    folder = _cache_folder()
-    if folder is None:
-        return False
     try:
         version = metadata.version("numba")
         for name, functions in _ENTRY_POINTS.items():
-            source = _HERE / name
+            source = _CORE / name
+            folder = _cache_folder(source.parent)
+            if folder is None:
+                return False
             text = source.read_bytes()
             stamp, lines = hashlib.sha256(text).digest(), _first_lines(text)
             for function in functions:
@@ -51,14 +51,13 @@ def kernels_cached() -> bool:
     return True
 
 
-def _cache_folder() -> Path | None:
-    """Return the folder numba caches this package's kernels in (its first two locators), or None."""
+def _cache_folder(package: Path) -> Path | None:
+    """Return the folder numba caches the kernels of a package folder in (its first two locators), or None."""
     configured = os.environ.get("NUMBA_CACHE_DIR")
     if configured:
-        folder = str(_HERE)
-        return Path(configured) / f"{_HERE.name}_{hashlib.sha1(folder.encode()).hexdigest()}"
-    if os.access(_HERE, os.W_OK):
-        return _HERE / "__pycache__"
+        return Path(configured) / f"{package.name}_{hashlib.sha1(str(package).encode()).hexdigest()}"
+    if os.access(package, os.W_OK):
+        return package / "__pycache__"
     return None
 
 

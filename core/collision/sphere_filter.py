@@ -111,6 +111,11 @@ class SphereFilter:
             still = np.zeros((2, robot.dof))
             self.trajectory_states(JointTrajectory(robot.joint_names, np.array([0.0, 1.0]), still, still, still),
                                    np.ones(robot.dof), 1.0)
+            # A plan with a filter times its paths with the compiled passes too (core/pipeline/step.py).
+            from ..timing import _compiled as timing_kernels
+
+            timing_kernels.fastest_speeds(np.array([0.0, 1.0]), np.ones((3, 1)), np.zeros((3, 1)), np.array([True]),
+                                          np.ones(1), np.ones(1))
 
     def classify(
         self, values: NDArray[np.float64], stop: bool = False

@@ -29,7 +29,7 @@ from ..errors import PlanningFailed
 from ..trajectory import quintic_peak_rates
 from ..types import JointTrajectory, frozen_array
 from .blends import BlendedPath, blended_path, distinct_waypoints
-from .topp import SpeedProfile, fastest_speeds
+from .topp import SpeedProfile, SpeedSolver, fastest_speeds
 
 __all__ = ["rest_to_rest", "time_parameterize"]
 
@@ -59,6 +59,7 @@ def time_parameterize(
     max_velocity: NDArray[np.float64],
     max_acceleration: NDArray[np.float64],
     max_step: float = 0.05,
+    speeds: SpeedSolver = fastest_speeds,
 ) -> JointTrajectory:
     """Return a near time-optimal trajectory along `waypoints` within the (already scaled) limits.
 
@@ -74,6 +75,8 @@ def time_parameterize(
         max_step: Corners are rounded within 0.44 of a step from their waypoint, the
             segments divided into equal steps of at most max_step [rad] in every joint:
             closer to the polyline than a cubic spline through those steps.
+        speeds: Solves for the time-optimal speeds: `topp.fastest_speeds`, or its compiled twin,
+            which gives the same numbers where numba is loaded already.
 
     Raises:
         PlanningFailed: If a shape is wrong, a waypoint is not finite, a limit or max_step is
@@ -86,7 +89,7 @@ def time_parameterize(
     if len(distinct) == 1:
         return _nudge(joint_names, points[0], points[-1], max_velocity, max_acceleration)
     path = blended_path(distinct, max_step, _CORNER_FRACTION)
-    profile, law = _optimal_law(path, points, max_velocity, max_acceleration)
+    profile, law = _optimal_law(path, points, max_velocity, max_acceleration, speeds)
     changes = law.changes()
     _check_duration(float(changes[-1]), "at least")
     # |dq/ds| <= 1: no joint moves faster than the top path speed.
@@ -101,7 +104,7 @@ def time_parameterize(
 
 def _optimal_law(
     path: BlendedPath, points: NDArray[np.float64], max_velocity: NDArray[np.float64],
-    max_acceleration: NDArray[np.float64],
+    max_acceleration: NDArray[np.float64], speeds: SpeedSolver,
 ) -> tuple[SpeedProfile, _TimeLaw]:
     """Return the time-optimal speeds along `path` and the time law that follows them."""
     grid, straight = _grid(path)
@@ -110,7 +113,7 @@ def _optimal_law(
     first, second = path.derivatives(points_and_middles)
     try:
         # A grid interval crossed in less than a knot gap would go without a knot of its own.
-        profile = fastest_speeds(grid, first, second, straight, max_velocity, max_acceleration, _MIN_KNOT_GAP_S)
+        profile = speeds(grid, first, second, straight, max_velocity, max_acceleration, _MIN_KNOT_GAP_S)
         return profile, _TimeLaw.of(profile)
     except PlanningFailed:
         # Limits so small that the squared path speeds underflow make the path look blocked.

@@ -15,6 +15,7 @@ between grid points within a fraction of a percent of the limits on a smooth pat
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,9 +24,9 @@ from numpy.typing import NDArray
 from ..errors import PlanningFailed
 from ..types import frozen_array
 
-__all__ = ["SpeedProfile", "fastest_speeds"]
+__all__ = ["STILL", "SpeedProfile", "SpeedSolver", "fastest_speeds"]
 
-_STILL = 1e-9  # |dq/ds| below this: the joint does not move along the path there
+STILL = 1e-9  # |dq/ds| below this: the joint does not move along the path there
 
 
 @dataclass(frozen=True)
@@ -44,6 +45,10 @@ class SpeedProfile:
         s = frozen_array(self.s, (None,), "s")
         object.__setattr__(self, "s", s)
         object.__setattr__(self, "squared_speeds", frozen_array(self.squared_speeds, s.shape, "squared_speeds"))
+
+
+SpeedSolver = Callable[..., SpeedProfile]
+"""`fastest_speeds`, or its compiled twin (core/timing/_compiled.py): the same arguments and result."""
 
 
 # A joint at rest along the path (a derivative of 0), or with a limit so large that its square
@@ -110,7 +115,7 @@ def _step_lines(
     size = np.abs(d1)
     reach = max_acceleration / size  # A: the bound on u at x = 0
     slope = d2 / d1  # B: how x shifts the bound on u
-    still = size <= _STILL
+    still = size <= STILL
     if still.any():
         # The joint's velocity is 0 there: its acceleration q'' x bounds x alone.
         cap = np.minimum(cap, np.where(still, max_acceleration / np.abs(d2), np.inf).min(axis=(1, 2)))
