@@ -336,14 +336,14 @@ def _quintic(
     a1: NDArray[np.float64],
 ) -> NDArray[np.float64]:
     """Return c3, c4, c5 (stacked) of the quintic with c0..c2 = p0, v0, a0 / 2 reaching p0 + dp, v1, a1 after h."""
+    # Written out rather than as a matrix product: BLAS may sum in any order (and fuse), which would
+    # make a plan's last bits depend on the machine, and the compiled twin (core/timing/_compiled.py)
+    # could not repeat them.
     h2 = h * h
-    terms = np.stack((dp, v0 * h, v1 * h, a0 * h2, a1 * h2))
-    scaled: NDArray[np.float64] = np.dot(_QUINTIC, terms.reshape(5, -1)).reshape(terms[:3].shape)
-    return scaled / np.stack((2 * h2 * h, 2 * h2 * h2, 2 * h2 * h2 * h))
-
-
-# c3 h^3, c4 h^4, c5 h^5 times 2, from dp, v0 h, v1 h, a0 h^2, a1 h^2.
-_QUINTIC = np.array([[20.0, -12.0, -8.0, -3.0, 1.0], [-30.0, 16.0, 14.0, 3.0, -2.0], [12.0, -6.0, -6.0, -1.0, 1.0]])
+    v0, v1, a0, a1 = v0 * h, v1 * h, a0 * h2, a1 * h2
+    return np.stack(((20.0 * dp - 12.0 * v0 - 8.0 * v1 - 3.0 * a0 + a1) / (2 * h2 * h),
+                     (-30.0 * dp + 16.0 * v0 + 14.0 * v1 + 3.0 * a0 - 2.0 * a1) / (2 * h2 * h2),
+                     (12.0 * dp - 6.0 * v0 - 6.0 * v1 - a0 + a1) / (2 * h2 * h2 * h)))
 
 
 def straight_states(a: NDArray[np.float64], b: NDArray[np.float64], count: int) -> NDArray[np.float64]:

@@ -14,7 +14,6 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from moveplan.core.errors import PlanningFailed
-from moveplan.core.timing import _compiled as compiled
 from moveplan.core.timing import time_parameterize
 from moveplan.core.trajectory import peak_rates, sample
 from moveplan.core.types import JointTrajectory
@@ -214,9 +213,9 @@ def test_the_compiled_speeds_give_the_same_trajectory_to_the_bit(case: Case) -> 
         reference = time_parameterize(joints, waypoints, max_velocity, max_acceleration)
     except PlanningFailed as exc:
         with pytest.raises(PlanningFailed, match=re.escape(str(exc))):
-            time_parameterize(joints, waypoints, max_velocity, max_acceleration, speeds=compiled.fastest_speeds)
+            time_parameterize(joints, waypoints, max_velocity, max_acceleration, compiled=True)
         return
-    twin = time_parameterize(joints, waypoints, max_velocity, max_acceleration, speeds=compiled.fastest_speeds)
+    twin = time_parameterize(joints, waypoints, max_velocity, max_acceleration, compiled=True)
     for field in ("times_s", "positions", "velocities", "accelerations"):
         assert np.array_equal(getattr(twin, field), getattr(reference, field)), field
 

@@ -21,7 +21,7 @@ __all__ = ["kernels_cached"]
 
 _CORE = Path(__file__).resolve().parent.parent
 _ENTRY_POINTS = {"collision/_kernels.py": ("classify", "edge"), "collision/_clearance.py": ("certify",),
-                 "collision/_states.py": ("trajectory_states",), "timing/_compiled.py": ("_speeds",)}
+                 "collision/_states.py": ("trajectory_states",), "timing/_compiled.py": ("_speeds", "_peaks")}
 """The kernels a filter loads, called from Python, by source file under core/; numba caches each under its own index."""
 
 

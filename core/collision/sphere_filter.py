@@ -116,6 +116,7 @@ class SphereFilter:
 
             timing_kernels.fastest_speeds(np.array([0.0, 1.0]), np.ones((3, 1)), np.zeros((3, 1)), np.array([True]),
                                           np.ones(1), np.ones(1))
+            timing_kernels.quintic_peak_rates(np.array([0.0, 1.0]), still, still, still)
 
     def classify(
         self, values: NDArray[np.float64], stop: bool = False

@@ -27,7 +27,6 @@ from ..planning.cartesian import straight_line
 from ..planning.goals import check_limits, joint_target, orientation_tolerance, pose_error, tip_target
 from ..planning.search import PathResult, Validity, plan_path, repair_path
 from ..timing import rest_to_rest, time_parameterize
-from ..timing.topp import SpeedSolver, fastest_speeds
 from ..types import JointTrajectory, StepResult
 from .request import PlanRequest
 
@@ -221,7 +220,8 @@ class _Certifier:
         """Return the path timed (resampled every `max_step` [rad]) and its first colliding state, if any."""
         mark = time.perf_counter()
         trajectory = time_parameterize(self.robot.joint_names, path.waypoints, self.settings.max_velocity,
-                                       self.settings.max_acceleration, max_step=max_step, speeds=self._speeds())
+                                       self.settings.max_acceleration, max_step=max_step,
+                                       compiled=isinstance(self.checks.spheres, SphereFilter))
         timed = time.perf_counter()
         hit = self.checks.first_collision_on_trajectory(trajectory)
         self._add(path, timed - mark, time.perf_counter() - timed)
@@ -244,17 +244,6 @@ class _Certifier:
             pair = self.checks.colliding_pair(hit) or ("?", "?")
             raise PlanningFailed(f"the timed trajectory collides ({pair[0]} touches {pair[1]}) where the path did not")
         return trajectory
-
-    def _speeds(self) -> SpeedSolver:
-        """Return the compiled time-optimal speeds where the sphere filter has loaded numba, else numpy's.
-
-        Both give the same numbers to the bit: the file is the same either way.
-        """
-        if not isinstance(self.checks.spheres, SphereFilter):
-            return fastest_speeds
-        from ..timing._compiled import fastest_speeds as compiled  # numba: loaded with the filter's kernels
-
-        return compiled
 
     def _add(self, path: PathResult, timing_s: float, certify_s: float) -> None:
         """Add one attempt's times to the step's statistics."""

@@ -1,9 +1,9 @@
-"""core/timing/topp.py `fastest_speeds`, compiled (numba): the same numbers to the bit, a tenth of the time.
+"""Compiled twins (numba) of core/timing/topp.py `fastest_speeds` and core/trajectory.py `quintic_peak_rates`.
 
-numpy's version spends a twelfth of a median MotionBenchMaker plan step in array calls on a few
-hundred numbers and in plain Python loops. This one repeats each of its floating-point
-operations in the same order (numba, like numpy, contracts nothing into fused multiply-adds),
-so a plan is byte for byte the same whichever runs; tests/test_topp.py holds them together.
+numpy's versions spend a sixth of a median MotionBenchMaker plan step in array calls on a few
+hundred numbers and in plain Python loops. These repeat each of their floating-point operations
+in the same order (numba, like numpy, contracts nothing into fused multiply-adds), so a plan is
+byte for byte the same whichever runs; tests/test_timing_properties.py holds them together.
 Imported only once the sphere filter has loaded numba (core/pipeline/step.py).
 """
 
@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from ..errors import PlanningFailed
 from .topp import STILL, SpeedProfile
 
-__all__ = ["fastest_speeds"]
+__all__ = ["fastest_speeds", "quintic_peak_rates"]
 
 
 def fastest_speeds(
@@ -37,6 +37,15 @@ def fastest_speeds(
     if not finite:
         raise PlanningFailed("time parameterisation found no motion along the path within the limits")
     return SpeedProfile(s, squared)
+
+
+def quintic_peak_rates(
+    knots: NDArray[np.float64], p: NDArray[np.float64], v: NDArray[np.float64], a: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Return trajectory.quintic_peak_rates(...) (same arguments, same result), computed by compiled code."""
+    if len(knots) == 1:
+        return np.abs(v[0]), np.abs(a[0])
+    return _peaks(*(_plain(x, np.float64) for x in (knots, p, v, a)))  # type: ignore[no-any-return]
 
 
 def _plain(values: NDArray[Any], dtype: type) -> NDArray[Any]:
@@ -154,3 +163,76 @@ def _speeds(grid: Any, first: Any, second: Any, max_velocity: Any, max_accelerat
     for k in range(1, len(s)):
         keep[k] = s[k] > s[k - 1]
     return s[keep], squared[keep], True
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _peaks(knots: Any, p: Any, v: Any, a: Any) -> Any:
+    """Return per joint the largest |velocity| and |acceleration| of the quintics (trajectory.quintic_peak_rates)."""
+    segments, n = len(knots) - 1, p.shape[1]
+    at = np.zeros((4, segments, n))  # 0, the jerk's zeros in the segment (else 0), h
+    acc, vel = np.empty((4, segments, n)), np.empty((4, segments, n))
+    higher = np.empty((3, segments, n))  # the acceleration's coefficients of x^1..3
+    for s in range(segments):
+        h = knots[s + 1] - knots[s]
+        h2 = h * h
+        for j in range(n):
+            dp, v0, v1, a0, a1 = p[s + 1, j] - p[s, j], v[s, j] * h, v[s + 1, j] * h, a[s, j] * h2, a[s + 1, j] * h2
+            j0 = (20.0 * dp - 12.0 * v0 - 8.0 * v1 - 3.0 * a0 + a1) / (2 * h2 * h) * 6.0
+            j1 = (-30.0 * dp + 16.0 * v0 + 14.0 * v1 + 3.0 * a0 - 2.0 * a1) / (2 * h2 * h2) * 24.0
+            j2 = (12.0 * dp - 6.0 * v0 - 6.0 * v1 - a0 + a1) / (2 * h2 * h2 * h) * 60.0
+            higher[0, s, j], higher[1, s, j], higher[2, s, j] = j0 / 1.0, j1 / 2.0, j2 / 3.0
+            root = np.sqrt(j1 * j1 - 4 * j2 * j0)
+            q = -0.5 * (j1 + np.copysign(root, j1))
+            r1, r2 = q / j2, j0 / q
+            r1 = r1 if (r1 > 0.0) and (r1 < h) else 0.0
+            r2 = r2 if (r2 > 0.0) and (r2 < h) else 0.0
+            at[1, s, j], at[2, s, j], at[3, s, j] = np.minimum(r1, r2), np.maximum(r1, r2), h
+            ha1, ha2, ha3 = higher[0, s, j], higher[1, s, j], higher[2, s, j]
+            hv2, hv3, hv4 = ha1 / 2.0, ha2 / 3.0, ha3 / 4.0
+            acc[0, s, j], vel[0, s, j] = a[s, j], v[s, j]
+            acc[3, s, j], vel[3, s, j] = a[s + 1, j], v[s + 1, j]
+            for k in (1, 2):
+                x = at[k, s, j]
+                acc[k, s, j] = ((ha3 * x + ha2) * x + ha1) * x + a[s, j]
+                vel[k, s, j] = (((hv4 * x + hv3) * x + hv2) * x + a[s, j]) * x + v[s, j]
+    peak_v, peak_a = np.zeros(n), np.zeros(n)
+    for k in range(4):
+        for s in range(segments):
+            for j in range(n):
+                peak_a[j] = max(peak_a[j], abs(acc[k, s, j]))
+                peak_v[j] = max(peak_v[j], abs(vel[k, s, j]))
+    # A bracket whose velocity cannot beat the joint's peak by more than rounding needs no search.
+    found = peak_v.copy()
+    for k in range(3):
+        for s in range(segments):
+            for j in range(n):
+                reach = max(abs(vel[k, s, j]), abs(vel[k + 1, s, j])) + max(abs(acc[k, s, j]), abs(acc[k + 1, s, j])) \
+                    * (at[k + 1, s, j] - at[k, s, j])
+                if acc[k, s, j] * acc[k + 1, s, j] < 0.0 and reach > peak_v[j] * (1.0 + 1e-12):
+                    extreme = abs(_velocity_extreme(v[s, j], a[s, j], higher[0, s, j], higher[1, s, j], higher[2, s, j],
+                                                    at[k, s, j], at[k + 1, s, j], acc[k, s, j], acc[k + 1, s, j]))
+                    found[j] = _max(found[j], extreme)
+    return found, peak_a
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _velocity_extreme(v0: float, a0: float, a1: float, a2: float, a3: float, lo: float, hi: float, f_lo: float,
+                      f_hi: float) -> float:
+    """Return the velocity where the acceleration is 0 in its bracket (trajectory._velocity_extreme, step for step)."""
+    x = lo - f_lo * (hi - lo) / (f_hi - f_lo)
+    rising = f_hi > 0.0
+    tolerance = 1e-7 * (hi - lo)
+    for _ in range(64):
+        f = a0 + x * (a1 + x * (a2 + x * a3))
+        if (f < 0.0) == rising:
+            lo = x
+        else:
+            hi = x
+        jerk = a1 + x * (2 * a2 + x * (3 * a3))
+        newton = x - f / jerk if jerk else np.inf
+        step = newton if lo <= newton <= hi else (lo + hi) / 2
+        converged = abs(step - x) <= tolerance
+        x = step
+        if converged:
+            break
+    return v0 + x * (a0 + x * (a1 / 2 + x * (a2 / 3 + x * (a3 / 4))))

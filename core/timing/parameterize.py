@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,7 +30,7 @@ from ..errors import PlanningFailed
 from ..trajectory import quintic_peak_rates
 from ..types import JointTrajectory, frozen_array
 from .blends import BlendedPath, blended_path, distinct_waypoints
-from .topp import SpeedProfile, SpeedSolver, fastest_speeds
+from .topp import SpeedProfile, fastest_speeds
 
 __all__ = ["rest_to_rest", "time_parameterize"]
 
@@ -59,7 +60,7 @@ def time_parameterize(
     max_velocity: NDArray[np.float64],
     max_acceleration: NDArray[np.float64],
     max_step: float = 0.05,
-    speeds: SpeedSolver = fastest_speeds,
+    compiled: bool = False,
 ) -> JointTrajectory:
     """Return a near time-optimal trajectory along `waypoints` within the (already scaled) limits.
 
@@ -75,8 +76,8 @@ def time_parameterize(
         max_step: Corners are rounded within 0.44 of a step from their waypoint, the
             segments divided into equal steps of at most max_step [rad] in every joint:
             closer to the polyline than a cubic spline through those steps.
-        speeds: Solves for the time-optimal speeds: `topp.fastest_speeds`, or its compiled twin,
-            which gives the same numbers where numba is loaded already.
+        compiled: Use the compiled twins of the speed and peak computations (core/timing/_compiled.py):
+            the same trajectory to the bit, in less time where numba is loaded already.
 
     Raises:
         PlanningFailed: If a shape is wrong, a waypoint is not finite, a limit or max_step is
@@ -89,6 +90,12 @@ def time_parameterize(
     if len(distinct) == 1:
         return _nudge(joint_names, points[0], points[-1], max_velocity, max_acceleration)
     path = blended_path(distinct, max_step, _CORNER_FRACTION)
+    if compiled:
+        from . import _compiled as twins  # numba: loaded already with the sphere filter's kernels
+
+        speeds, peaks = twins.fastest_speeds, twins.quintic_peak_rates
+    else:
+        speeds, peaks = fastest_speeds, quintic_peak_rates
     profile, law = _optimal_law(path, points, max_velocity, max_acceleration, speeds)
     changes = law.changes()
     _check_duration(float(changes[-1]), "at least")
@@ -99,12 +106,12 @@ def time_parameterize(
     times = every[knots]
     s, speed, acceleration = law.smoothed(every)
     positions, v, a = _sampled(path, s[knots], speed[knots], acceleration[knots], points[[0, -1]])
-    return _within_limits(joint_names, times, positions, v, a, max_velocity, max_acceleration)
+    return _within_limits(joint_names, times, positions, v, a, max_velocity, max_acceleration, peaks)
 
 
 def _optimal_law(
     path: BlendedPath, points: NDArray[np.float64], max_velocity: NDArray[np.float64],
-    max_acceleration: NDArray[np.float64], speeds: SpeedSolver,
+    max_acceleration: NDArray[np.float64], speeds: Callable[..., SpeedProfile],
 ) -> tuple[SpeedProfile, _TimeLaw]:
     """Return the time-optimal speeds along `path` and the time law that follows them."""
     grid, straight = _grid(path)
@@ -127,10 +134,10 @@ def _optimal_law(
 def _within_limits(
     joint_names: tuple[str, ...], times: NDArray[np.float64], positions: NDArray[np.float64],
     v: NDArray[np.float64], a: NDArray[np.float64], max_velocity: NDArray[np.float64],
-    max_acceleration: NDArray[np.float64],
+    max_acceleration: NDArray[np.float64], peaks: Callable[..., tuple[NDArray[np.float64], NDArray[np.float64]]],
 ) -> JointTrajectory:
     """Return the knots slowed by the one factor that brings their quintics within the limits, in whole ns."""
-    peak_v, peak_a = quintic_peak_rates(times, positions, v, a)
+    peak_v, peak_a = peaks(times, positions, v, a)
     excess = max(1.0, float((peak_v / max_velocity).max()), math.sqrt(float((peak_a / max_acceleration).max())))
     if excess > 1.0:
         logger.debug("interpolated trajectory peaks at %.4f of a limit; slowing it by %.4f", excess**2, excess)

@@ -15,7 +15,6 @@ between grid points within a fraction of a percent of the limits on a smooth pat
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,7 +23,7 @@ from numpy.typing import NDArray
 from ..errors import PlanningFailed
 from ..types import frozen_array
 
-__all__ = ["STILL", "SpeedProfile", "SpeedSolver", "fastest_speeds"]
+__all__ = ["STILL", "SpeedProfile", "fastest_speeds"]
 
 STILL = 1e-9  # |dq/ds| below this: the joint does not move along the path there
 
@@ -45,10 +44,6 @@ class SpeedProfile:
         s = frozen_array(self.s, (None,), "s")
         object.__setattr__(self, "s", s)
         object.__setattr__(self, "squared_speeds", frozen_array(self.squared_speeds, s.shape, "squared_speeds"))
-
-
-SpeedSolver = Callable[..., SpeedProfile]
-"""`fastest_speeds`, or its compiled twin (core/timing/_compiled.py): the same arguments and result."""
 
 
 # A joint at rest along the path (a derivative of 0), or with a limit so large that its square
