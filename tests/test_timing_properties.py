@@ -5,6 +5,7 @@ from __future__ import annotations
 import logging
 import math
 import re
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -175,18 +176,17 @@ def as_case(case: tuple[list[list[float]], list[float], list[float]]) -> Case:
     return np.array(case[0]), np.array(case[1]), np.array(case[2])
 
 
+def hand_picked(test: Callable[[Case], None]) -> Callable[[Case], None]:
+    """Return `test` with the hand-picked cases above added to hypothesis's."""
+    for case in (SLOW_JOINT, REVERSAL, SLOW_CORNER, REPEATS, NUDGE, HUGE_ACCELERATION, ROUNDING, LONG, CORNER_DIP):
+        test = example(as_case(case))(test)
+    return test
+
+
 @PROPERTIES
 @seed(20261125)
 @given(cases())
-@example(as_case(SLOW_JOINT))
-@example(as_case(REVERSAL))
-@example(as_case(SLOW_CORNER))
-@example(as_case(REPEATS))
-@example(as_case(NUDGE))
-@example(as_case(HUGE_ACCELERATION))
-@example(as_case(ROUNDING))
-@example(as_case(LONG))
-@example(as_case(CORNER_DIP))
+@hand_picked
 def test_any_polyline_within_any_limits_gives_a_valid_trajectory(case: Case) -> None:
     waypoints, max_velocity, max_acceleration = case
     trajectory = time_parameterize(names(waypoints.shape[1]), waypoints, max_velocity, max_acceleration)
@@ -196,16 +196,8 @@ def test_any_polyline_within_any_limits_gives_a_valid_trajectory(case: Case) -> 
 @settings(PROPERTIES, max_examples=300)
 @seed(20261125)
 @given(cases())
-@example(as_case(SLOW_JOINT))
-@example(as_case(REVERSAL))
-@example(as_case(SLOW_CORNER))
-@example(as_case(REPEATS))
-@example(as_case(NUDGE))
-@example(as_case(HUGE_ACCELERATION))
-@example(as_case(ROUNDING))
-@example(as_case(LONG))
-@example(as_case(CORNER_DIP))
-def test_the_compiled_speeds_give_the_same_trajectory_to_the_bit(case: Case) -> None:
+@hand_picked
+def test_the_compiled_twins_give_the_same_trajectory_to_the_bit(case: Case) -> None:
     # A plan's file must not depend on whether the sphere filter had loaded numba.
     waypoints, max_velocity, max_acceleration = case
     joints = names(waypoints.shape[1])

@@ -21,7 +21,8 @@ __all__ = ["kernels_cached"]
 
 _CORE = Path(__file__).resolve().parent.parent
 _ENTRY_POINTS = {"collision/_kernels.py": ("classify", "edge"), "collision/_clearance.py": ("certify",),
-                 "collision/_states.py": ("trajectory_states",), "timing/_compiled.py": ("_speeds", "_peaks")}
+                 "collision/_states.py": ("trajectory_states",), "timing/_compiled.py": ("_speeds", "_peaks"),
+                 "trajectory.py": ("_velocity_extreme",)}
 """The kernels a filter loads, called from Python, by source file under core/; numba caches each under its own index."""
 
 

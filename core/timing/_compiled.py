@@ -15,6 +15,7 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import trajectory
 from ..errors import PlanningFailed
 from .topp import STILL, SpeedProfile
 
@@ -56,6 +57,10 @@ def _plain(values: NDArray[Any], dtype: type) -> NDArray[Any]:
     if values.dtype == dtype and values.flags.c_contiguous and values.flags.writeable:
         return values
     return np.array(values, dtype=dtype, order="C")
+
+
+# The Newton search is plain Python on floats: numba compiles the very function numpy's version calls.
+_velocity_extreme = numba.njit(cache=True, error_model="numpy")(trajectory._velocity_extreme)
 
 
 # Python's min and max, which numpy's passes use on floats: the first argument on a tie.
@@ -213,26 +218,3 @@ def _peaks(knots: Any, p: Any, v: Any, a: Any) -> Any:
                                                     at[k, s, j], at[k + 1, s, j], acc[k, s, j], acc[k + 1, s, j]))
                     found[j] = _max(found[j], extreme)
     return found, peak_a
-
-
-@numba.njit(cache=True, error_model="numpy")
-def _velocity_extreme(v0: float, a0: float, a1: float, a2: float, a3: float, lo: float, hi: float, f_lo: float,
-                      f_hi: float) -> float:
-    """Return the velocity where the acceleration is 0 in its bracket (trajectory._velocity_extreme, step for step)."""
-    x = lo - f_lo * (hi - lo) / (f_hi - f_lo)
-    rising = f_hi > 0.0
-    tolerance = 1e-7 * (hi - lo)
-    for _ in range(64):
-        f = a0 + x * (a1 + x * (a2 + x * a3))
-        if (f < 0.0) == rising:
-            lo = x
-        else:
-            hi = x
-        jerk = a1 + x * (2 * a2 + x * (3 * a3))
-        newton = x - f / jerk if jerk else np.inf
-        step = newton if lo <= newton <= hi else (lo + hi) / 2
-        converged = abs(step - x) <= tolerance
-        x = step
-        if converged:
-            break
-    return v0 + x * (a0 + x * (a1 / 2 + x * (a2 / 3 + x * (a3 / 4))))
