@@ -10,7 +10,7 @@ from typing import Any
 import numba
 import numpy as np
 
-from ._kernels import _inside, forward, gap, place, place_owner, tabled, unpack
+from ._kernels import _inside, apart, forward, gap, place, place_owner, tabled, unpack
 from ._verdicts import CLEAR
 
 __all__ = ["certify", "clearance"]
@@ -21,13 +21,6 @@ def distance(kind: int, centre: Any, rot: Any, size: Any, p: Any) -> float:
     """Return the distance [m] from point `p` to an obstacle (box, sphere, cylinder; 0 inside it)."""
     radius = size[0] if kind == 1 else 0.0  # gap of a sphere obstacle: from its centre, less its radius
     return max(np.sqrt(gap(kind, centre, rot, size, p, 0.0) + radius * radius) - radius, 0.0)
-
-
-@numba.njit(cache=True)
-def apart(p: Any, r: Any, reach: float) -> bool:
-    """Return True if points `p` and `r` are farther apart than `reach`."""
-    dx, dy, dz = p[0] - r[0], p[1] - r[1], p[2] - r[2]
-    return dx * dx + dy * dy + dz * dz > reach * reach
 
 
 @numba.njit(cache=True, inline="always")
@@ -46,7 +39,7 @@ def clearance(q: Any, model: Any, cap: float, scratch: Any) -> tuple[int, float]
     _, joints, spheres, owners, _, pairs, obstacles, check = model
     centres, radii, sjoint, start = spheres
     ojoint, ocentre, oradius = owners
-    okind, opos, orot, osize, _ = obstacles
+    okind, opos, orot, osize, _, oball = obstacles
     forward(q, joints, rot, pos, local)
     place(ocentre, ojoint, rot, pos, owc)
     placed[:] = False
@@ -55,7 +48,8 @@ def clearance(q: Any, model: Any, cap: float, scratch: Any) -> tuple[int, float]
     # from everything, and an owner's bounding ball is no nearer than its spheres.
     for o in range(len(oradius)):
         for b in range(len(okind)):
-            if not check[o, b] or gap(okind[b], opos[b], orot[b], osize[b], owc[o], oradius[o] + best) > 0.0:
+            if not check[o, b] or apart(owc[o], opos[b], oradius[o] + best + oball[b]) \
+                    or gap(okind[b], opos[b], orot[b], osize[b], owc[o], oradius[o] + best) > 0.0:
                 continue
             place_owner(o, start, sjoint, centres, rot, pos, world, placed)
             for s in range(start[o], start[o + 1]):

@@ -44,6 +44,13 @@ def gap(kind: int, centre: Any, rot: Any, size: Any, p: Any, radius: float) -> f
 
 
 @numba.njit(cache=True)
+def apart(p: Any, r: Any, reach: float) -> bool:
+    """Return True if points `p` and `r` are farther apart than `reach`."""
+    dx, dy, dz = p[0] - r[0], p[1] - r[1], p[2] - r[2]
+    return dx * dx + dy * dy + dz * dz > reach * reach
+
+
+@numba.njit(cache=True)
 def tabled(q: Any, tables: Any) -> int:
     """Return CLEAR if every tabulated pair is apart at `q`, COLLIDES if one surely touches, else MAYBE."""
     axes, start, step, count, offset, margin, distance = tables
@@ -165,7 +172,7 @@ def judge(values: Any, stop: bool, base: Any, group: Any, continuous: Any, model
     tables, joints, spheres, owners, inner, pairs, obstacles, check = model
     centres, radii, sjoint, start = spheres
     ojoint, ocentre, oradius = owners
-    okind, opos, orot, osize, _ = obstacles
+    okind, opos, orot, osize, _, oball = obstacles
     nj = len(joints[0])
     rot, pos = np.empty((nj, 3, 3)), np.empty((nj, 3))
     world, iworld = np.empty((len(radii), 3)), np.empty((len(inner[1]), 3))
@@ -196,8 +203,8 @@ def judge(values: Any, stop: bool, base: Any, group: Any, continuous: Any, model
             if not free:
                 break
             for b in range(len(okind)):
-                if not check[o, b]:
-                    continue
+                if not check[o, b] or apart(owc[o], opos[b], oradius[o] + oball[b]):
+                    continue  # the ball around the obstacle first: a fifth of the cost of its exact gap
                 if gap(okind[b], opos[b], orot[b], osize[b], owc[o], oradius[o]) > 0.0:
                     continue
                 place_owner(o, start, sjoint, centres, rot, pos, world, placed)
@@ -241,12 +248,12 @@ def _inside(model: Any, rot: Any, pos: Any, iworld: Any, owc: Any) -> int:
     _, _, _, owners, inner, pairs, obstacles, check = model
     _, _, oradius = owners
     icentres, iradii, ijoint, istart = inner
-    okind, opos, orot, osize, osolid = obstacles
+    okind, opos, orot, osize, osolid, oball = obstacles
     # Most states the spheres cannot clear do collide: a ball inside a hull proves it cheaply.
     place(icentres, ijoint, rot, pos, iworld)
     for o in range(len(oradius)):
         for b in range(len(okind)):
-            if not (check[o, b] and osolid[b]):
+            if not (check[o, b] and osolid[b]) or apart(owc[o], opos[b], oradius[o] + oball[b]):
                 continue
             if gap(okind[b], opos[b], orot[b], osize[b], owc[o], oradius[o]) > 0.0:
                 continue
@@ -328,7 +335,7 @@ LAYOUT = (
     ("icentres", 2, False), ("iradii", 1, False), ("ijoint", 1, True), ("istart", 1, True),
     ("pairs", 2, True),
     ("okind", 1, True), ("opos", 2, False), ("orot", 3, False), ("osize", 2, False), ("osolid", 1, True),
-    ("check", 2, True),
+    ("check", 2, True), ("oball", 1, False),
 )
 
 
@@ -374,6 +381,6 @@ def unpack(f: Any, i: Any, h: Any) -> Any:
     spheres = (_2d(f, h[16]), _1d(f, h[17]), _1d(i, h[18]), _1d(i, h[19]))
     owners = (_1d(i, h[20]), _2d(f, h[21]), _1d(f, h[22]))
     inner = (_2d(f, h[23]), _1d(f, h[24]), _1d(i, h[25]), _1d(i, h[26]))
-    obstacles = (_1d(i, h[28]), _2d(f, h[29]), _3d(f, h[30]), _2d(f, h[31]), _1d(i, h[32]))
+    obstacles = (_1d(i, h[28]), _2d(f, h[29]), _3d(f, h[30]), _2d(f, h[31]), _1d(i, h[32]), _1d(f, h[34]))
     model = (tables, joints, spheres, owners, inner, _2d(i, h[27]), obstacles, _2d(i, h[33]))
     return _1d(f, h[0]), _1d(i, h[1]), _1d(i, h[2]), model

@@ -305,14 +305,15 @@ def _table_arrays(tables: list[PairTable]) -> dict[str, NDArray[Any]]:
 
 
 def _obstacles(world: list[CollisionObject]) -> dict[str, NDArray[Any]]:
-    """Return world obstacles as arrays: kind, centre, rotation, size, and whether each is that solid.
+    """Return world obstacles as arrays: kind, centre, rotation, size, whether each is that solid, and a ball's radius.
 
+    The ball, about the centre, encloses the obstacle: a sphere missing it misses the obstacle.
     Sizes: a box's half sides; a sphere's radius; a cylinder's radius and half length. A
     mesh is its bounding box, which is not solid: a ball touching it proves nothing.
     """
     from .checker import coal_geometry
 
-    kinds, centres, rotations, sizes = [], [], [], []
+    kinds, centres, rotations, sizes, balls = [], [], [], [], []
     solid = [obj.shape.kind in ("box", "sphere", "cylinder") for obj in world]
     for obj in world:
         shape, transform = obj.shape, np.asarray(obj.transform)
@@ -330,6 +331,7 @@ def _obstacles(world: list[CollisionObject]) -> dict[str, NDArray[Any]]:
             lo, hi = np.asarray(mesh.aabb_local.min_), np.asarray(mesh.aabb_local.max_)
             kind, size = _BOX, (hi - lo) / 2
             centre = centre + rotation @ ((hi + lo) / 2)
+        balls.append(float(np.linalg.norm(size)) if kind == _BOX else float(np.hypot(size[0], size[1])))
         kinds.append(kind)
         centres.append(centre)
         rotations.append(rotation)
@@ -337,5 +339,6 @@ def _obstacles(world: list[CollisionObject]) -> dict[str, NDArray[Any]]:
     count = len(world)
     return {"okind": np.array(kinds, dtype=np.int64), "opos": np.array(centres, dtype=float).reshape(count, 3),
             "orot": np.array(rotations, dtype=float).reshape(count, 3, 3),
-            "osize": np.array(sizes, dtype=float).reshape(count, 3), "osolid": np.array(solid, dtype=np.bool_)}
+            "osize": np.array(sizes, dtype=float).reshape(count, 3), "osolid": np.array(solid, dtype=np.bool_),
+            "oball": np.array(balls, dtype=float)}
 
