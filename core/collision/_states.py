@@ -1,10 +1,11 @@
 """The certified states of a timed trajectory, placed by compiled code (numba).
 
-The same computation as core/collision/certify.py `trajectory_states`, with the peak rates of
-core/trajectory.py `quintic_peak_rates` and the samples of its `sample`: numpy's version costs a
-tenth of a median MotionBenchMaker plan step in array calls on a few thousand numbers, this one a
-hundredth. The numbers agree to rounding (tests/test_certify_soundness.py); numpy's version is
-the reference, and the one used before the sphere filter (and numba) is loaded.
+The same computation as core/collision/certify.py `trajectory_states`, with the samples of
+core/trajectory.py `sample`; the peak rates come from timing's compiled twin, the numbers numpy's
+gives. numpy's version costs a tenth of a median MotionBenchMaker plan step in array calls on a
+few thousand numbers, this one a hundredth. The numbers agree to rounding
+(tests/test_certify_soundness.py); numpy's version is the reference, and the one used before the
+sphere filter (and numba) is loaded.
 """
 
 from __future__ import annotations
@@ -18,14 +19,15 @@ __all__ = ["trajectory_states"]
 
 
 @numba.njit(cache=True)
-def trajectory_states(knots: Any, p: Any, v: Any, a: Any, reach: Any, step: float, piece: int) -> Any:
+def trajectory_states(knots: Any, p: Any, v: Any, a: Any, peak_v: Any, peak_a: Any, reach: Any, step: float,
+                      piece: int) -> Any:
     """Return states along the controller's quintics through the points, at most `step` [m] of motion apart, and travel.
 
     As certify.trajectory_states: pieces of at most `piece` states at the peak speed, each with
     the speed bound (|v0| + |v1| + A h) / 2 of its ends; states at equal increments of its integral.
+    `peak_v` and `peak_a` are the joints' peak rates (trajectory.quintic_peak_rates, or its twin).
     """
     coefficients = _coefficients(knots, p, v, a)
-    peak_v, peak_a = _peak_rates(knots, coefficients, v, a)
     speed, accel = 0.0, 0.0
     for i in range(len(reach)):
         speed += peak_v[i] * reach[i]
@@ -105,74 +107,3 @@ def _coefficients(knots: Any, p: Any, v: Any, a: Any) -> Any:
             out[4, s, i] = (-30.0 * dp + 16.0 * v0 + 14.0 * v1 + 3.0 * a0 - 2.0 * a1) / (2 * h2 * h2)
             out[5, s, i] = (12.0 * dp - 6.0 * v0 - 6.0 * v1 - a0 + a1) / (2 * h2 * h2 * h)
     return out
-
-
-@numba.njit(cache=True)
-def _peak_rates(knots: Any, coefficients: Any, v: Any, a: Any) -> Any:
-    """Return per joint the largest |velocity| and |acceleration| of the quintics, as `quintic_peak_rates`.
-
-    The acceleration (a cubic) peaks at an end or where the jerk is 0; the velocity at an end or
-    where the acceleration is 0, found in each bracket between those points where it changes sign.
-    """
-    n = coefficients.shape[2]
-    peak_v, peak_a = np.abs(v[0]), np.abs(a[0])
-    at = np.empty(4)
-    for s in range(len(knots) - 1):
-        h = knots[s + 1] - knots[s]
-        for i in range(n):
-            c1, c2, c3, c4, c5 = (coefficients[1, s, i], coefficients[2, s, i], coefficients[3, s, i],
-                                  coefficients[4, s, i], coefficients[5, s, i])
-            j0, j1, j2 = 6.0 * c3, 24.0 * c4, 60.0 * c5  # the jerk, a quadratic
-            r1, r2 = _quadratic_roots(j2, j1, j0)
-            r1 = r1 if 0.0 < r1 < h else 0.0
-            r2 = r2 if 0.0 < r2 < h else 0.0
-            at[0], at[1], at[2], at[3] = 0.0, min(r1, r2), max(r1, r2), h
-            previous = 0.0
-            for k in range(4):
-                x = at[k]
-                # At the knots the segment meets its given velocity and acceleration; between, evaluate.
-                if k == 0:
-                    acc, vel = a[s, i], v[s, i]
-                elif k == 3:
-                    acc, vel = a[s + 1, i], v[s + 1, i]
-                else:
-                    acc = 2.0 * c2 + x * (6.0 * c3 + x * (12.0 * c4 + x * 20.0 * c5))
-                    vel = c1 + x * (2.0 * c2 + x * (3.0 * c3 + x * (4.0 * c4 + x * 5.0 * c5)))
-                peak_a[i] = max(peak_a[i], abs(acc))
-                peak_v[i] = max(peak_v[i], abs(vel))
-                if k > 0 and previous * acc < 0.0:
-                    peak_v[i] = max(peak_v[i], abs(_velocity_extreme(c1, c2, c3, c4, c5, at[k - 1], x, previous, acc)))
-                previous = acc
-    return peak_v, peak_a
-
-
-@numba.njit(cache=True)
-def _quadratic_roots(a: float, b: float, c: float) -> tuple[float, float]:
-    """Return the real roots of a x^2 + b x + c (NaN or inf where there are none), as core/trajectory.py does."""
-    discriminant = b * b - 4 * a * c
-    root = np.sqrt(discriminant) if discriminant >= 0.0 else np.nan
-    q = -0.5 * (b + (root if b >= 0.0 else -root))
-    return (q / a if a != 0.0 else np.inf), (c / q if q != 0.0 else np.inf)
-
-
-@numba.njit(cache=True)
-def _velocity_extreme(c1: float, c2: float, c3: float, c4: float, c5: float, lo: float, hi: float, f_lo: float,
-                      f_hi: float) -> float:
-    """Return the velocity where the acceleration, monotonic on [lo, hi] from f_lo to f_hi of the other sign, is 0."""
-    x = lo - f_lo * (hi - lo) / (f_hi - f_lo)  # false position: exact for a linear acceleration
-    rising = f_hi > 0.0
-    tolerance = 1e-7 * (hi - lo)  # the velocity is flat there: its error is ~1e-14 of its change
-    for _ in range(64):  # Newton converges in a few steps; bisection, its fallback, within 24
-        f = 2.0 * c2 + x * (6.0 * c3 + x * (12.0 * c4 + x * 20.0 * c5))
-        if (f < 0.0) == rising:
-            lo = x
-        else:
-            hi = x
-        jerk = 6.0 * c3 + x * (24.0 * c4 + x * 60.0 * c5)
-        newton = x - f / jerk if jerk != 0.0 else np.inf
-        step = newton if lo <= newton <= hi else (lo + hi) / 2
-        converged = abs(step - x) <= tolerance
-        x = step
-        if converged:
-            break
-    return c1 + x * (2.0 * c2 + x * (3.0 * c3 + x * (4.0 * c4 + x * 5.0 * c5)))

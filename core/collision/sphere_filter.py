@@ -88,10 +88,12 @@ class SphereFilter:
         self.tabulated = tuple((t.upper, t.lower) for t in tables)
         world = [obj for obj in objects if not obj.link]
         check = _world_checks(names, owner_joint, world, allowed)
+        from ..timing import _compiled as timing_kernels  # the peak rates the states are placed by
         from . import _clearance, _states  # numba too: the certification walk, the states it walks
         from . import _kernels as sphere_kernels  # numba: compiled once, then loaded from its disk cache
 
-        self._kernels, self._clearance, self._states = sphere_kernels, _clearance, _states
+        self._kernels, self._clearance, self._states, self._timing = sphere_kernels, _clearance, _states, \
+            timing_kernels
         base = robot.neutral() if base is None else base
         inner = inner_spheres(model, hulls or geometry, robot.config.urdf)
         # Packed once: the kernels run thousands of times per search, and a call costs per argument.
@@ -112,11 +114,8 @@ class SphereFilter:
             self.trajectory_states(JointTrajectory(robot.joint_names, np.array([0.0, 1.0]), still, still, still),
                                    np.ones(robot.dof), 1.0)
             # A plan with a filter times its paths with the compiled passes too (core/pipeline/step.py).
-            from ..timing import _compiled as timing_kernels
-
             timing_kernels.fastest_speeds(np.array([0.0, 1.0]), np.ones((3, 1)), np.zeros((3, 1)), np.array([True]),
                                           np.ones(1), np.ones(1))
-            timing_kernels.quintic_peak_rates(np.array([0.0, 1.0]), still, still, still)
 
     def classify(
         self, values: NDArray[np.float64], stop: bool = False
@@ -153,9 +152,10 @@ class SphereFilter:
         """
         if len(trajectory.times_s) == 1:
             return certify.trajectory_states(trajectory, reach_m, step_m)
-        return self._states.trajectory_states(*(_plain(x) for x in (
-            trajectory.times_s, trajectory.positions, trajectory.velocities, trajectory.accelerations, reach_m)),
-            step_m, certify.PIECE)
+        knots, p, v, a = (_plain(x) for x in (trajectory.times_s, trajectory.positions, trajectory.velocities,
+                                              trajectory.accelerations))
+        peak_v, peak_a = self._timing.quintic_peak_rates(knots, p, v, a)
+        return self._states.trajectory_states(knots, p, v, a, peak_v, peak_a, _plain(reach_m), step_m, certify.PIECE)
 
     def edge(
         self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, stop: bool = False
