@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import ROOT, Cli
+from conftest import REALWORLD, ROOT, Cli
 
 from moveplan.core.config.controllers import parse_controllers, parse_execution
 from moveplan.core.config.robot_config import load_robot_config
@@ -20,11 +20,8 @@ PLAN = ROOT / "samples" / "recordings" / "tool_up_plan.mcap"  # a UR10e plan
 
 @pytest.fixture(scope="module")
 def ur_controllers() -> Path:
-    """ur_robot_driver's ur_controllers.yaml in the real-world workspace; its absence is a failure, not a skip."""
-    workspace = Path(__file__).resolve().parents[2] / "shared" / "realworld" / "src"
-    path = workspace / "Universal_Robots_ROS2_Driver" / "ur_robot_driver" / "config" / "ur_controllers.yaml"
-    assert path.is_file(), f"the real-world MoveIt workspace is missing: {path}"
-    return path
+    """ur_robot_driver's ur_controllers.yaml in the real-world workspace."""
+    return REALWORLD / "Universal_Robots_ROS2_Driver" / "ur_robot_driver" / "config" / "ur_controllers.yaml"
 
 
 def one_line(result) -> str:  # noqa: ANN001 - click's Result
@@ -51,6 +48,7 @@ arm_controller:
 # --- ur_robot_driver's file ---------------------------------------------------------------------------
 
 
+@pytest.mark.realworld
 def test_ur_driver_controllers_load_with_tf_prefix_empty_by_default(ur_controllers: Path) -> None:
     controller = parse_controllers(ur_controllers)["joint_trajectory_controller"]
     assert controller.joints == UR_JOINTS
@@ -58,12 +56,14 @@ def test_ur_driver_controllers_load_with_tf_prefix_empty_by_default(ur_controlle
     assert controller.goal_tolerance["wrist_3_joint"] == 0.1
 
 
+@pytest.mark.realworld
 def test_ur_driver_controllers_take_tf_prefix_from_the_launch_args(ur_controllers: Path) -> None:
     controller = parse_controllers(ur_controllers, {"tf_prefix": "ur_"})["joint_trajectory_controller"]
     assert controller.joints == tuple(f"ur_{j}" for j in UR_JOINTS)
     assert controller.trajectory_tolerance["ur_elbow_joint"] == 0.2
 
 
+@pytest.mark.realworld
 def test_execute_with_the_ur_driver_controllers_file_succeeds(cli: Cli, ur_controllers: Path) -> None:
     code, document = cli.json("execute", PLAN, "--fake", "--controllers", ur_controllers)
     assert code == 0, document

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import ROOT, UR10E, Cli
+from conftest import REALWORLD, ROOT, UR10E, Cli
 
 from moveplan.core import bag as recording
 from moveplan.core.config.robot_config import load_robot_config
@@ -17,7 +17,6 @@ from moveplan.core.config.workspace import packages_under, workspace_src
 from moveplan.core.config.xacro import PackagePath
 from moveplan.core.errors import ConfigError, UsageError
 
-WORKSPACE = Path(__file__).resolve().parents[2] / "shared" / "realworld" / "src"
 FANUC = "moveit_resources/fanuc_moveit_config"
 PANDA = "moveit_resources/panda_moveit_config"
 GEN3_LITE = "ros2_kortex/kortex_moveit_config/kinova_gen3_lite_moveit_config"
@@ -42,9 +41,8 @@ LIMITS = "joint_limits:\n  j1: {has_acceleration_limits: true, max_acceleration:
 
 
 def real(package: str) -> Path:
-    """Return a package folder of the real workspace; the test fails (not skips) without it."""
-    assert WORKSPACE.is_dir(), f"the real MoveIt config workspace is missing: {WORKSPACE}"
-    return WORKSPACE / package
+    """Return a package folder of the real workspace."""
+    return REALWORLD / package
 
 
 def write(folder: Path, files: dict[str, str]) -> Path:
@@ -63,6 +61,7 @@ def no_ros_environment(monkeypatch: pytest.MonkeyPatch) -> None:
 # --- the real workspace, no environment variables -------------------------------------------------
 
 
+@pytest.mark.realworld
 def test_fanuc_config_finds_its_description_package_in_the_workspace(cli: Cli) -> None:
     code, document = cli.json("robot", real(FANUC))
     assert code == 0, document
@@ -71,6 +70,7 @@ def test_fanuc_config_finds_its_description_package_in_the_workspace(cli: Cli) -
     assert list(document["groups"]) == ["manipulator"]
 
 
+@pytest.mark.realworld
 def test_panda_config_with_three_srdfs_loads_the_one_setup_assistant_names(cli: Cli) -> None:
     code, document = cli.json("robot", real(PANDA))
     assert code == 0, document
@@ -80,6 +80,7 @@ def test_panda_config_with_three_srdfs_loads_the_one_setup_assistant_names(cli: 
     assert list(document["groups"]) == ["panda_arm", "hand", "panda_arm_hand"]
 
 
+@pytest.mark.realworld
 def test_gen3_urdf_comes_from_kortex_description_with_the_setup_assistant_xacro_args(cli: Cli) -> None:
     code, document = cli.json("robot", real(GEN3))
     assert code == 0, document
@@ -88,11 +89,13 @@ def test_gen3_urdf_comes_from_kortex_description_with_the_setup_assistant_xacro_
     assert document["groups"]["manipulator"]["joints"] == [f"joint_{i}" for i in range(1, 8)]
 
 
+@pytest.mark.realworld
 def test_a_xacro_arg_flag_overrides_one_setup_assistant_arg_and_keeps_the_others() -> None:
     config = load_robot_config(real(GEN3), xacro_args={"robot_ip": "10.0.0.2"})
     assert config.xacro_args == {"gripper": "robotiq_2f_85", "dof": "7", "robot_ip": "10.0.0.2"}
 
 
+@pytest.mark.realworld
 def test_gen3_lite_loads_the_urdf_named_like_its_srdf(cli: Cli) -> None:
     code, document = cli.json("robot", real(GEN3_LITE))
     assert code == 0, document
@@ -100,6 +103,7 @@ def test_gen3_lite_loads_the_urdf_named_like_its_srdf(cli: Cli) -> None:
     assert list(document["groups"]) == ["arm", "gripper"]
 
 
+@pytest.mark.realworld
 def test_abb_srdf_the_setup_assistant_names_without_xacro_is_found_with_it() -> None:
     root = real(ABB)
     found = discover(root, PackagePath(search_path(root)), {})
@@ -107,6 +111,7 @@ def test_abb_srdf_the_setup_assistant_names_without_xacro_is_found_with_it() -> 
     assert found.paths["urdf"] == real("abb_ros2/robot_specific_config/abb_irb1200_support/urdf/irb1200_5_90.xacro")
 
 
+@pytest.mark.realworld
 def test_ur_config_without_urdf_says_to_pass_urdf(cli: Cli) -> None:
     result = cli("robot", real(UR))
     assert result.exit_code == 3, result.stderr
@@ -114,6 +119,7 @@ def test_ur_config_without_urdf_says_to_pass_urdf(cli: Cli) -> None:
     assert f"{real(UR)}: no URDF file" in result.stderr and "pass --urdf FILE" in result.stderr
 
 
+@pytest.mark.realworld
 def test_ur_config_with_urdf_from_its_description_package_picks_the_top_srdf_and_plans(
     cli: Cli, tmp_path: Path
 ) -> None:
@@ -127,6 +133,7 @@ def test_ur_config_with_urdf_from_its_description_package_picks_the_top_srdf_and
     assert document["group"] == "ur_manipulator" and out.is_file()
 
 
+@pytest.mark.realworld
 def test_a_xacro_arg_without_default_names_the_flag_to_pass(cli: Cli) -> None:
     result = cli("robot", real(UR), "--urdf", "package://ur_description/urdf/ur.urdf.xacro")
     assert result.exit_code == 3
@@ -134,6 +141,7 @@ def test_a_xacro_arg_without_default_names_the_flag_to_pass(cli: Cli) -> None:
     assert "pass --xacro-arg name:=VALUE" in result.stderr
 
 
+@pytest.mark.realworld
 def test_a_lone_urdf_without_an_srdf_beside_it_says_to_pass_srdf(cli: Cli) -> None:
     urdf = real("moveit_resources/panda_description/urdf/panda.urdf")
     result = cli("robot", urdf)
@@ -142,6 +150,7 @@ def test_a_lone_urdf_without_an_srdf_beside_it_says_to_pass_srdf(cli: Cli) -> No
     assert f"{urdf}: no SRDF beside it" in result.stderr and "pass --srdf FILE" in result.stderr
 
 
+@pytest.mark.realworld
 def test_a_lone_urdf_with_srdf_by_package_uri_loads(cli: Cli) -> None:
     urdf = real("moveit_resources/panda_description/urdf/panda.urdf")
     code, document = cli.json("robot", urdf, "--srdf", "package://moveit_resources_panda_moveit_config/config/panda.srdf")
@@ -150,6 +159,7 @@ def test_a_lone_urdf_with_srdf_by_package_uri_loads(cli: Cli) -> None:
     assert "panda_arm" in document["groups"]
 
 
+@pytest.mark.realworld
 def test_a_lone_srdf_goes_with_the_urdf_of_the_same_name(cli: Cli) -> None:
     code, document = cli.json("robot", real(FANUC) / "config" / "fanuc.srdf")
     assert code == 0, document
@@ -157,6 +167,7 @@ def test_a_lone_srdf_goes_with_the_urdf_of_the_same_name(cli: Cli) -> None:
     assert document["sources"]["joint_limits"] == str(real(FANUC) / "config" / "joint_limits.yaml")
 
 
+@pytest.mark.realworld
 def test_a_file_that_is_no_robot_config_says_what_robot_takes(cli: Cli) -> None:
     result = cli("robot", real(FANUC) / "package.xml")
     assert result.exit_code == 3
@@ -165,6 +176,7 @@ def test_a_file_that_is_no_robot_config_says_what_robot_takes(cli: Cli) -> None:
     assert "malformed YAML" not in result.stderr
 
 
+@pytest.mark.realworld
 def test_urdf_flag_naming_an_srdf_is_a_usage_error(cli: Cli) -> None:
     result = cli("robot", real(UR), "--urdf", real(UR) / "srdf" / "ur.srdf.xacro")
     assert result.exit_code == 2

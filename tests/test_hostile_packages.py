@@ -14,9 +14,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import UR10E, Cli
-
-REALWORLD = Path(__file__).resolve().parents[2] / "shared" / "realworld" / "src"
+from conftest import REALWORLD, UR10E, Cli
 
 URDF = """<?xml version="1.0"?>
 <robot name="arm">
@@ -466,15 +464,15 @@ def test_world_object_id_twice_and_frame_cycle_are_refused(cli: Cli, tmp_path: P
 # the real workspace still loads under the stricter checks
 
 
+@pytest.mark.realworld
 @pytest.mark.parametrize("config", ["moveit_resources/panda_moveit_config", "moveit_resources/fanuc_moveit_config"])
 def test_real_moveit_configs_still_load(cli: Cli, config: str) -> None:
-    assert REALWORLD.is_dir(), f"the real MoveIt workspace is missing: {REALWORLD}"
     result = cli("robot", REALWORLD / config)
     assert result.exit_code == 0, result.stderr
 
 
+@pytest.mark.realworld
 def test_copied_panda_package_with_setup_assistant_still_loads(cli: Cli, tmp_path: Path) -> None:
-    assert REALWORLD.is_dir(), f"the real MoveIt workspace is missing: {REALWORLD}"
     src = tmp_path / "src"
     shutil.copytree(REALWORLD / "moveit_resources" / "panda_moveit_config", src / "panda_moveit_config")
     shutil.copytree(REALWORLD / "moveit_resources" / "panda_description", src / "panda_description", symlinks=True)

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ROOT, Cli, run_process
+from conftest import REALWORLD, ROOT, Cli, run_process
 
 from moveplan.core.bag.plan_file import read_plan
 from moveplan.core.config.limits import DEFAULT_ACCELERATION, merge_limits, parse_joint_limits
@@ -25,7 +25,6 @@ from moveplan.core.config.urdf import parse_urdf
 from moveplan.core.errors import ConfigError
 
 DATA = ROOT / "tests" / "data" / "limits_start"
-REALWORLD = Path(__file__).resolve().parents[2] / "shared" / "realworld" / "src"
 PANDA = ROOT / "configs" / "panda"
 GROUP = ("j1", "j2", "j3", "j4")
 
@@ -63,7 +62,6 @@ def first_point(plan: Path) -> dict[str, float]:
 
 @pytest.fixture(scope="module")
 def realworld() -> Path:
-    assert REALWORLD.is_dir(), f"the real MoveIt config workspace is missing: {REALWORLD}"
     return REALWORLD
 
 
@@ -215,6 +213,7 @@ def test_panda_without_initial_positions_starts_at_moveit_default_state(cli: Cli
 # --- real MoveIt config packages ---------------------------------------------------------------
 
 
+@pytest.mark.realworld
 def test_dual_arm_panda_starts_where_its_mock_hardware_starts(
     cli: Cli, tmp_path: Path, realworld: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -230,6 +229,7 @@ def test_dual_arm_panda_starts_where_its_mock_hardware_starts(
                                [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785], atol=1e-12)
 
 
+@pytest.mark.realworld
 def test_kinova_gripper_starts_closed_as_its_urdf_says_not_as_initial_positions_yaml(
     realworld: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:
@@ -242,6 +242,7 @@ def test_kinova_gripper_starts_closed_as_its_urdf_says_not_as_initial_positions_
     assert any("robotiq_85_left_knuckle_joint (0.7929, not 0)" in r.getMessage() for r in caplog.records)
 
 
+@pytest.mark.realworld
 def test_abb_irb1200_plans_with_the_default_acceleration_and_strict_limits_refuse(
     tmp_path: Path, realworld: Path
 ) -> None:

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from conftest import ROOT, Cli
+from conftest import REALWORLD, ROOT, Cli
 from rosbags.highlevel import AnyReader
 
 from moveplan.core.bag import read_plan
@@ -34,7 +34,6 @@ from moveplan.core.planning.goals import orientation_tolerance, tip_target
 DATA = ROOT / "tests" / "data" / "moveit_written"
 SCENE, REQUEST, MESH_SCENE = DATA / "panda_scene.yaml", DATA / "panda_request.yaml", DATA / "mesh_scene.yaml"
 MBM_PANDA = ROOT / "tests" / "data" / "mbm" / "panda_robot"  # its SRDF hangs panda_link0 from `world`, floating
-REALWORLD = Path(__file__).resolve().parents[2] / "shared" / "realworld" / "src"
 START = [0, -0.785, 0, -2.356, 0, 1.571, 0.785]
 TARGET = [0.45, 0.25, 0.55]  # the request's position goal for panda_hand, in world
 
@@ -217,9 +216,9 @@ def test_position_goal_out_of_reach_reports_the_distance_without_an_angle(panda:
         tip_target(panda, load_scene(SCENE, panda), far, panda.configuration(START), "request")
 
 
+@pytest.mark.realworld
 def test_real_panda_moveit_config_plans_the_moveit_files(cli: Cli, tmp_path: Path) -> None:
     config = REALWORLD / "moveit_resources" / "panda_moveit_config"
-    assert config.is_dir(), f"the real MoveIt workspace is missing: {config}"
     out = tmp_path / "out.mcap"
     code, document = cli.json("plan", "--robot", config, "--scene", SCENE, "--request", REQUEST, "-o", out)
     assert code == 0, document

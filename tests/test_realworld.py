@@ -12,13 +12,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import REALWORLD as SRC
 from conftest import Cli
 from rosbags.highlevel import AnyReader
 
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.model.robot import Robot
 
-SRC = Path(__file__).resolve().parents[2] / "shared" / "realworld" / "src"
+pytestmark = pytest.mark.realworld
 
 
 @dataclass(frozen=True)
@@ -50,10 +51,6 @@ def no_ros_environment(monkeypatch: pytest.MonkeyPatch) -> None:
     """Users run moveplan from a plain shell: no sourced workspace."""
     for name in ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH"):
         monkeypatch.delenv(name, raising=False)
-
-
-def test_the_shared_workspace_is_there() -> None:
-    assert SRC.is_dir(), f"{SRC}: the shared MoveIt workspace is missing; these tests need it"
 
 
 def _goal(package: Package) -> tuple[Robot, np.ndarray, np.ndarray]:

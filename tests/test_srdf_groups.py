@@ -7,7 +7,7 @@ import shutil
 from pathlib import Path
 
 import pytest
-from conftest import Cli
+from conftest import REALWORLD, Cli
 
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.config.srdf import parse_srdf
@@ -24,10 +24,8 @@ RIGHT_ARM = ("r_shoulder_pan_joint", "r_shoulder_lift_joint", "r_wrist_roll_join
 
 @pytest.fixture(scope="module")
 def realworld() -> Path:
-    """The workspace of real MoveIt configs; its absence is a failure, not a skip."""
-    path = Path(__file__).resolve().parents[2] / "shared" / "realworld" / "src"
-    assert path.is_dir(), f"the real-world MoveIt workspace is missing: {path}"
-    return path
+    """The workspace of real MoveIt configs."""
+    return REALWORLD
 
 
 def parse(srdf: str, tmp_path: Path) -> object:
@@ -193,6 +191,7 @@ def test_an_unknown_joint_in_a_group_lists_urdf_and_virtual_joints(tmp_path: Pat
 # --- real MoveIt configs ----------------------------------------------------------------------------
 
 
+@pytest.mark.realworld
 def test_moveit_resources_panda_hand_group_of_links_and_floating_virtual_joint(realworld: Path) -> None:
     resources = realworld / "moveit_resources"
     urdf = resources / "panda_description" / "urdf" / "panda.urdf"
@@ -204,6 +203,7 @@ def test_moveit_resources_panda_hand_group_of_links_and_floating_virtual_joint(r
     assert srdf.plannable("panda_arm_hand", srdf_path).joints[-2:] == ("panda_finger_joint1", "panda_finger_joint2")
 
 
+@pytest.mark.realworld
 def test_moveit_resources_fanuc_fixed_virtual_joint(realworld: Path) -> None:
     resources = realworld / "moveit_resources"
     urdf = resources / "fanuc_description" / "urdf" / "fanuc.urdf"
