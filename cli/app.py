@@ -20,6 +20,7 @@ from moveplan.cli.options import (
     QuietOpt,
     SrdfOpt,
     StrictLimitsOpt,
+    TimeoutOpt,
     UrdfOpt,
     VerboseOpt,
     XacroArgOpt,
@@ -99,7 +100,9 @@ def plan(
     linear: Annotated[bool, typer.Option("--linear", help="Move the tip along a straight line.")] = False,
     min_fraction: Annotated[str | None, typer.Option(help="With --linear: fail below this fraction (1).")] = None,
     planner: Annotated[str | None, typer.Option(help="OMPL geometric planner (default RRTConnect).")] = None,
-    planning_time: Annotated[str | None, typer.Option(help="Seconds the planner may search per step.")] = None,
+    planning_time: Annotated[str | None, typer.Option(
+        help="The search's budget per step, in seconds at 20,000 checked motions a second (not wall time).")] = None,
+    timeout: TimeoutOpt = None,
     seed: Annotated[int | None, typer.Option(min=0, max=MAX_SEED, help="Random seed: same seed, same plan.")] = None,
     velocity_scaling: Annotated[str | None, typer.Option(help="Velocity limits' fraction, in [0.001, 1].")] = None,
     acceleration_scaling: Annotated[str | None, typer.Option(help="Acceleration limits' fraction, [0.001, 1].")] = None,
@@ -142,8 +145,9 @@ def _plan_flags(args: dict[str, Any]) -> PlanFlags:
         pose=parse_optional(parse_pose, args["pose"], "--pose"), frame=args["frame"], link=args["link"],
         shift=parse_optional(parse_shift, args["shift"], "--shift"), shift_frame=args["shift_frame"],
         linear=args["linear"], min_fraction=number("min_fraction"), planner=args["planner"],
-        planning_time=number("planning_time"), seed=args["seed"], velocity_scaling=number("velocity_scaling"),
-        acceleration_scaling=number("acceleration_scaling"), package_paths=tuple(args["package_path"] or ()),
+        planning_time=number("planning_time"), timeout=number("timeout"), seed=args["seed"],
+        velocity_scaling=number("velocity_scaling"), acceleration_scaling=number("acceleration_scaling"),
+        package_paths=tuple(args["package_path"] or ()),
         xacro_args=parse_xacro_args(args["xacro_arg"] or ()), urdf=args["urdf"], srdf=args["srdf"],
         strict_limits=args["strict_limits"],
     )
@@ -303,7 +307,9 @@ def benchmark(
         help="OMPL planner; repeatable or comma-separated (default: the config's).")] = None,
     seeds: Annotated[str, typer.Option(help="Seeds: '0-4' or '0,3,7'.")] = "0",
     count: Annotated[int | None, typer.Option(min=1, help="Only the first N problems of each folder.")] = None,
-    planning_time: Annotated[str, typer.Option(help="Seconds each planner may search per problem.")] = "1.0",
+    planning_time: Annotated[str, typer.Option(
+        help="Each search's budget, in seconds at 20,000 checked motions a second (not wall time).")] = "1.0",
+    timeout: TimeoutOpt = None,
     jobs: Annotated[int, typer.Option(min=1, help="Planner/seed processes run at a time (1: cleanest times).")] = 1,
     csv: Annotated[Path | None, typer.Option(help="Write one CSV row per run here.")] = None,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG of the time distributions here.")] = None,
@@ -326,12 +332,15 @@ def benchmark(
                       {"PROBLEMS": problems, "--robot": robot, **description_inputs(urdf, srdf)})
         seed_list = parse_seeds(seeds)
         time_s = check_planning_time(parse_number(planning_time, "--planning-time"))
+        timeout_s = parse_optional(parse_number, timeout, "--timeout")
+        if timeout_s is not None:
+            check_planning_time(timeout_s, "--timeout")
         found = bench.find_problems(problems, count)
         source = robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits)
         config = source.load()
         planners = [p.strip() for text in planner or [config.planning["planner"]] for p in text.split(",")]
         with render.benchmark_progress(len(found) * len(planners) * len(seed_list), quiet) as advance:
-            runs = bench.run_benchmark(source, found, planners, seed_list, time_s, jobs, advance)
+            runs = bench.run_benchmark(source, found, planners, seed_list, time_s, jobs, advance, timeout_s)
         if csv is not None:
             bench.write_csv(runs, csv)
         if plot is not None:

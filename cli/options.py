@@ -12,8 +12,8 @@ if TYPE_CHECKING:  # imported by the command that loads a robot: `moveplan --hel
     from moveplan.core.pipeline.request import RobotSource
 
 __all__ = [
-    "ROBOT_HELP", "JsonOpt", "PackagePathOpt", "QuietOpt", "SrdfOpt", "StrictLimitsOpt", "UrdfOpt", "VerboseOpt",
-    "XacroArgOpt", "robot_source", "setup_logging",
+    "ROBOT_HELP", "JsonOpt", "PackagePathOpt", "QuietOpt", "SrdfOpt", "StrictLimitsOpt", "TimeoutOpt", "UrdfOpt",
+    "VerboseOpt", "XacroArgOpt", "robot_source", "setup_logging",
 ]
 
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON document on stdout, nothing else.")]
@@ -29,6 +29,9 @@ SrdfOpt = Annotated[str | None, typer.Option(
 StrictLimitsOpt = Annotated[bool, typer.Option(
     "--strict-limits", help="An acceleration limit missing in the config is an error instead of the documented "
                             "default.")]
+TimeoutOpt = Annotated[str | None, typer.Option(
+    metavar="SECONDS", help="Wall-clock safety limit of each search (default: 20 x the planning time, at least 60 s); "
+                            "the planning time is a budget of work, the same at any load.")]
 ROBOT_HELP = ("Robot config: a moveplan.yaml or its folder, a MoveIt config package, a URDF or SRDF file, "
                "or a shipped name.")
 

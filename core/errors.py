@@ -180,7 +180,7 @@ class PlanningFailed(NoPlan):
 
 
 class PlanningTimeExceeded(PlanningFailed):
-    """A search reached the wall-clock planning time before its budget of checked motions.
+    """A search reached its wall-clock safety limit (--timeout) before its budget of checked motions.
 
     Never caught to try something else: what a plan does next must not depend on the clock.
     """

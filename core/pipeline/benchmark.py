@@ -126,11 +126,14 @@ def run_benchmark(
     planning_time: float,
     jobs: int = 1,
     on_run: Callable[[Run], None] | None = None,
+    timeout: float | None = None,
 ) -> list[Run]:
     """Return every run of every problem with every planner and seed, in a stable order.
 
     Each (planner, seed) is one child process; `jobs` of them run at a time.
     `on_run` is called in this process as each run completes (for a progress bar).
+    `planning_time` is each search's budget of work; `timeout` its wall-clock safety limit
+    (None: the default for the budget).
     """
     context = multiprocessing.get_context("spawn")
     results: queue_module.Queue[Any] = context.Queue()
@@ -141,7 +144,8 @@ def run_benchmark(
         while pending and len(running) < max(1, jobs):
             planner, seed = pending.pop(0)
             process = context.Process(
-                target=_worker, args=(robot, tuple(problems), planner, seed, planning_time, results), daemon=True)
+                target=_worker, args=(robot, tuple(problems), planner, seed, (planning_time, timeout), results),
+                daemon=True)
             process.start()
             running[(planner, seed)] = process
         try:
@@ -176,8 +180,8 @@ def _rebuild(payload: dict[str, Any]) -> Exception:
     return RuntimeError(f"benchmark worker failed: {payload['message']}\n{payload['traceback']}")
 
 
-def _worker(robot: Path | RobotSource, problems: tuple[Problem, ...], planner: str, seed: int, planning_time: float,
-            results: Any) -> None:
+def _worker(robot: Path | RobotSource, problems: tuple[Problem, ...], planner: str, seed: int,
+            budget: tuple[float, float | None], results: Any) -> None:
     """Run every problem with one planner and seed, and put each run on `results`."""
     key = (planner, seed)
     try:
@@ -187,9 +191,9 @@ def _worker(robot: Path | RobotSource, problems: tuple[Problem, ...], planner: s
         with tempfile.TemporaryDirectory(prefix="moveplan-benchmark-") as folder:
             # Once untimed: the process's one-time set-up (numba's kernels, the sphere models) is
             # no part of any call, as the config's loading is not.
-            _solve(problems[0], config, planner, seed, planning_time, Path(folder) / "plan.mcap")
+            _solve(problems[0], config, planner, seed, budget, Path(folder) / "plan.mcap")
             for problem in problems:
-                run = _solve(problem, config, planner, seed, planning_time, Path(folder) / "plan.mcap")
+                run = _solve(problem, config, planner, seed, budget, Path(folder) / "plan.mcap")
                 results.put(("run", key, asdict(run)))
     except Exception as exc:  # noqa: BLE001 - reported to the parent, which raises it there
         results.put(("error", key, {"exit_code": getattr(exc, "exit_code", 1), "message": str(exc),
@@ -198,15 +202,19 @@ def _worker(robot: Path | RobotSource, problems: tuple[Problem, ...], planner: s
     results.put(("done", key, None))
 
 
-def _solve(problem: Problem, config: Any, planner: str, seed: int, planning_time: float, output: Path) -> Run:
-    """Return the run of one problem, its plan written to `output`; no plan is a failed run, bad input an error."""
+def _solve(problem: Problem, config: Any, planner: str, seed: int, budget: tuple[float, float | None],
+           output: Path) -> Run:
+    """Return the run of one problem, its plan written to `output`; no plan is a failed run, bad input an error.
+
+    `budget` is the search's planning time and wall-clock timeout.
+    """
     from ..bag.plan_writer import write_plan
     from ..config.tasks import load_task
     from . import plan as pipeline
 
     began = time.perf_counter()
     flags = pipeline.PlanFlags(robot=config.root, scene=problem.scene, request=problem.request, planner=planner,
-                               planning_time=planning_time, seed=seed)
+                               planning_time=budget[0], timeout=budget[1], seed=seed)
     request = pipeline.resolve_request(load_task(problem.task) if problem.task else None, flags)
     where = {"problem": problem.name, "scenario": problem.scenario, "planner": planner, "seed": seed}
     try:

@@ -89,7 +89,8 @@ class PlanFlags:
         linear: Move the tip along a straight line.
         min_fraction: With `linear`, the smallest fraction of the line that is a success, in [0, 1].
         planner: OMPL planner name.
-        planning_time: Seconds the planner may search per step, positive.
+        planning_time: Seconds the planner may search per step, positive: a budget of work.
+        timeout: Wall-clock safety limit of each search in [s], positive.
         seed: Random seed.
         velocity_scaling, acceleration_scaling: Fractions of the limits, in (0, 1].
         package_paths: Folders searched for package:// URIs.
@@ -116,6 +117,7 @@ class PlanFlags:
     min_fraction: float | None = None
     planner: str | None = None
     planning_time: float | None = None
+    timeout: float | None = None
     seed: int | None = None
     velocity_scaling: float | None = None
     acceleration_scaling: float | None = None
@@ -140,6 +142,8 @@ class PlanFlags:
             raise UsageError(f"--min-fraction: expected a number in [0, 1], got {self.min_fraction:g}")
         if self.planning_time is not None:
             check_planning_time(self.planning_time)
+        if self.timeout is not None:
+            check_planning_time(self.timeout, "--timeout")
         for name in ("velocity_scaling", "acceleration_scaling"):
             factor = getattr(self, name)
             if factor is not None and not MIN_SCALING <= factor <= 1.0:
@@ -182,6 +186,7 @@ class PlanRequest:
     start: Start = None
     planner: str | None = None
     planning_time: float | None = None
+    timeout: float | None = None
     velocity_scaling: float | None = None
     acceleration_scaling: float | None = None
     seed: int = 0
@@ -216,6 +221,7 @@ def resolve_request(task: TaskFile | None, flags: PlanFlags) -> PlanRequest:
         group=_first(flags.group, motion and motion.group_name, task and task.group), start=start,
         planner=_first(flags.planner, motion and motion.planner, defaults.get("planner")),
         planning_time=_first(flags.planning_time, motion and motion.planning_time, defaults.get("planning_time")),
+        timeout=flags.timeout,
         velocity_scaling=_first(flags.velocity_scaling, motion and motion.velocity_scaling,
                                 defaults.get("velocity_scaling")),
         acceleration_scaling=_first(flags.acceleration_scaling, motion and motion.acceleration_scaling,

@@ -51,7 +51,8 @@ class _Settings:
 
     Attributes:
         planner: OMPL planner name.
-        planning_time: Seconds the planner may search.
+        planning_time: Seconds the planner may search: a budget of work.
+        timeout: Wall-clock safety limit of each search in [s]; None: the default for the budget.
         max_velocity: Scaled velocity limits per group joint in [rad]/[s] or [m]/[s].
         max_acceleration: Scaled acceleration limits per group joint in [rad]/[s]^2 or [m]/[s]^2.
         min_fraction: Smallest fraction of a straight line that is a success.
@@ -59,6 +60,7 @@ class _Settings:
 
     planner: str
     planning_time: float
+    timeout: float | None
     max_velocity: NDArray[np.float64]
     max_acceleration: NDArray[np.float64]
     min_fraction: float
@@ -111,6 +113,7 @@ def _settings(spec: StepSpec, request: PlanRequest, robot: Robot) -> _Settings:
     return _Settings(
         planner=spec.planner or request.planner or config.planning["planner"],
         planning_time=spec.planning_time or request.planning_time or config.planning["planning_time"],
+        timeout=request.timeout,
         max_velocity=robot.max_velocity * velocity,
         max_acceleration=robot.max_acceleration * acceleration,
         min_fraction=spec.min_fraction if spec.min_fraction is not None else request.min_fraction,
@@ -152,7 +155,7 @@ def _search(
         goal = target.values
         assert goal is not None, "a step that is not linear has target values"
         return (lambda validity: plan_path(start, goal, robot.lower, robot.upper, validity, settings.planner,
-                                           settings.planning_time)), 1.0
+                                           settings.planning_time, settings.timeout)), 1.0
     assert target.pose is not None, "a linear step has a target pose"
     line = straight_line(robot, target.link, start, target.pose, checks.base, checks.free,
                          checks.checker.colliding_pair)
@@ -190,7 +193,7 @@ def _certified(
         logger.debug("trajectory collides when certified; planning its colliding segments again, finer")
         try:
             path = repair_path(path.waypoints, robot.lower, robot.upper, checked(_FINE_RAD), settings.planner,
-                               settings.planning_time)
+                               settings.planning_time, settings.timeout)
             trajectory, hit = certifier.certified(path, _FINE_STEP_RAD)
         except PlanningTimeExceeded:
             raise  # the clock never decides what a plan does next

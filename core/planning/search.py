@@ -8,8 +8,9 @@ under the same checks.
 
 A search is bounded by work, not by the clock: it may check a number of motions
 (states and edges) proportional to its planning time, so the same seed gives the same
-path on any machine under any load. The planning time itself is kept as a wall-clock
-safety cap: a search that reaches it before its budget fails and says so.
+path, or the same failure, on any machine under any load. The wall clock is only a safety
+limit, apart from the budget and far above it (`--timeout`, by default 20 times the planning
+time and at least 60 s): a search that reaches it fails and says so.
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ from ..config.planners import PLANNERS
 from ..errors import PlanningFailed, PlanningTimeExceeded, UsageError, known
 from ..types import frozen_array
 
-__all__ = ["PLANNERS", "PathResult", "Validity", "plan_path", "repair_path", "seed_planner"]
+__all__ = ["PLANNERS", "PathResult", "Validity", "default_timeout", "plan_path", "repair_path", "seed_planner"]
 
 logger = logging.getLogger(__name__)
 ou.setLogLevel(ou.LOG_ERROR)
@@ -49,12 +50,21 @@ _RANGE_RAD = 1.0  # the longest edge a tree-growing planner adds in one step
 # problems; LBKPIECE1 then searches on.
 _FALLBACK = {"RRTConnect": "LBKPIECE1"}
 _FALLBACK_AFTER = 0.2  # of the search's budget
-# Checked motions a search may spend per second of planning time. A Panda search among
-# MotionBenchMaker obstacles checks 30,000-75,000 a second on one core of a 2-core machine, so
-# its budget is spent in under half the planning time quiet; a robot without a sphere filter
-# checks fewer, and reaches the wall-clock cap first. A path found is the same either way:
-# the clock only decides whether the search is cut short.
+# Checked motions a search may spend per second of planning time: the fixed reference rate. A
+# Panda search among MotionBenchMaker obstacles checks 30,000-75,000 a second on one core of a
+# 2-core machine, so its budget is spent in under half the planning time quiet; a robot without
+# a sphere filter checks fewer, and spends its budget in more wall time than its planning time.
 _CHECKS_PER_S = 20_000
+# The wall-clock safety limit, unless given: so far above the budget that only a machine stalled
+# or loaded far beyond eight busy processes per core reaches it.
+TIMEOUT_FACTOR, TIMEOUT_MIN_S = 20.0, 60.0
+
+
+def default_timeout(planning_time_s: float) -> float:
+    """Return the wall-clock safety limit of a search with `planning_time_s` of budget, in [s]."""
+    return max(TIMEOUT_MIN_S, TIMEOUT_FACTOR * planning_time_s)
+
+
 def seed_planner(seed: int) -> None:
     """Seed OMPL's process-wide generator of seeds: every planner, sampler and simplifier made after draws from it."""
     # OMPL logs an error when it is reseeded after first use, yet reseeds. Each search makes its
@@ -96,30 +106,31 @@ class PathResult:
 
 
 class _Work:
-    """The checked motions a search has spent against its budget, and its wall-clock cap."""
+    """The checked motions a search has spent against its budget, and its wall-clock safety limit."""
 
-    def __init__(self, time_s: float) -> None:
+    def __init__(self, time_s: float, timeout_s: float | None) -> None:
         self.time_s = time_s
+        self.timeout_s = default_timeout(time_s) if timeout_s is None else timeout_s
         self.budget = max(1, math.ceil(time_s * _CHECKS_PER_S))
-        self.deadline = time.perf_counter() + time_s
+        self.deadline = time.perf_counter() + self.timeout_s
         self.set_up_before = setup_clock.spent()
         self.used = 0
 
     def until(self, checks: int) -> ob.PlannerTerminationCondition:
-        """Return OMPL's condition that ends a search after `checks` motions in all, or at the cap."""
+        """Return OMPL's condition that ends a search after `checks` motions in all, or at the safety limit."""
         return ob.PlannerTerminationCondition(lambda: self.used >= checks or self.out_of_time())
 
     def out_of_time(self) -> bool:
-        """Return True once the wall-clock cap is reached, not counting set-up done meanwhile (setup_clock)."""
+        """Return True once the wall-clock limit is reached, not counting set-up done meanwhile (setup_clock)."""
         return time.perf_counter() - (setup_clock.spent() - self.set_up_before) > self.deadline
 
     def failure(self, planner: str, status: object) -> PlanningFailed:
         """Return the error for a search that found no path, naming what ended it."""
         if self.used < self.budget and self.out_of_time():
             return PlanningTimeExceeded(
-                f"{planner} reached the planning time cap of {self.time_s:g} s after {self.used} of its "
-                f"{self.budget} checked motions; the machine is slower or busier than the budget assumes: "
-                "raise --planning-time")
+                f"{planner} timed out: {self.timeout_s:g} s of wall time passed after {self.used} of its "
+                f"{self.budget} checked motions ({self.time_s:g} s of planning time); the machine is stalled "
+                "or far busier than the safety limit allows: raise --timeout")
         return PlanningFailed(f"{planner} found no path within {self.budget} checked motions "
                               f"({self.time_s:g} s of planning time) ({status})")
 
@@ -132,15 +143,16 @@ def plan_path(
     validity: Validity,
     planner: str = "RRTConnect",
     time_s: float = 1.0,
+    timeout_s: float | None = None,
 ) -> PathResult:
     """Return a collision-free path from `start` to `goal`, both given as group joint values.
 
     The search may check `time_s` x 20,000 motions; it fails when those find no path, or
-    when `time_s` seconds of wall time pass first.
+    when `timeout_s` seconds of wall time (default: `default_timeout(time_s)`) pass first.
     """
     if planner not in PLANNERS:
         raise UsageError(f"unknown planner '{planner}'; OMPL geometric planners: {known(PLANNERS)}")
-    return _plan(start, goal, lower, upper, validity, planner, _Work(time_s))
+    return _plan(start, goal, lower, upper, validity, planner, _Work(time_s, timeout_s))
 
 
 def repair_path(
@@ -150,6 +162,7 @@ def repair_path(
     validity: Validity,
     planner: str,
     time_s: float,
+    timeout_s: float | None = None,
 ) -> PathResult:
     """Return `waypoints` with each segment `validity` rejects replaced by a path searched between its ends.
 
@@ -158,7 +171,7 @@ def repair_path(
     budget of `time_s`.
     """
     began = time.perf_counter()
-    work = _Work(time_s)
+    work = _Work(time_s, timeout_s)
     pieces, simplify_s, used = [waypoints[:1]], 0.0, planner
     for a, b in zip(waypoints[:-1], waypoints[1:], strict=True):
         if validity.edge_free(a, b):
