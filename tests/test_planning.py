@@ -89,10 +89,18 @@ def test_a_search_stops_after_its_budget_of_checked_motions(monkeypatch: pytest.
         plan_path(np.array([-0.5, -0.5]), np.array([0.5, 0.5]), LOWER, UPPER, _boxed_in(), "RRTConnect", 0.05)
 
 
-def test_a_slow_search_stops_at_the_wall_clock_cap_and_says_so() -> None:
-    cap = r"planning time cap of 0.05 s after \d+ of its 1000 checked motions"
-    with pytest.raises(PlanningTimeExceeded, match=cap):
-        plan_path(np.array([-0.5, -0.5]), np.array([0.5, 0.5]), LOWER, UPPER, _boxed_in(0.002), "RRTConnect", 0.05)
+def test_a_slow_search_stops_at_the_wall_clock_safety_limit_and_says_so() -> None:
+    limit = r"timed out: 0.05 s of wall time passed after \d+ of its 20000 checked motions \(1 s of planning time\)"
+    with pytest.raises(PlanningTimeExceeded, match=limit):
+        plan_path(np.array([-0.5, -0.5]), np.array([0.5, 0.5]), LOWER, UPPER, _boxed_in(0.002), "RRTConnect", 1.0,
+                  timeout_s=0.05)
+
+
+def test_a_slow_search_spends_its_whole_budget_past_its_planning_time_in_wall_time() -> None:
+    # 0.05 s of planning time is 1000 checked motions, whatever they cost: the clock does not cut the search.
+    with pytest.raises(PlanningFailed, match="found no path within 1000 checked motions") as failed:
+        plan_path(np.array([-0.5, -0.5]), np.array([0.5, 0.5]), LOWER, UPPER, _boxed_in(0.0002), "RRTConnect", 0.05)
+    assert not isinstance(failed.value, PlanningTimeExceeded)
 
 
 def test_the_same_seed_gives_the_same_path_whatever_ran_before() -> None:
