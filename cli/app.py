@@ -118,11 +118,12 @@ def plan(
 ) -> None:
     """Plan collision-free, time-parameterised motions and write them to MCAP."""
     setup_logging(verbose, quiet)
-    with exit_codes(as_json):
+    from moveplan.cli import render
+
+    with exit_codes(as_json, render.plan_failure):
         check_outputs({"-o": output}, {"TASK": task, "--robot": robot, "--scene": scene, "--request": motion_request,
                                        "--start-from": start_from, **description_inputs(urdf, srdf)})
         flags = _plan_flags(locals())
-        from moveplan.cli import render
         from moveplan.core.pipeline.plan import plan_to_file
 
         result = plan_to_file(task, flags, output, ros_distro)

@@ -13,7 +13,7 @@ import os
 import signal
 import sys
 import traceback
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from types import FrameType
@@ -21,6 +21,11 @@ from typing import Any
 
 import typer
 from typer.core import TyperGroup
+
+try:  # typer 0.28 parses with its own copy of click
+    from typer._click.exceptions import UsageError as ClickUsageError
+except ImportError:
+    from click import UsageError as ClickUsageError
 
 from moveplan.core.errors import MoveplanError, UsageError
 
@@ -34,6 +39,7 @@ PIPE_CLOSED = 128 + signal.SIGPIPE
 """Exit code when the reader of stdout or stderr went away: 141, as for a process killed by SIGPIPE."""
 
 _SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+_QUIET = "moveplan.quiet"  # ctx.meta key: the command's arguments hold --quiet
 
 
 class Interrupted(KeyboardInterrupt):
@@ -66,8 +72,14 @@ def _interrupt_message(exc: KeyboardInterrupt) -> tuple[int, str]:
 class GuardedGroup(TyperGroup):
     """The app's command group: a closed stdout exits PIPE_CLOSED quietly, an interrupt 128 + signal.
 
-    Around the whole command, rendering included (exit_codes covers only the work).
+    Around the whole command, rendering included (exit_codes covers only the work). With --quiet,
+    a usage error is one line too, without click's usage text.
     """
+
+    def resolve_command(self, ctx: Any, args: list[str]) -> Any:
+        """Return the command `args` name, as click does, noting whether they ask for --quiet."""
+        ctx.meta[_QUIET] = "--quiet" in args or "-q" in args
+        return super().resolve_command(ctx, args)
 
     def invoke(self, ctx: Any) -> Any:
         """Invoke the command; then flush stdout, so that a closed pipe is noticed here, not at exit."""
@@ -79,6 +91,11 @@ class GuardedGroup(TyperGroup):
                     sys.stdout.flush()
         except BrokenPipeError:
             _pipe_closed()
+        except ClickUsageError as exc:
+            if not ctx.meta.get(_QUIET):
+                raise
+            print(f"moveplan: error: {exc.format_message()}", file=sys.stderr)
+            raise typer.Exit(exc.exit_code) from None
         except SystemExit as exc:
             # rich's Console.on_broken_pipe exits 1 while handling the BrokenPipeError: same case.
             if isinstance(exc.__context__, BrokenPipeError):
@@ -145,12 +162,15 @@ def _same_file(a: Path, b: Path) -> bool:
 
 
 @contextmanager
-def exit_codes(as_json: bool) -> Iterator[None]:
-    """Turn a MoveplanError into its exit code and an unexpected exception into exit 1, no traceback."""
+def exit_codes(as_json: bool, report: Callable[[MoveplanError], dict[str, Any]] | None = None) -> Iterator[None]:
+    """Turn a MoveplanError into its exit code and an unexpected exception into exit 1, no traceback.
+
+    `report` returns what the command's JSON document adds to the error's (a plan's steps).
+    """
     try:
         yield
     except MoveplanError as exc:
-        _report(exc.exit_code, str(exc), as_json, kind=exc.kind)
+        _report(exc.exit_code, str(exc), as_json, kind=exc.kind, **(report(exc) if report and as_json else {}))
     except KeyboardInterrupt as exc:  # Ctrl-C, and SIGTERM/SIGHUP once handle_signals ran
         _report(*_interrupt_message(exc), as_json, kind="Interrupted")
     except BrokenPipeError:
@@ -163,9 +183,9 @@ def exit_codes(as_json: bool) -> Iterator[None]:
         _report(1, message, as_json, kind="InternalError")
 
 
-def _report(code: int, message: str, as_json: bool, *, kind: str) -> None:
+def _report(code: int, message: str, as_json: bool, *, kind: str, **document: Any) -> None:
     if as_json:
-        print(json.dumps({"ok": False, "error": {"exit_code": code, "kind": kind, "message": message}}))
+        print(json.dumps({"ok": False, **document, "error": {"exit_code": code, "kind": kind, "message": message}}))
     else:
         print(f"moveplan: error: {message}", file=sys.stderr)
     raise typer.Exit(code)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import logging
 import sys
+import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import asdict
@@ -18,12 +19,13 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from moveplan.cli.tables import console as _console
 from moveplan.cli.tables import emit as _emit
+from moveplan.cli.tables import is_terminal, show, table
 from moveplan.cli.tables import number as _number
-from moveplan.cli.tables import show, table
 
 if TYPE_CHECKING:  # each command imports only the core modules it runs
     from moveplan.core.config.robot_config import RobotConfig
     from moveplan.core.control.check_report import CheckReport
+    from moveplan.core.errors import MoveplanError
     from moveplan.core.pipeline.benchmark import Run
     from moveplan.core.pipeline.execute import PlanExecution
     from moveplan.core.pipeline.inspection import Inspection
@@ -31,8 +33,8 @@ if TYPE_CHECKING:  # each command imports only the core modules it runs
     from moveplan.core.pipeline.state import RobotState, StateResult
 
 __all__ = [
-    "benchmark_progress", "benchmark_summary", "check_summary", "execution_summary", "inspect_summary", "plan_summary",
-    "robot_summary", "state_summary",
+    "PROGRESS_EVERY_S", "benchmark_progress", "benchmark_summary", "check_summary", "execution_summary",
+    "inspect_summary", "plan_failure", "plan_summary", "robot_summary", "state_summary",
 ]
 
 logger = logging.getLogger("moveplan")
@@ -40,15 +42,7 @@ logger = logging.getLogger("moveplan")
 
 def plan_summary(plan: PlanResult, output: Path, as_json: bool, quiet: bool) -> None:
     """Print what was planned: one row per step and where each ends, or the plan JSON document."""
-    steps = [
-        {
-            "name": s.name, "status": "ok", "goal": s.goal, "planner": s.planner,
-            "planning_time_s": round(s.planning_time_s, 6), "duration_s": round(s.trajectory.duration_s, 6),
-            "fraction": s.fraction, "residual": s.residual, "points": len(s.trajectory.times_s),
-            "end_state": end.as_dict(),
-        }
-        for s, end in zip(plan.steps, plan.end_states, strict=True)
-    ]
+    steps = _step_documents(plan)
     if as_json:
         _emit({"ok": True, "output": str(output), "robot": plan.robot_name, "group": plan.group,
                "steps": steps, "error": None})
@@ -63,6 +57,29 @@ def plan_summary(plan: PlanResult, output: Path, as_json: bool, quiet: bool) -> 
     show(rows)
     if plan.end_states:
         _end_poses([s.name for s in plan.steps], plan.end_states)
+
+
+def plan_failure(error: MoveplanError) -> dict[str, Any]:
+    """Return what a failed plan's JSON document holds besides its error: the steps planned, then the failing one."""
+    plan: PlanResult | None = error.partial
+    steps = _step_documents(plan) if plan else []
+    if error.step is not None:
+        steps.append({"name": error.step, "status": "error"})
+    return {"output": None, "robot": plan.robot_name if plan else None, "group": plan.group if plan else None,
+            "steps": steps}
+
+
+def _step_documents(plan: PlanResult) -> list[dict[str, Any]]:
+    """Return the plan JSON document's "steps": each planned step, its goal, planning, trajectory and end state."""
+    return [
+        {
+            "name": s.name, "status": "ok", "goal": s.goal, "planner": s.planner,
+            "planning_time_s": round(s.planning_time_s, 6), "duration_s": round(s.trajectory.duration_s, 6),
+            "fraction": s.fraction, "residual": s.residual, "points": len(s.trajectory.times_s),
+            "end_state": end.as_dict(),
+        }
+        for s, end in zip(plan.steps, plan.end_states, strict=True)
+    ]
 
 
 def _end_poses(names: list[str], states: tuple[RobotState, ...]) -> None:
@@ -222,6 +239,7 @@ def execution_summary(outcome: PlanExecution, output: Path | None, as_json: bool
         _emit(document)
         return
     if quiet:
+        _failure_line("execute", document)
         return
     _verdict(document, f"smallest margin to tolerance ({document['controller']})")
     _tracking(document)
@@ -245,11 +263,33 @@ def check_summary(report: CheckReport, recording: Path, as_json: bool, quiet: bo
     if document["error"] is not None:
         print(f"moveplan: error: {document['error']['message']}", file=sys.stderr)
     if quiet:
+        if document["error"] is None:
+            _failure_line("check-tolerances", document)
         return
     _verdict(document, "smallest margin to tolerance")
     _tracking(document)
     if "cycles" in document:
         _cycles(document)
+
+
+def _failure_line(command: str, document: dict[str, Any]) -> None:
+    """Print on stderr, if the verdict is a failure, one line naming the result and the worst violation (--quiet).
+
+    The worst is the one furthest beyond its tolerance; one whose numbers are not finite (a diverged plant) first.
+    """
+    if document["ok"]:
+        return
+    result, violations = document["result"], document["violations"]
+    detail = result["message"]
+    if violations:
+        def excess(v: dict[str, Any]) -> float:
+            return float("inf") if v["error"] is None else abs(v["error"]) - v["tolerance"]
+
+        v = max(violations, key=excess)
+        detail = (f"{v['joint'] or v['check']} at {_number(v['time_s'], '.3f')} s in step '{v['step']}': "
+                  f"{v['check']} error {_number(v['error'], '.4g')}, tolerance {_number(v['tolerance'], '.4g')} "
+                  f"({len(violations)} violation{'s' if len(violations) > 1 else ''})")
+    print(" ".join(f"moveplan: {command}: {result['name']}: {detail}".split()), file=sys.stderr)
 
 
 def _cycles(document: dict[str, Any]) -> None:
@@ -305,11 +345,22 @@ def _tracking(document: dict[str, Any]) -> None:
         _console.print(f"[yellow]ringing[/yellow] (error sign changes after the stop): {', '.join(ringing)}")
 
 
+PROGRESS_EVERY_S = 5.0
+"""Seconds between two progress lines of `benchmark` on a stderr that is no terminal (a CI log)."""
+
+
 @contextmanager
 def benchmark_progress(total: int, quiet: bool) -> Iterator[Callable[[Run], None]]:
-    """Yield a callback that advances a progress bar on stderr by one run (no bar when quiet or not a terminal)."""
+    """Yield a callback that counts a finished run: a bar on a terminal, else a line now and then; none when quiet.
+
+    On a file or a pipe, a line such as `benchmark: 120/1500 runs, 118 solved, 42 s` once a run ends
+    PROGRESS_EVERY_S after the last line: a CI job's log shows the benchmark is alive.
+    """
+    if quiet or not is_terminal(sys.stderr):
+        yield (lambda run: None) if quiet else _progress_lines(total)
+        return
     progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                        console=Console(stderr=True), disable=quiet, transient=True)
+                        console=Console(stderr=True), transient=True)
     with progress:
         task = progress.add_task("planning", total=total)
         failed = 0
@@ -320,6 +371,22 @@ def benchmark_progress(total: int, quiet: bool) -> Iterator[Callable[[Run], None
             progress.update(task, advance=1, description=f"planning ({failed} failed)" if failed else "planning")
 
         yield advance
+
+
+def _progress_lines(total: int) -> Callable[[Run], None]:
+    """Return a callback that counts a finished run and prints a progress line on stderr every PROGRESS_EVERY_S."""
+    began = last = time.monotonic()
+    done = solved = 0
+
+    def advance(run: Run) -> None:
+        nonlocal done, solved, last
+        done, solved = done + 1, solved + run.ok
+        now = time.monotonic()
+        if now - last >= PROGRESS_EVERY_S:
+            last = now
+            print(f"benchmark: {done}/{total} runs, {solved} solved, {now - began:.0f} s", file=sys.stderr, flush=True)
+
+    return advance
 
 
 def benchmark_summary(runs: list[Run], rows: list[dict[str, Any]], as_json: bool, quiet: bool) -> None:
@@ -346,5 +413,4 @@ def benchmark_summary(runs: list[Run], rows: list[dict[str, Any]], as_json: bool
                       *(ms(row, stage) for stage in ("search", "simplify", "certify", "timing", "total", "whole_call")),
                            number(row["path_length_median"], 2),
                            number(row["duration_median_s"], 2), f"{row['exact_valid']}/{row['succeeded']}")
-    # Piped to a file, the whole table: a log or a CI artifact is read in an editor, not at 80 columns.
-    show(rows_table, _console if _console.is_terminal else Console(width=200))
+    show(rows_table)

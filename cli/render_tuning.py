@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rich.console import Console
 from rich.markup import escape
 
 from moveplan.cli.tables import console as _console
@@ -44,7 +43,7 @@ def tuning_summary(result: TuneResult, plot: Path | None, as_json: bool, quiet: 
                          f"{g['d']:.4g}", str(r["oscillations"]), _number(r["decay_ratio"], ".2f"),
                          _number(r["overshoot"], ".1e"), settle, escape(stage["note"]),
                          end_section=stage["stage"] == "final")
-    show(rows, _console if _console.is_terminal else Console(width=160))
+    show(rows)
     verification = document["verification"]
     colour = "green" if document["ok"] else "red"
     ringing = ", ".join(document["ringing"]) or "none"

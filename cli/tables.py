@@ -2,22 +2,43 @@
 
 Rich fits a table that is too wide by cutting its cells ("wrist_1_j…"), which hides the very names
 a report is about. A table that does not fit is printed instead as one line per row, each cell
-after its header, which the terminal wraps between words.
+after its header, which the terminal wraps between words. Printed to a file or a pipe (a CI log),
+every table takes that form and no line is wrapped: one record, one line, whatever `COLUMNS` says.
 """
 
 from __future__ import annotations
 
 import json
 from collections.abc import Sequence
-from typing import Any
+from typing import IO, Any
 
 from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-__all__ = ["console", "emit", "number", "show", "table"]
+__all__ = ["console", "emit", "is_terminal", "number", "show", "table"]
 
-console = Console()
+
+def is_terminal(stream: IO[str] | None) -> bool:
+    """Return True if `stream` is a terminal.
+
+    Not rich's `is_terminal`, which FORCE_COLOR (set in many CI jobs for coloured logs) makes True.
+    """
+    try:
+        return stream is not None and stream.isatty()
+    except ValueError:  # closed
+        return False
+
+
+class _Output(Console):
+    """rich's Console, except that on a file or a pipe it wraps no line: a log is read by grep and editors."""
+
+    def print(self, *objects: Any, soft_wrap: bool | None = None, **options: Any) -> None:
+        """Print as rich does; by default soft-wrapped (no line broken) when not on a terminal."""
+        super().print(*objects, soft_wrap=not is_terminal(self.file) if soft_wrap is None else soft_wrap, **options)
+
+
+console = _Output()
 """Where people's output goes (stdout: --json, which prints no table, has it to itself)."""
 
 
@@ -32,20 +53,21 @@ def table(title: str, columns: Sequence[str], left: int = 1, **options: Any) -> 
     return result
 
 
-def show(rows: Table, out: Console | None = None) -> None:
-    """Print `rows` as a table if it fits the terminal's width, else one line per row with every cell whole."""
-    out = out or console
-    natural = out.measure(rows, options=out.options.update_width(1_000_000)).maximum  # unclamped by the terminal
-    if natural <= out.width:
-        out.print(rows)
-        return
+def show(rows: Table) -> None:
+    """Print `rows` as a table on a terminal it fits, else one line per row with every cell whole."""
+    if is_terminal(console.file):
+        natural = console.measure(rows, options=console.options.update_width(1_000_000)).maximum  # not clamped
+        if natural <= console.width:
+            console.print(rows)
+            return
     if rows.title:
-        out.print(rows.title)
+        console.print(rows.title)
     headers = [str(column.header) for column in rows.columns]
     for cells in zip(*(column.cells for column in rows.columns), strict=True):
         name, *rest = (str(cell) for cell in cells)
-        pairs = "  ".join(f"{header} {cell}" for header, cell in zip(headers[1:], rest, strict=True) if cell)
-        out.print(f"{name}: {pairs}" if name else f"  {pairs}")
+        pairs = "  ".join(f"{header} {cell}" if header else cell
+                          for header, cell in zip(headers[1:], rest, strict=True) if cell)
+        console.print(f"{name}: {pairs}" if name else f"  {pairs}")
 
 
 def emit(document: dict[str, Any]) -> None:

@@ -8,7 +8,7 @@ valid alternatives where there are any.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import Self
+from typing import Any, Self
 
 __all__ = [
     "ConfigError",
@@ -48,10 +48,13 @@ class MoveplanError(Exception):
     Attributes:
         step: Name of the plan step the error happened in, None outside a step; when set,
             the message begins with it: "step 'approach': ...".
+        partial: What the command had done before the error, for its report (a plan's steps
+            planned before the failing one: a pipeline.plan.PlanResult); None if nothing.
     """
 
     exit_code = 1
     step: str | None = None
+    partial: Any = None
 
     @property
     def kind(self) -> str:

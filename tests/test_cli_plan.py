@@ -181,6 +181,23 @@ def test_a_failing_task_step_is_named_in_the_one_line_error(cli: Cli, tmp_path: 
     assert document["error"]["message"].startswith("step 'back': goal for joint 'elbow_joint'")
 
 
+def test_json_of_a_plan_failing_at_its_second_step_lists_the_step_planned_before(cli: Cli, tmp_path: Path) -> None:
+    task = tmp_path / "task.yaml"
+    task.write_text(f"robot: {UR10E}\nstart: {{named: home}}\nsteps:\n  - {{name: reach, joints: {GOAL}}}\n"
+                    "  - {name: far, pose: {xyz: [5, 0, 0], rpy: [3.14159, 0, 0]}}\n"
+                    "  - {name: home, named: home}\n")
+    code, document = cli.json("plan", task, "-o", tmp_path / "o.mcap")
+    assert code == 4
+    assert document["ok"] is False and document["output"] is None
+    assert (document["robot"], document["group"]) == ("ur10e", "manipulator")
+    assert document["error"]["kind"] == "GoalUnreachable" and document["error"]["message"].startswith("step 'far'")
+    reach, far = document["steps"]
+    assert (reach["name"], reach["status"], reach["goal"]) == ("reach", "ok", {"joints": GOAL})
+    assert reach["duration_s"] > 0 and reach["end_state"]["joints"]["elbow_joint"] == pytest.approx(GOAL[2])
+    assert far == {"name": "far", "status": "error"}
+    assert list(tmp_path.iterdir()) == [task]
+
+
 def test_goal_outside_limits_names_joint_value_and_limit(cli: Cli, tmp_path: Path) -> None:
     code, document = cli.json("plan", "--robot", UR10E, "--joints", "elbow_joint=4", "-o", tmp_path / "o.mcap")
     assert code == 4

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -58,3 +59,29 @@ def test_plan_and_inspect_tables_carry_units_and_whole_step_names(plan_file: Pat
             assert step in result.stdout
     assert "planning [ms]" in planned.stdout and "duration [s]" in planned.stdout
     assert "duration [s]" in inspected.stdout and "position [m]" in inspected.stdout
+
+
+def test_piped_inspect_prints_each_topic_whole_on_one_line() -> None:
+    recording = SAMPLES / "recordings" / "tool_up_ok.mcap"
+    result = _at_80_columns("inspect", recording)
+    topics = json.loads(_at_80_columns("inspect", recording, "--json").stdout)["topics"]
+    assert result.returncode == 0
+    title, *rows = result.stdout.splitlines()
+    assert title.startswith(f"{recording}  (ros2, ")
+    assert rows == [f"{t['topic']}: type {t['type']}  count {t['count']}  durability {t['durability']}" for t in topics]
+    assert "durability transient_local" in result.stdout and max(map(len, rows)) > 80
+
+
+def test_piped_verdict_and_violations_are_one_line_each_whatever_the_width() -> None:
+    args = ("execute", SAMPLES / "recordings" / "tool_up_plan.mcap", "--fake", "--plant", "pid", "--controllers",
+            SAMPLES / "ur10e_mistuned_controllers.yaml")
+    result = _at_80_columns(*args)
+    document = json.loads(_at_80_columns(*args, "--json").stdout)
+    assert result.returncode == 5
+    lines = result.stdout.splitlines()
+    verdict = document["result"]
+    assert lines[0] == f"{verdict['name']} ({verdict['code']}): {verdict['message']}" and len(lines[0]) > 80
+    for v in document["violations"]:
+        assert (f"{v['step']}: check {v['check']}  joint {v['joint']}  time [s] {v['time_s']:.3f}  reference "
+                f"{v['reference']:.4f}  actual {v['actual']:.4f}  error {v['error']:.4f}  tolerance "
+                f"{v['tolerance']:.4f}") in lines

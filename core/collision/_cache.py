@@ -21,16 +21,13 @@ import logging
 import os
 import pickle
 import tempfile
-import threading
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import pinocchio as pin
 
-__all__ = ["FORMAT", "announce", "announced_if_slow", "digest", "path", "read", "write"]
+__all__ = ["FORMAT", "announce", "announce_compilation", "digest", "path", "read", "write"]
 
 logger = logging.getLogger(__name__)
 
@@ -98,20 +95,14 @@ def announce(work: str, where: Path) -> None:
     logger.info("%s (once per robot; cached in %s)", work, where.parent)
 
 
-@contextmanager
-def announced_if_slow(work: str, after_s: float = 1.0) -> Iterator[None]:
-    """Run the block, logging `work` at INFO if it is still running after `after_s` seconds; yield None.
+def announce_compilation(work: str, compiled: bool) -> None:
+    """Log at INFO, before it starts, a compilation of numba kernels unless they are `compiled` already; return None.
 
-    For one-time work whose cost is unknown beforehand: numba loads cached kernels in a fraction of
-    a second but compiles them in tens of seconds on a fresh machine.
+    Decided by numba's cache, not by the clock: cached kernels load in a fraction of a second, but
+    a busy machine can take longer and compiles nothing; a fresh install compiles for tens of seconds.
     """
-    timer = threading.Timer(after_s, logger.info, args=(work,))
-    timer.daemon = True
-    timer.start()
-    try:
-        yield
-    finally:
-        timer.cancel()
+    if not compiled:
+        logger.info("%s", work)
 
 
 def _untrusted(where: Path, why: str) -> None:

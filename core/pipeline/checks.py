@@ -30,7 +30,7 @@ from ..collision import CollisionChecker, MotionChecker, SphereFilter, setup_clo
 from ..collision.checker import GeometryMode
 from ..collision.kernel_cache import kernels_cached
 from ..collision.motion import hull_checker, sphere_filter
-from ..collision.sphere_filter import MAYBE
+from ..collision.sphere_filter import MAYBE, kernels_loaded
 from ..model.robot import Robot
 from ..model.scene import Scene
 from ..trajectory import interpolate
@@ -44,12 +44,10 @@ FILTER_AFTER_STATES = 20_000
 FILTER_AFTER_STATES_UNCOMPILED = 1_000_000
 """The same when numba has yet to compile the kernels: ~15 s of hull checks, what the compilation costs."""
 
-_kernels_loaded = False  # set once a filter is built: later ones cost no numba start-up
-
 
 def filter_threshold() -> int:
     """Return how many states a one-shot command checks with coal before it builds the sphere filter."""
-    return FILTER_AFTER_STATES if _kernels_loaded or kernels_cached() else FILTER_AFTER_STATES_UNCOMPILED
+    return FILTER_AFTER_STATES if kernels_loaded() or kernels_cached() else FILTER_AFTER_STATES_UNCOMPILED
 
 
 def problem_checks(
@@ -63,12 +61,9 @@ def problem_checks(
     hulls = hull_checker(robot, checker, scene)
 
     def build() -> SphereFilter | None:
-        global _kernels_loaded
-        spheres = sphere_filter(robot, checker, hulls, scene, base)
-        _kernels_loaded = _kernels_loaded or spheres is not None
-        return spheres
+        return sphere_filter(robot, checker, hulls, scene, base)
 
-    if after <= 0 or _kernels_loaded:
+    if after <= 0 or kernels_loaded():
         return MotionChecker(robot, checker, base, build(), hulls)
     motion = MotionChecker(robot, checker, base, None, hulls)
     # Once built, the filter replaces the stand-in: a search calls it thousands of times, each call through

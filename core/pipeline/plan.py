@@ -12,6 +12,7 @@ import json
 import logging
 import os
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -102,7 +103,8 @@ def plan(
     is built after `filter_after` checked states (core/pipeline/checks.py): 0, now.
 
     Raises:
-        MoveplanError: Any error while planning a step carries the step's name (`step`).
+        MoveplanError: Any error while planning a step carries the step's name (`step`), and
+            the plan of the steps before it (`partial`, None if it is the first).
     """
     seed_planner(request.seed)
     loaded_here = config is None
@@ -123,7 +125,14 @@ def plan(
     pair = checks.colliding_pair(current)
     if pair:
         raise StartInCollision(pair)
-    steps = _plan_steps(request, robot, scene, checks, current)
+    steps: list[StepResult] = []
+    try:
+        for step in _planned_steps(request, robot, scene, checks, current):
+            steps.append(step)
+    except MoveplanError as exc:
+        if steps:
+            exc.partial = assemble(request, config, robot, scene, base, steps)
+        raise
     if exact_check:
         referee = exact_checks(checks, scene)
         for step in steps:
@@ -242,20 +251,18 @@ def _start_from(path: Path, robot: Robot) -> JointGoal:
     return JointGoal.by_name({j: values[j] for j in shared})
 
 
-def _plan_steps(
+def _planned_steps(
     request: PlanRequest, robot: Robot, scene: Scene, checks: MotionChecker, start: NDArray[np.float64]
-) -> list[StepResult]:
-    """Return every step planned in order, each from where the previous one ended."""
-    steps: list[StepResult] = []
+) -> Iterator[StepResult]:
+    """Yield every step planned in order, each from where the previous one ended."""
     current = start
     for spec in request.steps:
         try:
             step = plan_step(spec, request, robot, scene, checks, current)
         except MoveplanError as exc:
             raise exc.in_step(spec.name) from None
-        steps.append(step)
+        yield step
         current = step.trajectory.positions[-1].copy()
-    return steps
 
 
 def assemble(
