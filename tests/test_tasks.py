@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from conftest import UR10E, Cli
 
 from moveplan.core.config.goals import JointGoal, NamedGoal, PoseGoal, ShiftGoal, StartFrom
 from moveplan.core.config.tasks import load_task
@@ -80,3 +81,27 @@ def test_task_without_start_starts_at_the_initial_positions(tmp_path: Path) -> N
 def test_malformed_goal_is_a_config_error_naming_the_step(tmp_path: Path, step: str, message: str) -> None:
     with pytest.raises(ConfigError, match=message):
         load_task(write_task(tmp_path, f"robot: r\nsteps:\n  - {step}\n"))
+
+
+def test_task_robot_by_bare_name_plans_with_the_shipped_config(tmp_path: Path) -> None:
+    task = write_task(tmp_path, "robot: ur10e\nsteps: [{name: bend, joints: {elbow_joint: -1.0}}]\n")
+    result = Cli()("plan", task, "-o", tmp_path / "out.mcap", "--quiet")
+    assert result.exit_code == 0, result.stderr
+    assert (tmp_path / "out.mcap").is_file()
+
+
+def test_task_robot_beside_the_task_file_comes_before_a_shipped_config(tmp_path: Path) -> None:
+    (tmp_path / "ur10e").mkdir()
+    assert load_task(write_task(tmp_path, "robot: ur10e\nsteps: [{named: home}]\n")).robot == tmp_path / "ur10e"
+    shipped = load_task(write_task(tmp_path, "robot: panda\nsteps: [{named: home}]\n")).robot
+    assert shipped is not None and shipped.samefile(UR10E.parent / "panda")
+
+
+def test_task_robot_by_unknown_bare_name_is_one_line_naming_it_and_the_shipped_configs(tmp_path: Path) -> None:
+    task = write_task(tmp_path, "robot: ur10\nsteps: [{named: home}]\n")
+    result = Cli()("plan", task, "-o", tmp_path / "out.mcap")
+    assert result.exit_code == 3
+    assert result.stderr.count("\n") == 1
+    assert "ur10: robot config not found" in result.stderr
+    assert "shipped config: excavator, panda, ur10e" in result.stderr
+    assert not (tmp_path / "out.mcap").exists()

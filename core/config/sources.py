@@ -41,7 +41,8 @@ from .xacro import PackagePath
 
 __all__ = [
     "CONFIG_FILE", "FILE_KEYS", "Discovered", "discover", "discover_beside", "flag_file", "manifest_files",
-    "read_manifest", "resolve_config_path", "robot_file_kind", "search_path", "shipped_configs", "stem",
+    "read_manifest", "resolve_config_path", "robot_file_kind", "search_path", "shipped_config", "shipped_configs",
+    "stem",
 ]
 
 CONFIG_FILE = "moveplan.yaml"
@@ -95,8 +96,8 @@ def resolve_config_path(robot: str | Path, srdf_given: bool = False) -> Path:
     or if `srdf_given` (--srdf names the SRDF).
     """
     path = Path(robot)
-    shipped = Path(str(resources.files("moveplan.configs"))) / str(robot)
-    if not path.exists() and path.name == str(robot) and (shipped / CONFIG_FILE).is_file():
+    shipped = shipped_config(str(robot))
+    if not path.exists() and shipped is not None:
         path = shipped
     if path.is_dir():
         if (path / CONFIG_FILE).is_file():
@@ -125,6 +126,14 @@ def robot_file_kind(path: Path) -> str | None:
     if name.endswith((*_URDF_SUFFIXES, ".xacro")):
         return "urdf"
     return None
+
+
+def shipped_config(name: str) -> Path | None:
+    """Return the folder of the config shipped with moveplan under the bare name `name`, None if there is none."""
+    if not name or Path(name).name != name:
+        return None
+    folder = Path(str(resources.files("moveplan.configs"))) / name
+    return folder if (folder / CONFIG_FILE).is_file() else None
 
 
 def shipped_configs() -> list[str]:

@@ -2,7 +2,7 @@
 
 A task names a robot and scene, a start, defaults, and steps; each step is one
 motion goal, parsed here into a typed goal (goals.py). Paths in a task resolve
-relative to the task file.
+relative to the task file; its robot may also be a shipped config's bare name.
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from typing import Any
 from ..errors import ConfigError
 from .fields import MAX_MAGNITUDE, angle, check_keys, coordinate, load_yaml, mapping, number, pose_angle
 from .goals import GOAL_KINDS, SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
+from .sources import shipped_config
 
 __all__ = [
     "GOAL_KINDS", "MIN_SCALING", "SHIFT_AXES", "StepSpec", "TaskFile", "load_task", "parse_goal", "parse_pose",
@@ -49,7 +50,7 @@ class StepSpec:
 
 @dataclass(frozen=True)
 class TaskFile:
-    """A parsed task file; paths are already resolved against its folder."""
+    """A parsed task file; paths are already resolved against its folder (a robot by bare name: the shipped config)."""
 
     source: Path
     robot: Path | None
@@ -167,6 +168,18 @@ def _defaults(entry: dict[str, Any], where: str) -> dict[str, Any]:
     return result
 
 
+def _robot(beside: Path | None, written: str | None) -> Path | None:
+    """Return a task's robot: `beside` (`written` in the task's folder) if it exists, else the shipped config `written`.
+
+    A bare name thus finds what `--robot NAME` finds, the task's folder standing in for the
+    working directory. Anything else is left as `beside`, for loading the robot to report
+    (exit 3, with the shipped configs' names), as a missing path is.
+    """
+    if beside is None or beside.exists() or written is None:
+        return beside
+    return shipped_config(written) or beside
+
+
 def load_task(path: Path) -> TaskFile:
     """Return the task in a task file."""
     source = str(path)
@@ -217,7 +230,7 @@ def load_task(path: Path) -> TaskFile:
     group = top.get("group")
     return TaskFile(
         source=path,
-        robot=relative("robot"),
+        robot=_robot(relative("robot"), top.get("robot")),
         scene=relative("scene"),
         group=str(group) if group is not None else None,
         start=start,
