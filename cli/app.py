@@ -216,6 +216,8 @@ def check_tolerances(
     controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml overriding the plan's.")] = None,
     start: Annotated[str, typer.Option(help="auto, a time [s] from the recording's start, or all.")] = "auto",
     time_source: Annotated[str, typer.Option(help="header (message stamps) or log (receive times).")] = "header",
+    skip_damaged: Annotated[bool, typer.Option("--skip-damaged", help=(
+        "Skip MCAP chunks failing their CRC or size checks, with a warning (JSON: skipped)."))] = False,
     plot: Annotated[Path | None, typer.Option(metavar="FILE.png", help=(
         "Write a PNG: per joint reference and actual, the error against the tolerances, violations "
         "(with --start all: the first failing cycle, else the first)."))] = None,
@@ -237,7 +239,7 @@ def check_tolerances(
         if time_source not in ("header", "log"):
             raise UsageError(f"--time-source: expected header or log, got '{time_source}'")
         when: str | float = start if start in ("auto", "all") else parse_time(start, "--start (auto, all or seconds)")
-        request = CheckRequest(plan_file, recording_file, topic, controllers, when, time_source)
+        request = CheckRequest(plan_file, recording_file, topic, controllers, when, time_source, skip_damaged)
         if plot is None:
             report = check(request)
         else:
@@ -279,6 +281,8 @@ def inspect(
         help="Any ROS 2 bag (.mcap, .db3 or a bag folder); plan files get a per-step summary.")],
     plot: Annotated[Path | None, typer.Option(metavar="FILE.png", help=(
         "Plan files: write a PNG of each joint's position, velocity and acceleration against its limits."))] = None,
+    skip_damaged: Annotated[bool, typer.Option("--skip-damaged", help=(
+        "Skip MCAP chunks failing their CRC or size checks, with a warning (JSON: skipped)."))] = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
 ) -> None:
@@ -293,7 +297,7 @@ def inspect(
 
             check_outputs({"--plot": plot}, {"FILE": file})
             plots.check_plot_path(plot)
-        inspection = inspect_file(file)
+        inspection = inspect_file(file, skip_damaged)
         if plot is not None:
             plots.write_plan_plot(inspection.plan, file, plot)
     render.inspect_summary(inspection, as_json, quiet)

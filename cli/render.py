@@ -206,6 +206,7 @@ def inspect_summary(inspection: Inspection, as_json: bool, quiet: bool) -> None:
                     "durability": t.qos_durability} for t in summary.topics],
         "metadata": list(summary.metadata), "attachments": list(summary.attachments),
         "plan": None if plan is None else {"robot": plan.robot_name, "group": plan.group, "steps": steps},
+        "skipped": [part.as_dict() for part in summary.skipped],
     }
     if as_json:
         _emit(document)

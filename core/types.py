@@ -24,6 +24,7 @@ __all__ = [
     "Plan",
     "RobotState",
     "Shape",
+    "SkippedData",
     "StepResult",
     "TfSamples",
     "TimeSource",
@@ -389,3 +390,24 @@ class RobotState:
             raise ValueError("a pose has 3 position, 4 quaternion and 3 rpy values")
         link_pose = LinkPose(str(pose["link"]), str(pose["frame"]), position, quaternion, rpy)  # type: ignore[arg-type]
         return cls({str(j): float(v) for j, v in document["joints"].items()}, link_pose, prismatic)
+
+
+@dataclass(frozen=True)
+class SkippedData:
+    """A damaged part of a recording that a read skipped, as asked (--skip-damaged).
+
+    Attributes:
+        file: The file it lies in.
+        offset: Where it starts, in bytes from the start of the file.
+        part: What it is: "chunk", "data section", "summary section", "attachment 'NAME'".
+        reason: What is wrong with it: which check failed, with the numbers compared.
+    """
+
+    file: str
+    offset: int
+    part: str
+    reason: str
+
+    def as_dict(self) -> dict[str, object]:
+        """Return it as the JSON documents give it: {"file", "offset", "part", "reason"}."""
+        return {"file": self.file, "offset": self.offset, "part": self.part, "reason": self.reason}

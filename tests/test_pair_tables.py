@@ -72,7 +72,7 @@ def test_tables_are_cached_on_disk(
     monkeypatch.setenv("MOVEPLAN_CACHE_DIR", str(tmp_path))
     monkeypatch.setattr(pair_tables, "_MEMORY", {})
     first = pair_tables.pair_tables(robot.model, hulls, robot.config.srdf.disabled_pairs, robot.config.urdf)
-    [cached] = tmp_path.glob("pairs-*.pickle")
+    [cached] = tmp_path.glob("pairs-*.entry")
     monkeypatch.setattr(pair_tables, "_MEMORY", {})
     monkeypatch.setattr(pair_tables, "_tables", lambda *args: pytest.fail("recomputed a cached table"))
     again = pair_tables.pair_tables(robot.model, hulls, robot.config.srdf.disabled_pairs, robot.config.urdf)

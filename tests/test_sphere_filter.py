@@ -151,12 +151,12 @@ def test_fitted_spheres_are_cached_on_disk_and_a_corrupt_cache_is_rebuilt(
     geometry = CollisionChecker(robot).robot_geometry
     monkeypatch.setattr(sphere_model, "_CACHE", {})
     first = robot_spheres(robot.model, geometry, robot.config.urdf)
-    [cached] = tmp_path.glob("spheres-*.pickle")
-    cached.write_bytes(b"not a pickle")
+    [cached] = tmp_path.glob("spheres-*.entry")
+    cached.write_bytes(b"not a cache entry")
     monkeypatch.setattr(sphere_model, "_CACHE", {})
     again = robot_spheres(robot.model, geometry, robot.config.urdf)
     np.testing.assert_array_equal(first.radii, again.radii)
-    assert cached.read_bytes() != b"not a pickle"
+    assert cached.read_bytes() != b"not a cache entry"
 
 
 def test_a_state_the_filter_finds_colliding_collides_under_the_hulls_and_most_hull_collisions_are_found(

@@ -11,6 +11,7 @@ A file is told by its first bytes, not its name: the MCAP magic or the SQLite he
 from __future__ import annotations
 
 import re
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -18,7 +19,7 @@ from typing import Any, Literal
 from ..config.fields import load_yaml
 from ..errors import InputError
 
-__all__ = ["MCAP_MAGIC", "SQLITE_HEADER", "BagFile", "Storage", "bag_files", "split_order"]
+__all__ = ["MCAP_MAGIC", "SQLITE_HEADER", "BagFile", "Storage", "bag_files", "check_regular", "split_order"]
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 SQLITE_HEADER = b"SQLite format 3\x00"
@@ -55,9 +56,11 @@ def storage_of(path: Path) -> Storage:
     """Return the storage kind of the file at `path`, told by its first bytes.
 
     Raises:
-        InputError: The file is missing, unreadable, a folder, or neither MCAP nor SQLite.
+        InputError: The file is missing, unreadable, a folder, a device or pipe, or neither
+            MCAP nor SQLite.
 
     """
+    check_regular(path)
     try:
         with path.open("rb") as stream:
             head = stream.read(len(SQLITE_HEADER))
@@ -75,6 +78,27 @@ def storage_of(path: Path) -> Storage:
         raise InputError(f"{path}: not a rosbag2 sqlite3 file (it does not start with the "
                          "SQLite header)")
     raise InputError(f"{path}: not an MCAP file (it does not start with the MCAP magic)")
+
+
+_KINDS = ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISFIFO, "a pipe"),
+          (stat.S_ISSOCK, "a socket"))
+
+
+def check_regular(path: Path) -> None:
+    """Raise InputError unless `path` is a regular file (or a folder, which the caller tells apart).
+
+    A device or pipe is refused before it is opened: /dev/zero never ends, a pipe without a
+    writer blocks the open itself, and neither can be read twice or from its end.
+    """
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        raise InputError(f"{path}: file not found") from None
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    kind = next((name for test, name in _KINDS if test(mode)), None)
+    if kind is not None:
+        raise InputError(f"{path}: not a regular file ({kind}); give an .mcap or .db3 file, or a bag folder")
 
 
 def split_order(path: Path) -> tuple[str, int]:

@@ -11,13 +11,22 @@ Messages are read in the order they were inserted (by id), a few thousand at a t
 SQLite concatenates a batch's payloads and receive times (group_concat), which spares
 Python a tuple and a bytes object per message, and the payloads are handed on as numpy
 bytes like MCAP chunks. A damaged file (truncated, or not a bag) is an InputError naming it.
+
+Reading never changes a file of the bag, nor adds one beside it: SQLite opens a file with
+no pending write-ahead log or rollback journal as immutable (no lock, no -shm file); one
+with them (a recorder that crashed, or is still writing) is copied with them to a
+temporary folder, where SQLite replays the log into the copy: the data read is what a
+recovered bag holds, the bag folder stays as it was.
 """
 
 from __future__ import annotations
 
+import logging
+import shutil
 import sqlite3
+import tempfile
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,7 +35,11 @@ from numpy.typing import NDArray
 
 from ..errors import CorruptData, InputError
 
-__all__ = ["Db3Batch", "Db3Info", "Db3Topic", "db3_info", "db3_messages", "open_db3", "topic_counts"]
+__all__ = [
+    "Db3Batch", "Db3Info", "Db3Topic", "check_pages", "db3_info", "db3_messages", "open_db3", "topic_counts",
+]
+
+logger = logging.getLogger(__name__)
 
 # Message ids per query: a batch of a few MB, like an MCAP chunk.
 _BATCH_IDS = 8192
@@ -70,19 +83,62 @@ class Db3Batch:
 
 @contextmanager
 def open_db3(path: Path) -> Iterator[sqlite3.Connection]:
-    """Yield `path` opened read-only; an sqlite3 error inside the block becomes an InputError naming it."""
+    """Yield `path` opened for reading without changing it; an sqlite3 error inside the block becomes an InputError.
+
+    The error names `path`, also when a copy is read (a file with a pending write-ahead log).
+    """
+    with ExitStack() as stack:
+        try:
+            connection = _connect(path, stack)
+        except sqlite3.Error as exc:
+            raise InputError(f"{path}: cannot open as a rosbag2 sqlite3 file: {exc}") from None
+        try:
+            yield connection
+        except sqlite3.Error as exc:
+            raise InputError(_damage(path, exc)) from None
+        except CorruptData as exc:
+            raise InputError(f"{path}: {exc}") from None
+        finally:
+            connection.close()
+
+
+def _connect(path: Path, stack: ExitStack) -> sqlite3.Connection:
+    """Return a connection reading `path` that writes nothing in its folder; a copy's folder goes on `stack`."""
+    pending = [log for log in (Path(f"{path}-wal"), Path(f"{path}-journal")) if _has_bytes(log)]
+    if not pending:
+        # Read-only alone is not enough: a reader still writes its marks into a WAL database's -shm file.
+        return sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro&immutable=1", uri=True)
+    # immutable=1 would ignore the log and read the bag as it was before its last transactions.
+    logger.info("%s: has a pending %s; reading a copy, so that the bag stays untouched", path,
+                " and ".join(log.name for log in pending))
     try:
-        connection = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True)
-    except sqlite3.Error as exc:
-        raise InputError(f"{path}: cannot open as a rosbag2 sqlite3 file: {exc}") from None
+        folder = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="moveplan-db3-")))
+        copy = folder / path.name
+        shutil.copyfile(path, copy)
+        for log in pending:
+            shutil.copyfile(log, folder / (copy.name + log.name[len(path.name) :]))
+    except OSError as exc:
+        raise InputError(f"{path}: cannot copy it with its {pending[0].name} to {tempfile.gettempdir()} (set "
+                         f"TMPDIR to a folder with space): {exc.strerror or exc}") from None
+    return sqlite3.connect(copy)
+
+
+def _has_bytes(path: Path) -> bool:
     try:
-        yield connection
-    except sqlite3.Error as exc:
-        raise InputError(_damage(path, exc)) from None
-    except CorruptData as exc:
-        raise InputError(f"{path}: {exc}") from None
-    finally:
-        connection.close()
+        return path.stat().st_size > 0
+    except OSError:
+        return False
+
+
+def check_pages(connection: sqlite3.Connection, path: Path) -> None:
+    """Raise InputError naming `path` unless SQLite's quick_check finds every page of the file sound.
+
+    It reads every page: garbage in the pages of messages a count never visits is found too.
+    """
+    (result,) = connection.execute("PRAGMA quick_check(1)").fetchone()
+    if result != "ok":
+        found = "; ".join(line.strip() for line in str(result).splitlines() if not line.startswith("***"))
+        raise InputError(f"{path}: corrupt sqlite3 file (SQLite's quick_check: {found})")
 
 
 def _damage(path: Path, exc: sqlite3.Error) -> str:

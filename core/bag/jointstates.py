@@ -16,6 +16,7 @@ from __future__ import annotations
 import logging
 import struct
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -67,6 +68,7 @@ def open_joint_states(
     joints: Sequence[str] | None = None,
     time_source: TimeSource = "header",
     velocities: bool = True,
+    skip_damaged: bool = False,
 ) -> JointStateStore:
     """Return the joint states recorded on `topic` as a store read by row ranges (close it after use).
 
@@ -84,11 +86,13 @@ def open_joint_states(
             when every stamp is zero), "log" for the bag's log time (receive time).
         velocities: False to leave the recorded velocities unread (store.has_velocities is
             False): an hour at 1 kHz holds 170 MB of them.
+        skip_damaged: Skip the MCAP chunks (and summary or data sections) that fail their CRC
+            or size checks, with a warning, instead of refusing the file; store.skipped lists them.
 
     Raises:
-        InputError: The file is missing, of no bag kind, truncated or corrupt; the topic is
-            absent (the message lists the topics present) or not JointState; or no
-            message carries all of `joints` (the message lists the joints present); a
+        InputError: The file is missing, of no bag kind, truncated or corrupt (damaged, unless
+            skipped); the topic is absent (the message lists the topics present) or not
+            JointState; or no message carries all of `joints` (the message lists the joints present); a
             message names a joint twice; a time goes back more than 50 ms; or a wanted
             joint has no finite position in any message.
 
@@ -98,8 +102,8 @@ def open_joint_states(
     source = Path(path)
     decoder = _Decoder(source, topic, tuple(joints) if joints is not None else None, velocities,
                        time_source)
-    read_topic(source, topic, decoder)
-    return decoder.store(time_source)
+    skipped = read_topic(source, topic, decoder, skip_damaged)
+    return replace(decoder.store(time_source), skipped=skipped)
 
 
 class _Decoder:

@@ -14,12 +14,14 @@ from __future__ import annotations
 import struct
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import IO
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import CorruptData, InputError
+from .chunk_codecs import DEFAULT_MAX_CHUNK_BYTES, MAX_CHUNK_ENV, Damage, Skips
 from .mcap_records import (
     ATTACHMENT,
     CHANNEL,
@@ -68,8 +70,14 @@ class DataRecord:
     indexes: dict[int, NDArray[np.uint64]] | None = None
 
 
-def data_records(stream: IO[bytes], size: int) -> Iterator[DataRecord]:
-    """Yield the records after the magic up to the footer; a cut record last, as opcode CUT."""
+def data_records(stream: IO[bytes], size: int, limit: int = DEFAULT_MAX_CHUNK_BYTES) -> Iterator[DataRecord]:
+    """Yield the records after the magic up to the footer; a cut record last, as opcode CUT.
+
+    Raises:
+        CorruptData: A record whose content is read (not a chunk, not an attachment) is
+            longer than `limit` bytes.
+
+    """
     position = len(MAGIC)
     while position < size:
         stream.seek(position)
@@ -88,6 +96,9 @@ def data_records(stream: IO[bytes], size: int) -> Iterator[DataRecord]:
             indexes, end = _message_indexes(stream, end, size)
             yield DataRecord(opcode, position, b"", length, indexes)
         elif opcode != MESSAGE_INDEX:  # one that follows no chunk indexes nothing
+            if length > limit and opcode != ATTACHMENT:
+                raise CorruptData(f"the record at byte {position} (opcode {opcode:#04x}) is {length} bytes long, "
+                                  f"more than {MAX_CHUNK_ENV} allows ({limit})")
             # Of an attachment (a file of any size), only the head that names it is read.
             yield DataRecord(opcode, position, stream.read(min(length, _ATTACHMENT_HEAD)
                                                            if opcode == ATTACHMENT else length), length)
@@ -119,12 +130,15 @@ class Definitions:
     """The Schema and Channel records of a file read linearly, learned from chunks only as needed.
 
     `learn` takes each Schema or Channel record met, as (opcode, content); `skipped` are the
-    positions of chunks not walked, searched if a channel or schema stays undefined.
+    positions of chunks not walked, searched if a channel or schema stays undefined. A
+    damaged chunk of the file at `path` goes to `skips` (which refuses it unless allowed).
     """
 
     stream: IO[bytes]
     learn: Callable[[int, memoryview], None]
     codecs: Codecs
+    path: Path = Path()
+    skips: Skips = field(default_factory=Skips)
     channels: dict[int, int] = field(default_factory=dict)
     schemas: set[int] = field(default_factory=set)
     skipped: list[int] = field(default_factory=list)
@@ -148,12 +162,14 @@ class Definitions:
 
         Walked: a chunk without message indexes, or one naming an undefined channel. The
         skipped chunks before it are searched first when it needs a definition it lacks.
-        The records returned are valid until the next call.
+        The records returned are valid until the next call. A damaged chunk skipped gives None.
         """
         if record.indexes is not None and all(c in self.channels for c in record.indexes):
             self.skipped.append(record.position)
             return None
         buf = self.records(record)
+        if buf is None:
+            return None
         found = [(op, content) for op, content in walk(memoryview(buf.data)) if op in (SCHEMA, CHANNEL)]
         if not self._complete(found, record.indexes or {}):
             self._search_skipped()
@@ -161,14 +177,25 @@ class Definitions:
             self.take(opcode, content)
         return buf
 
-    def records(self, record: DataRecord) -> NDArray[np.uint8]:
-        """Return a chunk's records read and decompressed, valid until the next call."""
-        self.stream.seek(record.position)
-        raw = self.stream.read(RECORD_HEAD + record.length)
-        (size,) = struct.unpack_from("<Q", raw, RECORD_HEAD + 16)
-        if len(self.out) < size:
-            self.out = bytearray(size)
-        return chunk_records(memoryview(raw), record.position, self.codecs, self.out)
+    def records(self, record: DataRecord) -> NDArray[np.uint8] | None:
+        """Return a chunk's records read and decompressed, valid until the next call; None if damaged and skipped."""
+        return self._read(record, reuse=True)
+
+    def _read(self, record: DataRecord, reuse: bool) -> NDArray[np.uint8] | None:
+        """Return a chunk's records, in the reused buffer if `reuse`; None if damaged and skipped."""
+        try:
+            damage = self.codecs.too_long(record.position, record.length)
+            if damage is not None:
+                raise damage
+            self.stream.seek(record.position)
+            raw = self.stream.read(RECORD_HEAD + record.length)
+            (size,) = struct.unpack_from("<Q", raw, RECORD_HEAD + 16)
+            if reuse and len(self.out) < size <= self.codecs.limit:
+                self.out = bytearray(size)
+            return chunk_records(memoryview(raw), record.position, self.codecs, self.out if reuse else None)
+        except Damage as damage:
+            self.skips.take(self.path, damage)
+            return None
 
     def _complete(self, found: list[tuple[int, memoryview]], indexed: dict[int, NDArray[np.uint64]]) -> bool:
         """Return True if the known definitions and `found` define every channel and schema needed."""
@@ -190,10 +217,12 @@ class Definitions:
         skipped, self.skipped = self.skipped, []
         for position in skipped:
             self.stream.seek(position)
-            _, length = struct.unpack("<BQ", self.stream.read(RECORD_HEAD))
-            self.stream.seek(position)
-            raw = memoryview(self.stream.read(RECORD_HEAD + length))
-            for opcode, content in walk(memoryview(chunk_records(raw, position, self.codecs).data)):
+            opcode, length = struct.unpack("<BQ", self.stream.read(RECORD_HEAD))
+            # Not in the reused buffer: it holds the records of the chunk that needs these definitions.
+            buf = self._read(DataRecord(opcode, position, b"", length), reuse=False)
+            if buf is None:
+                continue
+            for opcode, content in walk(memoryview(buf.data)):
                 if opcode in (SCHEMA, CHANNEL):
                     self.take(opcode, content)
 
@@ -239,11 +268,12 @@ class Survey:
         self.messages += len(log_times)
 
 
-def survey(path: object, stream: IO[bytes], size: int) -> Survey:
+def survey(path: Path, stream: IO[bytes], size: int, skips: Skips | None = None) -> Survey:
     """Return what an MCAP file holds, counted from the start without a summary.
 
     Chunks are counted from the MessageIndex records that follow them, and decompressed
-    only to learn definitions or where they have no message indexes.
+    only to learn definitions or where they have no message indexes. A damaged chunk that
+    `skips` allows to skip is counted from its message indexes all the same, else not at all.
 
     Raises:
         InputError: The file is truncated inside a record, or corrupt, or a message uses
@@ -251,9 +281,9 @@ def survey(path: object, stream: IO[bytes], size: int) -> Survey:
 
     """
     found = Survey()
-    definitions = Definitions(stream, found.learn, Codecs())
+    definitions = Definitions(stream, found.learn, Codecs(), path, skips or Skips())
     try:
-        for record in data_records(stream, size):
+        for record in data_records(stream, size, definitions.codecs.limit):
             if record.opcode == CUT:
                 raise InputError(f"{path}: file is truncated (the record at byte "
                                  f"{record.position} runs past its end)")

@@ -11,12 +11,13 @@ from __future__ import annotations
 import struct
 from collections.abc import Iterator
 from dataclasses import dataclass, field
-from typing import IO, Any
+from typing import IO
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import CorruptData, InputError
+from .chunk_codecs import MAX_CHUNK_ENV, Codecs, Damage, crc32
 
 __all__ = [
     "ATTACHMENT",
@@ -79,19 +80,34 @@ class Summary:
     channel_counts: dict[int, int] = field(default_factory=dict)
 
 
-def read_summary(stream: IO[bytes], size: int) -> Summary | None:
-    """Return the schemas, channels and chunk indexes of the summary section, or None."""
+def read_summary(stream: IO[bytes], size: int, limit: int) -> Summary | None:
+    """Return the schemas, channels and chunk indexes of the summary section, or None without a readable one.
+
+    Raises:
+        Damage: The summary section is longer than `limit` bytes, or fails the footer's CRC check.
+
+    """
     if size < len(MAGIC) + FOOTER_SIZE:
         return None
     stream.seek(size - FOOTER_SIZE)
     tail = stream.read(FOOTER_SIZE)
     if tail[-len(MAGIC) :] != MAGIC or tail[0] != FOOTER:
         return None
-    summary_start = struct.unpack_from("<Q", tail, RECORD_HEAD)[0]
+    summary_start, _, summary_crc = struct.unpack_from("<QQI", tail, RECORD_HEAD)
     if not len(MAGIC) <= summary_start <= size - FOOTER_SIZE:
         return None
+    length = size - FOOTER_SIZE - summary_start
+    if length > limit:
+        raise Damage("summary section", summary_start, f"is {length} bytes long, more than {MAX_CHUNK_ENV} "
+                                                       f"allows ({limit})")
     stream.seek(summary_start)
-    data = stream.read(size - FOOTER_SIZE - summary_start)
+    data = stream.read(length)
+    if summary_crc:
+        # Over the summary and the footer up to its summary_crc field (MCAP specification).
+        computed = crc32(tail[: RECORD_HEAD + 16], crc32(data))
+        if computed != summary_crc:
+            raise Damage("summary section", summary_start, f"fails its CRC check: its CRC-32 is {computed:#010x}, "
+                                                           f"the footer records {summary_crc:#010x}")
     summary = Summary()
     try:
         for opcode, content in walk(data):
@@ -198,68 +214,44 @@ def _chunk_index(content: memoryview) -> ChunkIndex:
 def chunk_records(
     raw: memoryview, chunk_at: int, codecs: Codecs, out: bytearray | None = None
 ) -> NDArray[np.uint8]:
-    """Return the decompressed records of the Chunk record in `raw`, in `out` if it fits."""
+    """Return the decompressed records of the Chunk record in `raw`, in `out` if it fits, checked whole.
+
+    Raises:
+        Damage: The chunk declares more records than `codecs.limit`, holds fewer bytes than it
+            says, does not decompress to the size it declares, or fails its CRC check.
+        CorruptData: There is no chunk at all where `raw` begins.
+
+    """
     opcode, _ = struct.unpack_from("<BQ", raw)
     if opcode != CHUNK:
         raise CorruptData(f"no chunk at byte {chunk_at}, where the chunk index points")
-    (uncompressed_size,) = struct.unpack_from("<Q", raw, RECORD_HEAD + 16)
+    uncompressed_size, uncompressed_crc = struct.unpack_from("<QI", raw, RECORD_HEAD + 16)
+    damage = codecs.too_large(chunk_at, uncompressed_size)
+    if damage is not None:
+        raise damage
     compression, offset = _string(raw, RECORD_HEAD + 28)
     (length,) = struct.unpack_from("<Q", raw, offset)
     records = raw[offset + 8 : offset + 8 + length]
     if len(records) != length:
-        raise CorruptData(f"the chunk at byte {chunk_at} is cut")
+        raise Damage("chunk", chunk_at, f"holds {len(records)} bytes of records where it declares {length}")
     try:
         data = codecs.decompress(compression, records, uncompressed_size, out)
-    except (InputError, CorruptData):
+    except Damage:
+        raise
+    except CorruptData as exc:
+        raise Damage("chunk", chunk_at, str(exc)) from None
+    except InputError:
         raise
     except Exception as exc:  # each codec raises its own kinds
-        raise CorruptData(f"the chunk at byte {chunk_at} does not decompress ({exc})") from None
+        raise Damage("chunk", chunk_at, f"does not decompress ({type(exc).__name__}: {exc})") from None
     if len(data) != uncompressed_size:
-        raise CorruptData(f"the chunk at byte {chunk_at} decompresses to the wrong size")
+        raise Damage("chunk", chunk_at, f"decompresses to {len(data)} bytes, not the {uncompressed_size} it declares")
+    if uncompressed_crc:
+        computed = crc32(data)
+        if computed != uncompressed_crc:
+            raise Damage("chunk", chunk_at, f"fails its CRC check: its records' CRC-32 is {computed:#010x}, the "
+                                            f"chunk records {uncompressed_crc:#010x}")
     return np.frombuffer(data, dtype=np.uint8)
-
-
-class Codecs:
-    """Decompressors, made once per read: a zstd context costs more to make than to use."""
-
-    def __init__(self) -> None:
-        self._zstd: Any = None
-
-    def decompress(
-        self, compression: str, records: memoryview, size: int, out: bytearray | None
-    ) -> bytes | memoryview:
-        """Return one chunk's records decompressed, into `out` where the codec allows it.
-
-        Decompressing into a reused buffer spares a fresh megabyte of memory, and its
-        page faults, per chunk.
-        """
-        if compression == "":
-            return records
-        if compression == "zstd":
-            if self._zstd is None:
-                import zstandard
-
-                self._zstd = zstandard.ZstdDecompressor()
-            if out is None or len(out) < size:
-                return self._zstd.decompress(records, max_output_size=size)  # type: ignore[no-any-return]
-            view = memoryview(out)[:size]
-            filled = 0
-            with self._zstd.stream_reader(records) as reader:
-                while filled < size:
-                    count = reader.readinto(view[filled:])
-                    if not count:
-                        break
-                    filled += count
-                if filled < size or reader.read(1):
-                    raise CorruptData(f"a chunk does not decompress to its {size} bytes")
-            return view
-        if compression == "lz4":
-            try:
-                import lz4.frame
-            except ImportError:
-                raise InputError("the file has lz4-compressed chunks; install lz4") from None
-            return bytes(lz4.frame.decompress(records))
-        raise CorruptData(f"unknown chunk compression '{compression}'")
 
 
 def message_index(raw: memoryview, at: int) -> NDArray[np.uint64]:

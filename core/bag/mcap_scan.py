@@ -24,6 +24,7 @@ from mcap.records import Attachment, Channel, Header, McapRecord, Message, Metad
 from mcap.stream_reader import MAGIC_SIZE, StreamReader
 
 from ..errors import InputError
+from .bag_files import check_regular
 
 __all__ = ["DAMAGE", "Contents", "Kept", "open_mcap", "scan"]
 
@@ -55,9 +56,10 @@ def open_mcap(path: Path) -> Iterator[IO[bytes]]:
     """Yield `path` opened for reading, after checking that it starts like an MCAP file.
 
     Raises:
-        InputError: The file is missing, a folder, unreadable or not MCAP.
+        InputError: The file is missing, a folder, a device or pipe, unreadable or not MCAP.
 
     """
+    check_regular(path)
     try:
         stream = path.open("rb")
     except FileNotFoundError:

@@ -16,7 +16,9 @@ from mcap_ros2.decoder import DecoderFactory
 
 from ..errors import InputError
 from ..types import JointTrajectory
+from .chunk_codecs import Skips
 from .mcap_scan import DAMAGE, Contents, Kept, open_mcap, scan
+from .mcap_verify import verify_mcap
 from .messages import trajectory_from_message
 
 __all__ = [
@@ -88,10 +90,13 @@ def read_plan(path: Path) -> PlanFile:
     """Return the plan stored in the moveplan MCAP file at `path`.
 
     Raises:
-        InputError: The file is missing, not MCAP, truncated, corrupt or not a moveplan plan.
+        InputError: The file is missing, not MCAP, truncated, corrupt (a chunk, attachment or
+            section failing its CRC or size checks) or not a moveplan plan.
 
     """
     with open_mcap(path) as stream:
+        # Checked whole first: the mcap package would unpack a chunk to whatever size its frame claims.
+        verify_mcap(path, stream, stream.seek(0, 2), Skips())
         contents = scan(path, stream, keep_topics=(TRAJECTORY, ROBOT_DESCRIPTION))
     info = next((m.metadata for m in contents.metadata if m.name == "moveplan"), {})
     if any(key not in info for key in PLAN_KEYS):

@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..types import JointStateSeries, TimeSource
+from ..types import JointStateSeries, SkippedData, TimeSource
 from .joint_state_checks import REORDER_LIMIT_NS, OrderWatch, finite_error
 
 __all__ = ["JointStateStore", "SampleSpool"]
@@ -96,6 +96,7 @@ class JointStateStore:
         start_ns: Time of the first sample in [ns] (header stamp or log time).
         time_source: "header" or "log", as for JointStateSeries.
         source: The file or folder read, for messages.
+        skipped: The damaged parts of the recording its read skipped, as asked (--skip-damaged).
 
     """
 
@@ -107,6 +108,7 @@ class JointStateStore:
     _times: _Column
     _positions: _Column
     _velocities: _Column | None
+    skipped: tuple[SkippedData, ...] = ()
 
     @property
     def has_velocities(self) -> bool:

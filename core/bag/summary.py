@@ -2,8 +2,9 @@
 
 Of an MCAP file, taken from the summary section's statistics when they are complete, else
 counted in one linear pass (an unfinished or damaged file) through the message indexes
-that follow each chunk (core.bag.mcap_linear). Of a rosbag2 sqlite3 file, counted by
-SQLite. Of a bag folder, its split files' summaries merged.
+that follow each chunk (core.bag.mcap_linear); either way after every CRC and size the
+file records has been checked (core.bag.mcap_verify). Of a rosbag2 sqlite3 file, counted
+by SQLite after its quick_check. Of a bag folder, its split files' summaries merged.
 """
 
 from __future__ import annotations
@@ -15,10 +16,13 @@ from typing import IO
 from mcap.reader import SeekingReader
 from mcap.records import Channel, Header, Schema
 
+from ..types import SkippedData
 from .bag_files import bag_files
-from .db3 import db3_info, open_db3, topic_counts
+from .chunk_codecs import Skips
+from .db3 import check_pages, db3_info, open_db3, topic_counts
 from .mcap_linear import survey
 from .mcap_scan import DAMAGE, open_mcap
+from .mcap_verify import verify_mcap
 from .qos import durability
 
 __all__ = ["BagSummary", "TopicSummary", "summarize"]
@@ -37,7 +41,11 @@ class TopicSummary:
 
 @dataclass(frozen=True)
 class BagSummary:
-    """What `moveplan inspect` shows of an MCAP file; times are log times in [ns]."""
+    """What `moveplan inspect` shows of an MCAP file; times are log times in [ns].
+
+    `skipped` lists the damaged parts left out (`skip_damaged`); the counts leave out the
+    messages of a skipped chunk, as its message indexes count them.
+    """
 
     profile: str
     library: str
@@ -47,33 +55,42 @@ class BagSummary:
     topics: tuple[TopicSummary, ...]
     metadata: tuple[str, ...]
     attachments: tuple[str, ...]
+    skipped: tuple[SkippedData, ...] = ()
 
 
-def summarize(path: Path) -> BagSummary:
+def summarize(path: Path, skip_damaged: bool = False) -> BagSummary:
     """Return profile, topics, counts, time range, metadata and attachment names of a bag.
 
     `path` is an MCAP or rosbag2 sqlite3 (.db3) file, or a bag folder (its splits merged).
-    An MCAP file's summary section is used when complete, else it is counted in one pass.
+    An MCAP file is checked whole first (every chunk decompressed, every CRC compared); its
+    summary section is used when complete, else it is counted in one pass. A .db3 file's
+    pages are checked by SQLite's quick_check. With `skip_damaged`, damaged MCAP chunks (or
+    summary, data section, attachments) are skipped with a warning and listed in `skipped`.
 
     Raises:
-        InputError: A file is missing, of neither kind, truncated or corrupt.
+        InputError: A file is missing, of neither kind, truncated or corrupt (naming the
+            damaged part's offset and the check it fails).
 
     """
-    summaries = [_db3_summary(file.path) if file.storage == "sqlite3" else _mcap_summary(file.path)
+    skips = Skips(skip_damaged)
+    summaries = [_db3_summary(file.path) if file.storage == "sqlite3" else _mcap_summary(file.path, skips)
                  for file in bag_files(path)]
-    return summaries[0] if len(summaries) == 1 else _merged(summaries)
+    summary = summaries[0] if len(summaries) == 1 else _merged(summaries)
+    return replace(summary, skipped=tuple(skips.found))
 
 
-def _mcap_summary(path: Path) -> BagSummary:
-    """Return the summary of one MCAP file: from its summary section, else counted."""
+def _mcap_summary(path: Path, skips: Skips) -> BagSummary:
+    """Return the summary of one MCAP file, checked whole: from its summary section, else counted."""
     with open_mcap(path) as stream:
-        indexed = _summary_from_index(stream)
+        size = stream.seek(0, 2)
+        verified = verify_mcap(path, stream, size, skips)
+        indexed = _summary_from_index(stream, verified.lost) if verified.summary_sound else None
         if indexed is not None:
             return indexed
-        size = stream.seek(0, 2)
-        found = survey(path, stream, size)
+        found = survey(path, stream, size, skips)
     topics = [
-        TopicSummary(topic, found.schemas.get(schema_id, ""), encoding, found.counts.get(channel_id, 0),
+        TopicSummary(topic, found.schemas.get(schema_id, ""), encoding,
+                     found.counts.get(channel_id, 0) - verified.lost.get(channel_id, 0),
                      durability(metadata.get("offered_qos_profiles", "")))
         for channel_id, (topic, schema_id, encoding, metadata) in found.channels.items()
     ]
@@ -86,6 +103,7 @@ def _mcap_summary(path: Path) -> BagSummary:
 def _db3_summary(path: Path) -> BagSummary:
     """Return the summary of one rosbag2 sqlite3 file, its messages counted by SQLite."""
     with open_db3(path) as connection:
+        check_pages(connection, path)
         info = db3_info(connection, path)
         counts, start_ns, end_ns = topic_counts(connection, [t.id for t in info.topics])
     schema = f", schema version {info.schema_version}" if info.schema_version else ""
@@ -114,8 +132,11 @@ def _merged(summaries: list[BagSummary]) -> BagSummary:
                       tuple(n for s in summaries for n in s.attachments))
 
 
-def _summary_from_index(stream: IO[bytes]) -> BagSummary | None:
-    """Return the summary from the file's summary section, or None where that is incomplete."""
+def _summary_from_index(stream: IO[bytes], lost: dict[int, int]) -> BagSummary | None:
+    """Return the summary from the file's summary section, or None where that is incomplete.
+
+    `lost` counts per channel id the messages of chunks skipped as damaged: not counted.
+    """
     stream.seek(0)
     try:
         reader = SeekingReader(stream)
@@ -138,7 +159,7 @@ def _summary_from_index(stream: IO[bytes]) -> BagSummary | None:
             (
                 channel,
                 summary.schemas.get(channel.schema_id),
-                stats.channel_message_counts.get(channel.id, 0),
+                stats.channel_message_counts.get(channel.id, 0) - lost.get(channel.id, 0),
             )
             for channel in summary.channels.values()
         ],

@@ -11,9 +11,11 @@ warning: chunk by chunk through the MessageIndex records that follow each chunk.
 file is read a batch of messages at a time (core.bag.db3). Only the current chunk or batch
 is held: memory does not grow with the recording.
 
-The records are core.bag.mcap_records' to parse, without the mcap package. Chunk CRCs
-are not checked, as rosbag2 writes none (CRC 0) by default; decompression and the
-record structure still catch damaged chunks.
+The records are core.bag.mcap_records' to parse, without the mcap package. Each chunk
+read is checked whole (core.bag.chunk_codecs): decompressed no further than the size it
+declares, itself bounded, and its CRC compared where the writer computed one; the summary
+and data section CRCs too, where present. A damaged part is bad input, or with
+`skip_damaged` skipped with a warning, and listed in what `read_topic` returns.
 """
 
 from __future__ import annotations
@@ -31,7 +33,9 @@ from numpy.lib.stride_tricks import as_strided, sliding_window_view
 from numpy.typing import NDArray
 
 from ..errors import CorruptData, InputError
+from ..types import SkippedData
 from .bag_files import MCAP_MAGIC, bag_files
+from .chunk_codecs import Damage, Skips
 from .db3 import db3_info, db3_messages, open_db3
 from .mcap_linear import CUT, DataRecord, Definitions, data_records
 from .mcap_records import (
@@ -42,6 +46,7 @@ from .mcap_records import (
     MESSAGE_FIXED,
     RECORD_HEAD,
     SCHEMA,
+    ChunkIndex,
     Codecs,
     Summary,
     channel_record,
@@ -51,6 +56,7 @@ from .mcap_records import (
     schema_record,
     walk_positions,
 )
+from .mcap_verify import data_section_damage
 
 __all__ = ["Channel", "MessageSink", "byte_rows", "read_topic"]
 
@@ -98,22 +104,24 @@ class MessageSink(Protocol):
         ...
 
 
-def read_topic(source: Path, topic: str, sink: MessageSink) -> None:
-    """Hand every message on `topic` to `sink`, file by file, in file order.
+def read_topic(source: Path, topic: str, sink: MessageSink, skip_damaged: bool = False) -> tuple[SkippedData, ...]:
+    """Hand every message on `topic` to `sink`, file by file, in file order; return the damaged parts skipped.
 
     Args:
         source: An MCAP or rosbag2 sqlite3 (.db3) file, or a rosbag2 bag folder whose
             split files are read in order (core.bag.bag_files).
         topic: The topic to read.
         sink: Checks the topic's channels, then takes their payloads.
+        skip_damaged: Skip an MCAP chunk that fails its CRC or size checks, the summary
+            section or data section CRC, with a warning, instead of refusing the file.
 
     Raises:
-        InputError: A file is missing, neither MCAP nor sqlite3, or corrupt; the topic is
-            absent (the message lists the topics present) or has no messages; or `sink`
-            refused a channel.
+        InputError: A file is missing, neither MCAP nor sqlite3, or corrupt (a damaged part
+            names its offset and the check that failed); the topic is absent (the message
+            lists the topics present) or has no messages; or `sink` refused a channel.
 
     """
-    reader = _Reader(topic, sink)
+    reader = _Reader(topic, sink, skips=Skips(skip_damaged))
     for file in bag_files(source):
         if file.storage == "sqlite3":
             reader.read_db3(file.path)
@@ -125,7 +133,9 @@ def read_topic(source: Path, topic: str, sink: MessageSink) -> None:
         raise InputError(f"{source}: no topic {topic}{cut}; topics present: {present}")
     if reader.messages == 0:
         cut = f"; {reader.cut[0]}" if reader.cut else ""
-        raise InputError(f"{source}: no messages on {topic}{cut}")
+        lost = f"; {len(reader.skips.found)} damaged parts skipped" if reader.skips.found else ""
+        raise InputError(f"{source}: no messages on {topic}{cut}{lost}")
+    return tuple(reader.skips.found)
 
 
 def byte_rows(buf: NDArray[np.uint8], starts: NDArray[np.int64], length: int) -> NDArray[np.uint8]:
@@ -153,6 +163,7 @@ class _Reader:
     codecs: Codecs = field(default_factory=lambda: Codecs())
     messages: int = 0
     cut: list[str] = field(default_factory=list)
+    skips: Skips = field(default_factory=Skips)
 
     def read_file(self, path: Path) -> None:
         """Read one MCAP file: through its summary's indexes, else by a linear scan."""
@@ -171,17 +182,29 @@ class _Reader:
             # Channel and schema ids are per file.
             self.path, self.wanted, self.schemas = path, set(), {}
             try:
-                summary = read_summary(stream, size)
+                summary = self._summary(stream, size)
                 if summary is not None and summary.chunks and summary.channels:
                     _read_indexed(stream, size, summary, self)
                 else:
-                    if summary is None:
-                        logger.warning(
-                            "%s: no summary index (an unfinished or cut-off recording?); reading "
-                            "it by a linear scan", path)
                     _read_linear(stream, size, self)
+                # Last: a damaged chunk read is named by its own offset, not by the whole section's CRC.
+                damage = data_section_damage(stream, size)
+                if damage is not None:
+                    self.skips.take(path, damage)
             except CorruptData as exc:
                 raise InputError(f"{path}: corrupt MCAP data: {exc}") from None
+
+    def _summary(self, stream: BufferedReader, size: int) -> Summary | None:
+        """Return the file's summary section; None if it has none (with a warning), or one damaged and skipped."""
+        try:
+            summary = read_summary(stream, size, self.codecs.limit)
+        except Damage as damage:
+            self.skips.take(self.path, damage)  # its warning says why the file is read by a linear scan
+            return None
+        if summary is None:
+            logger.warning("%s: no summary index (an unfinished or cut-off recording?); reading it by a linear scan",
+                           self.path)
+        return summary
 
     def read_db3(self, path: Path) -> None:
         """Read one rosbag2 sqlite3 file, a batch of messages at a time."""
@@ -260,8 +283,8 @@ def _read_indexed(stream: BufferedReader, size: int, summary: Summary, reader: _
     if not wanted:
         return
     reader.sink.reserve(sum(summary.channel_counts.get(c, 0) for c in wanted))
-    chunks = [c for c in sorted(summary.chunks, key=lambda c: c.start)
-              if not c.message_index_offsets or wanted & c.message_index_offsets.keys()]
+    chunks = _sized(reader, size, [c for c in sorted(summary.chunks, key=lambda c: c.start)
+                                   if not c.message_index_offsets or wanted & c.message_index_offsets.keys()])
     # One buffer for the file bytes, one for the decompressed records, reused chunk after
     # chunk: fresh megabytes per chunk cost more in page faults than the decompression.
     # (A reading thread does not pay on two cores: it waits for the GIL as long as it saves.)
@@ -270,9 +293,13 @@ def _read_indexed(stream: BufferedReader, size: int, summary: Summary, reader: _
     for chunk in chunks:
         raw = memoryview(raw_buffer)[: chunk.length + chunk.message_index_length]
         stream.seek(chunk.start)
-        if stream.readinto(raw) < len(raw) or chunk.start + len(raw) > size:
+        if stream.readinto(raw) < len(raw):
             raise CorruptData(f"the chunk at byte {chunk.start} runs past the end of the file")
-        buf = chunk_records(raw[: chunk.length], chunk.start, reader.codecs, out)
+        try:
+            buf = chunk_records(raw[: chunk.length], chunk.start, reader.codecs, out)
+        except Damage as damage:
+            reader.skips.take(reader.path, damage)
+            continue
         ids = [c for c in chunk.message_index_offsets if c in wanted]
         if not ids:  # a chunk written without message indexes: walk its records
             _decode_walked(buf, wanted, reader)
@@ -283,6 +310,25 @@ def _read_indexed(stream: BufferedReader, size: int, summary: Summary, reader: _
             index = np.concatenate(entries)
             index = index[np.argsort(index[:, 1], kind="stable")]
         _decode_records(buf, index[:, 1].astype(np.int64), index[:, 0], reader, chunk.start)
+
+
+def _sized(reader: _Reader, size: int, chunks: list[ChunkIndex]) -> list[ChunkIndex]:
+    """Return the chunks whose sizes, as their indexes declare them, fit the file and the limits.
+
+    Checked before any buffer is made for them: a declared size is a number anyone can write.
+    A chunk over a limit is damage (refused, or skipped); one past the file's end, corruption.
+    """
+    fitting = []
+    for chunk in chunks:
+        if chunk.start + chunk.length + chunk.message_index_length > size:
+            raise CorruptData(f"the chunk at byte {chunk.start} runs past the end of the file")
+        damage = (reader.codecs.too_long(chunk.start, max(chunk.length, chunk.message_index_length))
+                  or reader.codecs.too_large(chunk.start, chunk.uncompressed_size))
+        if damage is not None:
+            reader.skips.take(reader.path, damage)
+        else:
+            fitting.append(chunk)
+    return fitting
 
 
 def _decode_records(
@@ -331,7 +377,7 @@ def _decode_walked(buf: NDArray[np.uint8], wanted: set[int], reader: _Reader) ->
 
 def _read_linear(stream: IO[bytes], size: int, reader: _Reader) -> None:
     """Read the topic's messages from the start, chunk by chunk; stop at a cut record."""
-    definitions = Definitions(stream, reader.learn, reader.codecs)
+    definitions = Definitions(stream, reader.learn, reader.codecs, reader.path, reader.skips)
     batch: list[bytes] = []
     batch_times: list[int] = []
 
@@ -344,7 +390,7 @@ def _read_linear(stream: IO[bytes], size: int, reader: _Reader) -> None:
             batch.clear()
             batch_times.clear()
 
-    for record in data_records(stream, size):
+    for record in data_records(stream, size, reader.codecs.limit):
         if record.opcode == CUT:
             reader.cut_at(record.position)
             break
@@ -368,13 +414,15 @@ def _read_chunk(record: DataRecord, definitions: Definitions, reader: _Reader) -
     walked = definitions.chunk(record)
     indexes = record.indexes
     if indexes is None:
-        assert walked is not None  # a chunk without message indexes is always walked
-        _decode_walked(walked, set(reader.wanted), reader)
+        if walked is not None:  # None: damaged, and skipped
+            _decode_walked(walked, set(reader.wanted), reader)
         return
     ids = [c for c in indexes if c in reader.wanted]
     if not ids:
         return
     buf = walked if walked is not None else definitions.records(record)
+    if buf is None:
+        return
     index = indexes[ids[0]]
     if len(ids) > 1:
         index = np.concatenate([indexes[c] for c in ids])

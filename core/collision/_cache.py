@@ -1,14 +1,17 @@
 """Per-robot data computed once and kept on disk between runs (fitted spheres, distance tables).
 
-Entries are pickles named by a digest of what they were computed from, in
+Entries are files named by a digest of what they were computed from, in
 $MOVEPLAN_CACHE_DIR, else $XDG_CACHE_HOME/moveplan, else ~/.cache/moveplan.
 
-An entry is a header line, `moveplan-cache FORMAT SHA256` and a newline, then the pickle; the sha256
-is the pickle's. An entry that is missing is computed silently; one that cannot be
-trusted (another format, a checksum that does not match, a pickle that does not load or
-holds the wrong type) is recomputed and replaced, with one warning. An entry that cannot
-be written (a read-only folder, a full disk) is skipped and leaves no partial file. The
-value read back is the value written, so a plan is the same with a cold or warm cache.
+An entry is a header line, `moveplan-cache FORMAT SHA256` and a newline, then the payload; the
+sha256 is the payload's. The payload is data checked as it is read (_cache_codec.py: JSON and raw
+arrays), never a pickle: a shared cache folder must not let whoever writes to it run code here,
+and the checksum guards against damage only (anyone can compute it). An entry that is missing is
+computed silently; one that cannot be trusted (another format, a checksum that does not match, a
+payload that does not decode or holds the wrong type, a file over _MOST_BYTES) is recomputed and
+replaced, with one warning. An entry that cannot be written (a read-only folder, a full disk) is
+skipped and leaves no partial file. The value read back is the value written, so a plan is the
+same with a cold or warm cache.
 """
 
 from __future__ import annotations
@@ -19,7 +22,6 @@ import glob
 import hashlib
 import logging
 import os
-import pickle
 import tempfile
 import time
 from pathlib import Path
@@ -27,15 +29,18 @@ from typing import Any
 
 import pinocchio as pin
 
+from ._cache_codec import decode, encode
+
 __all__ = ["FORMAT", "announce", "announce_compilation", "digest", "path", "read", "write"]
 
 logger = logging.getLogger(__name__)
 
-FORMAT = 2
+FORMAT = 3
 """Version of the entry layout; bump it when the layout changes (the old entries are rebuilt)."""
 
 _MAGIC = b"moveplan-cache"
 _STALE_S = 3600.0  # a partial file this old belongs to no running writer
+_MOST_BYTES = 256 * 1024 * 1024  # a robot's entries are kilobytes; a planted file must not fill memory
 
 
 def digest(text: str, geometry: pin.GeometryModel) -> str:
@@ -67,6 +72,8 @@ def path(name: str) -> Path:
 def read(where: Path, kind: type) -> Any:
     """Return the object cached at `where` if it is a trustworthy `kind`, else None (missing or rebuilt)."""
     try:
+        if where.stat().st_size > _MOST_BYTES:
+            return _untrusted(where, f"larger than {_MOST_BYTES:,} bytes")
         data = where.read_bytes()
     except FileNotFoundError:
         return None
@@ -79,8 +86,8 @@ def read(where: Path, kind: type) -> Any:
     if fields[2] != hashlib.sha256(payload).hexdigest().encode():
         return _untrusted(where, "checksum mismatch (a damaged file)")
     try:
-        value = pickle.loads(payload)  # noqa: S301 - our own cache file, written by `write`, checksum verified
-    except Exception as exc:  # noqa: BLE001 - whatever an old pickle raises, the entry is rebuilt
+        value = decode(payload)
+    except Exception as exc:  # noqa: BLE001 - whatever a malformed payload raises, the entry is rebuilt
         return _untrusted(where, f"{type(exc).__name__}: {exc}")
     if not isinstance(value, kind):
         return _untrusted(where, f"holds a {type(value).__name__}, not a {kind.__name__}")
@@ -115,7 +122,7 @@ def write(where: Path, value: Any) -> None:
     Concurrent writers of one entry each write their own temporary file (a random name beside
     `where`) and rename it: the entry is always one complete file, the same whichever wins.
     """
-    payload = pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
+    payload = encode(value)
     header = b"%s %d %s\n" % (_MAGIC, FORMAT, hashlib.sha256(payload).hexdigest().encode())
     try:
         where.parent.mkdir(parents=True, exist_ok=True)

@@ -32,7 +32,7 @@ def inner_spheres(model: pin.Model, hulls: pin.GeometryModel, urdf: str) -> Sphe
     """
     key = disk_cache.digest(f"inner {_VERSION}\n{urdf}", hulls)
     if key not in _MEMORY:
-        path = disk_cache.path(f"inner-{key[:32]}.pickle")
+        path = disk_cache.path(f"inner-{key[:32]}.entry")
         balls = disk_cache.read(path, SphereSet)
         if balls is None:
             balls = _fit(model, hulls)

@@ -5,6 +5,11 @@ them for 15-60 s when it has not (a fresh install, a new numba). A one-shot comm
 so that it can stay with coal rather than pay a compilation a short plan does not need
 (core/pipeline/checks.py). Importing numba to ask would cost half a second itself, so the index
 files are looked up where numba keeps them, as numba.core.caching names them.
+
+An index is pickled, and unpickling a file runs whatever code it names. numba unpickles its own
+cache when it loads the kernels: that is numba's trust in the folder it caches in (the
+__pycache__ beside moveplan's source, or NUMBA_CACHE_DIR). This look unpickles nothing: it
+compares bytes, so asking whether the kernels are cached runs no code from that folder.
 """
 
 from __future__ import annotations
@@ -47,7 +52,7 @@ def kernels_cached() -> bool:
                                  f"{sys.version_info[1]}.nbi"
                 if not _index_matches(index, version, stamp):
                     return False
-    except (OSError, KeyError, metadata.PackageNotFoundError, pickle.UnpicklingError, EOFError):
+    except (OSError, KeyError, metadata.PackageNotFoundError):
         return False
     return True
 
@@ -80,8 +85,10 @@ def _first_lines(source: bytes) -> dict[str, int]:
 def _index_matches(index: Path, version: str, stamp: bytes) -> bool:
     """Return True if `index` was written by numba `version` for the source whose sha256 is `stamp`.
 
-    An index is the numba version pickled, then the pickled (stamp, overloads); the overloads
-    need numba to unpickle, so the stamp's 32 bytes are looked for in the stream instead.
+    An index is the numba version pickled (numba: `pickle.dump(version, f, protocol=-1)`), then the
+    pickled (stamp, overloads). The first is compared as bytes with the same pickling of `version`,
+    and the stamp's 32 bytes are looked for in the rest: nothing is unpickled.
     """
-    with index.open("rb") as stream:
-        return pickle.load(stream) == version and stamp in stream.read()
+    data = index.read_bytes()
+    expected = pickle.dumps(version, protocol=pickle.HIGHEST_PROTOCOL)
+    return data.startswith(expected) and stamp in data[len(expected):]

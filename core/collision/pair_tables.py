@@ -58,7 +58,7 @@ def pair_tables(
     """
     key = disk_cache.digest(f"pairs {_VERSION}\n{urdf}\n{sorted(map(sorted, disabled))}", hulls)
     if key not in _MEMORY:
-        path = disk_cache.path(f"pairs-{key[:32]}.pickle")
+        path = disk_cache.path(f"pairs-{key[:32]}.entry")
         tables = disk_cache.read(path, tuple)
         if tables is None:
             disk_cache.announce(f"tabulating distances of wrist link pairs for {model.name}", path)

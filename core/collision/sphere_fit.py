@@ -60,7 +60,7 @@ def robot_spheres(model: pin.Model, geometry: pin.GeometryModel, urdf: str) -> S
     key = disk_cache.digest(f"{settings}\n{kinds}\n{urdf}", geometry)
     if key in _CACHE:
         return _CACHE[key]
-    path = disk_cache.path(f"spheres-{key[:32]}.pickle")
+    path = disk_cache.path(f"spheres-{key[:32]}.entry")
     spheres = disk_cache.read(path, SphereSet)
     if spheres is None:
         disk_cache.announce(f"fitting collision spheres for {model.name}", path)

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from .fields import boolean, check_keys, mapping, number
+from .fields import boolean, check_keys, load_yaml, mapping, number
 from .substitutions import load_substituted_yaml
 
 __all__ = [
@@ -85,19 +85,23 @@ class ExecutionConfig:
     execution_duration_monitoring: bool = True
 
 
-def parse_controllers(path: Path, launch_args: Mapping[str, str] | None = None) -> dict[str, ControllerConfig]:
+def parse_controllers(
+    path: Path, launch_args: Mapping[str, str] | None = None, substitute: bool = True
+) -> dict[str, ControllerConfig]:
     """Return the JointTrajectoryControllers configured in a ros2_controllers.yaml, by name.
 
     Args:
         path: The file.
         launch_args: Values of its `$(var NAME)` substitutions (the xacro args in force).
+        substitute: False for a file a plan carries: its substitutions were made when the plan
+            was, and a `$(` left in it is text (no environment variable is read for a plan).
 
     Raises:
         ConfigError: A malformed value, or an unknown key in a JointTrajectoryController's
             parameters, `constraints` or `gains`; names the file and the key path. An
             unsupported or malformed substitution; names the file, line and substitution.
     """
-    top = mapping(load_substituted_yaml(path, launch_args), str(path))
+    top = mapping(load_substituted_yaml(path, launch_args) if substitute else load_yaml(path), str(path))
     manager = _ros_parameters(top, "controller_manager", path)
     where = f"{path}: controller_manager.ros__parameters.update_rate"
     rate = number(manager.get("update_rate", 100), where, positive=True)
@@ -126,12 +130,15 @@ def default_controller(joints: Sequence[str]) -> ControllerConfig:
     )
 
 
-def parse_execution(path: Path, launch_args: Mapping[str, str] | None = None) -> ExecutionConfig:
+def parse_execution(
+    path: Path, launch_args: Mapping[str, str] | None = None, substitute: bool = True
+) -> ExecutionConfig:
     """Return moveit_controllers.yaml's trajectory_execution settings, MoveIt's defaults where absent.
 
-    `launch_args` are the values of its `$(var NAME)` substitutions, as for parse_controllers.
+    `launch_args` are the values of its `$(var NAME)` substitutions and `substitute` whether to
+    make them, as for parse_controllers.
     """
-    top = mapping(load_substituted_yaml(path, launch_args), str(path))
+    top = mapping(load_substituted_yaml(path, launch_args) if substitute else load_yaml(path), str(path))
     section = mapping(top.get("trajectory_execution"), f"{path}: trajectory_execution")
     defaults = ExecutionConfig()
     where = f"{path}: trajectory_execution"

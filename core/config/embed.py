@@ -1,15 +1,59 @@
-"""The config files a plan file carries, laid out so that they load again as the same config."""
+"""The config files a plan file carries, laid out so that they load again as the same config, and no code.
+
+A plan carries its URDF and SRDF expanded, never xacro: opening a plan file someone else wrote
+must not run their code (`xacro` evaluates Python expressions). Plans written before this rule
+may carry .xacro files; they are refused (check_carried), to be planned again.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import yaml
 
+from ..errors import ConfigError
 from .sources import CONFIG_FILE, FILE_KEYS, stem
 
-__all__ = ["embedded_files"]
+__all__ = ["carried_paths", "check_carried", "embedded_files", "is_xacro"]
+
+_HOST_KEYS = ("package_paths", "xacro_args")  # they name folders of this machine, or feed xacro
+
+
+def is_xacro(name: str) -> bool:
+    """Return whether a file name is a xacro file's (.xacro, in any case)."""
+    return name.lower().endswith(".xacro")
+
+
+def check_carried(files: Mapping[str, bytes], source: str) -> None:
+    """Raise ConfigError naming `source` (the plan file) if the files a plan carries include xacro."""
+    for name in files:
+        if is_xacro(name):
+            raise ConfigError(f"{source}: the plan carries xacro ({name}); moveplan evaluates no code from a "
+                              "plan file: re-plan it with this version of moveplan")
+
+
+def carried_paths(manifest: Path, top: Mapping[str, Any]) -> dict[str, Path]:
+    """Return setting -> file of a config a plan carries: the files its moveplan.yaml names beside it, none xacro.
+
+    Raises:
+        ConfigError: A file key names a path outside the folder (absolute, `..`), a URI, xacro,
+            or a file that is not there; names `manifest` and the key.
+    """
+    root = manifest.parent.resolve()
+    paths: dict[str, Path] = {}
+    for key in FILE_KEYS:
+        value = top.get(key)
+        if value is None and key not in ("urdf", "srdf"):
+            continue
+        file = root / value if isinstance(value, str) and "://" not in value else None
+        if file is None or is_xacro(file.name) or not file.resolve().is_relative_to(root) or not file.is_file():
+            raise ConfigError(f"{manifest}: {key}: {value!r} is not a file the plan carries; a plan's config is "
+                              "read from its own attachments only (no path of this machine, no package:// URI, "
+                              "no xacro)")
+        paths[key] = file
+    return paths
 
 
 def embedded_files(
@@ -23,15 +67,18 @@ def embedded_files(
 ) -> dict[str, bytes]:
     """Return file name -> bytes of the config files to embed in plan files.
 
-    A moveplan.yaml whose files all lie in its folder is embedded as it is, with the files
-    under the names it gives them. Otherwise (a MoveIt package, xacro, package:// files) the
-    expanded URDF and SRDF (`texts`) and the other files are embedded side by side, with a
-    generated moveplan.yaml naming them.
+    A moveplan.yaml whose files all lie in its folder, none of them xacro, and that names no
+    package_paths or xacro_args, is embedded as it is, with the files under the names it gives
+    them. Otherwise (a MoveIt package, xacro, package:// files) the expanded URDF and SRDF
+    (`texts`) and the other files are embedded side by side, with a generated moveplan.yaml
+    naming them; no name ends in .xacro.
     """
     embed = [k for k in FILE_KEYS if k in paths]
-    if manifest is not None and not any(paths[k].name.endswith(".xacro") for k in ("urdf", "srdf")):
+    if manifest is not None and not any(is_xacro(paths[k].name) for k in embed) and not any(
+            top.get(k) for k in _HOST_KEYS):
         written = {k: str(top[k]) for k in embed}
-        if all("://" not in v and (root / v).resolve().is_relative_to(root.resolve()) for v in written.values()):
+        if all("://" not in v and not is_xacro(v) and (root / v).resolve().is_relative_to(root.resolve())
+               for v in written.values()):
             files = {CONFIG_FILE: manifest.read_bytes()}
             # Controller files go in substituted (texts); the rest as they are.
             files.update({written[k]: texts[k].encode("utf-8") if k in texts and k not in ("urdf", "srdf")
@@ -41,7 +88,9 @@ def embedded_files(
     generated: dict[str, Any] = {"name": name}
     for key in embed:
         path = paths[key]
+        # An expanded file is not xacro any more, whatever the name it was read under.
         file_name = f"{stem(path)}.{key}" if key in ("urdf", "srdf") else path.name
+        file_name = file_name[:-len(".xacro")] if is_xacro(file_name) else file_name
         if file_name in files or file_name == CONFIG_FILE:
             file_name = f"{key}_{file_name}"
         files[file_name] = texts[key].encode("utf-8") if key in texts else path.read_bytes()

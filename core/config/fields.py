@@ -75,6 +75,9 @@ class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: ignore[mi
 
 
 _Loader.add_implicit_resolver("tag:yaml.org,2002:float", _ROS_FLOAT, list("-+0123456789."))
+# xacro.load_yaml adds unit tags (!degrees, ...) to PyYAML's SafeLoader that evaluate xacro expressions:
+# a file moveplan reads gets PyYAML's safe constructors alone, whichever loader it derives from.
+_Loader.yaml_constructors = dict(yaml.constructor.SafeConstructor.yaml_constructors)
 
 
 def load_yaml(path: Path) -> Any:

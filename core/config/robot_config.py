@@ -5,6 +5,10 @@ URDF and SRDF through xacro (descriptions.py) and parse them (urdf.py, srdf.py),
 limits as MoveIt does: URDF limits, overridden by joint_limits.yaml (limits.py), read the
 controllers (controllers.py) and the other settings (settings.py), and collect the files
 a plan embeds (embed.py). Every error names the file and key path.
+
+A config a plan file carries (`embedded=True`) is data only: no xacro runs, no `$(...)`
+substitution is made, no package is searched for, and its moveplan.yaml may name only files
+beside it, which are the plan's attachments.
 """
 
 from __future__ import annotations
@@ -14,14 +18,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..errors import UnknownName
+from ..errors import ConfigError, UnknownName
 from .controllers import ControllerConfig, ExecutionConfig, parse_controllers, parse_execution
 from .descriptions import check_xacro_args, expand, file_xacro_args
-from .embed import embedded_files
+from .embed import carried_paths, embedded_files
 from .initial_state import initial_state
 from .limits import DEFAULT_SOURCE, JointLimit, merge_limits, parse_joint_limits
 from .settings import parse_kinematics, planning_defaults
 from .sources import (
+    CONFIG_FILE,
     discover,
     discover_beside,
     flag_file,
@@ -154,6 +159,7 @@ def load_robot_config(
     urdf: str | None = None,
     srdf: str | None = None,
     strict_limits: bool = False,
+    embedded: bool = False,
 ) -> RobotConfig:
     """Return the parsed robot config at `robot`.
 
@@ -168,21 +174,26 @@ def load_robot_config(
         srdf: --srdf, likewise the SRDF.
         strict_limits: --strict-limits: a joint without an acceleration limit is an error
             instead of planning with the documented default.
+        embedded: `robot` is the folder a plan file's attachments were written to: read as
+            data only (module docstring); its moveplan.yaml's package_paths and xacro_args
+            are not read.
 
     Raises:
         ConfigError: A file is missing or malformed, or the files are ambiguous; the message
             names file and key, or the files and the flag that settles it.
         UsageError: A --xacro-arg the xacro files do not declare.
     """
-    found = _locate(robot, package_paths, urdf, srdf)
+    found = _carried(Path(robot)) if embedded else _locate(robot, package_paths, urdf, srdf)
     paths = found.paths
     model = _read_model(found, xacro_args or {})
     limit_overrides, v_scale, a_scale = parse_joint_limits(paths.get("joint_limits"))
     limits = merge_limits(paths["urdf"], model.urdf_joints, paths.get("joint_limits"), limit_overrides,
                           strict=strict_limits)
-    controllers = parse_controllers(paths["controllers"], model.xacro_args) if "controllers" in paths else {}
+    substitute = not embedded
+    controllers = (parse_controllers(paths["controllers"], model.xacro_args, substitute=substitute)
+                   if "controllers" in paths else {})
     _check_controller_joints(controllers, model.urdf_joints, paths.get("controllers"))
-    execution = (parse_execution(paths["moveit_controllers"], model.xacro_args)
+    execution = (parse_execution(paths["moveit_controllers"], model.xacro_args, substitute=substitute)
                  if "moveit_controllers" in paths else ExecutionConfig())
     initial = initial_state(model.urdf_text, paths["urdf"], model.urdf_joints, limits, paths.get("initial_positions"))
     kinematics = parse_kinematics(paths["kinematics"], model.srdf) if "kinematics" in paths else {}
@@ -193,7 +204,7 @@ def load_robot_config(
     texts = {"urdf": model.urdf_text, "srdf": model.srdf_text}
     # A plan carries controller files with their launch substitutions made: execute reads them without args.
     texts.update({key: read_substituted(paths[key], model.xacro_args) for key in ("controllers", "moveit_controllers")
-                  if key in paths and b"$(" in paths[key].read_bytes()})
+                  if substitute and key in paths and b"$(" in paths[key].read_bytes()})
     config = RobotConfig(
         name=name,
         root=found.root,
@@ -242,6 +253,15 @@ def _locate(robot: str | Path, package_paths: Sequence[Path], urdf: str | None, 
     if found.root != root:
         packages = PackagePath(search_path(found.root, tuple(package_paths)))
     return _Located(None, found.root, top, packages, found.paths, found.xacro_args, found.xacro_source)
+
+
+def _carried(folder: Path) -> _Located:
+    """Return the files of a config a plan carries, written to `folder`: those its moveplan.yaml names beside it."""
+    manifest = folder / CONFIG_FILE
+    if not manifest.is_file():
+        raise ConfigError(f"{folder}: no {CONFIG_FILE}")
+    top, _ = read_manifest(manifest)
+    return _Located(manifest, folder, top, PackagePath(()), carried_paths(manifest, top))
 
 
 def _read_model(found: _Located, flags: Mapping[str, str]) -> _Model:

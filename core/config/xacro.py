@@ -8,7 +8,9 @@ package.xml names it. The same lookup resolves `$(find pkg)` in xacro files and
 
 xacro itself resolves `$(find pkg)` through ament_index_python, which needs a sourced
 ROS 2 install; here the PyPI `xacro` package runs with that one function replaced by
-the lookup above (xacro keeps it in a module global, looked up at each call).
+the lookup above (xacro keeps it in a module global, looked up at each call), and with its
+expressions evaluated within the guards and bounds of core/config/xacro_sandbox.py (no
+expression reaches Python's internals).
 """
 
 from __future__ import annotations
@@ -29,6 +31,8 @@ from xacro import substitution_args as _substitution_args
 
 from ..errors import ConfigError, UsageError
 from .workspace import duplicate_packages, package_name, packages_under
+from .xacro_expressions import Refused
+from .xacro_sandbox import sandboxed
 
 __all__ = ["PackagePath", "XacroResult", "parse_xacro_args", "process_xacro"]
 
@@ -194,13 +198,14 @@ def process_xacro(path: Path, args: Mapping[str, str], packages: PackagePath, sh
 
     Raises:
         ConfigError: A xacro or XML error (naming the file it happened in and the files that
-            included it), or a package `$(find)` cannot find.
+            included it), a package `$(find)` cannot find, or an expression or a document that
+            xacro_sandbox refuses (naming the expression).
     """
     table = _RecordingArgs(args)
     _xacro.all_includes.clear()
     captured = io.StringIO()  # xacro prints warnings to stderr; a library logs them instead
     try:
-        with _find_through(packages), contextlib.redirect_stderr(captured):
+        with _find_through(packages), sandboxed(), contextlib.redirect_stderr(captured):
             doc = _xacro.process_file(str(path), mappings=table, verbosity=0)
     except ConfigError:
         raise
@@ -209,6 +214,8 @@ def process_xacro(path: Path, args: Mapping[str, str], packages: PackagePath, sh
         if isinstance(cause, ConfigError):
             raise cause from None
         where = _location(path)
+        if isinstance(cause, Refused):
+            raise ConfigError(f"{where}: xacro: {cause}") from None
         if isinstance(exc, xml.parsers.expat.ExpatError):
             raise ConfigError(f"{where}: malformed XML: {exc}") from None
         message = "; ".join(line.strip() for line in str(exc).splitlines() if line.strip())

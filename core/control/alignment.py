@@ -43,6 +43,7 @@ from .tolerances import position_error
 __all__ = [
     "DEPARTURE_THRESHOLD_RAD",
     "GAP_FACTOR",
+    "PROFILE_SAMPLES",
     "ZONE_RAD",
     "Samples",
     "StepProfile",
@@ -62,6 +63,9 @@ still found, and reported); the robot must then move beyond twice this radius.""
 
 GAP_FACTOR = 5.0
 """A pause between samples longer than this many median sample periods is reported."""
+
+PROFILE_SAMPLES = 200_000
+"""The most points a step's profile has (a step over 200 s is profiled more coarsely than every 1 ms)."""
 
 _MAX_GAPS = 1000
 # Several cycles of the same plan cannot overlap: the controller follows the plan's timing.
@@ -88,11 +92,15 @@ class StepProfile:
 
     @staticmethod
     def build(
-        name: str, trajectory: JointTrajectory, continuous: NDArray[np.bool_], zone: float
+        name: str, trajectory: JointTrajectory, continuous: NDArray[np.bool_], zone: float,
+        resolution_s: float = 1e-3,
     ) -> StepProfile:
-        """Return the profile of `trajectory` (in controller order), zone radius `zone` [rad]."""
+        """Return the profile of `trajectory` (in controller order), zone radius `zone` [rad], on a `resolution_s` grid.
+
+        The grid has at most PROFILE_SAMPLES points: a step of a day is not sampled every millisecond.
+        """
         duration = trajectory.duration_s
-        count = int(min(200_000, max(2, math.ceil(duration / 1e-3) + 1)))
+        count = int(min(PROFILE_SAMPLES, max(2, math.ceil(duration / resolution_s) + 1)))
         times = np.linspace(0.0, duration, count)
         positions, _, _ = sample(trajectory, times, derivatives=0)
         error = position_error(positions, trajectory.positions[0], continuous)

@@ -12,7 +12,10 @@ from .alignment import ZONE_RAD, StepProfile
 from .check_samples import Samples, SampleSource
 from .tolerances import SegmentTolerances, in_controller_order, segment_tolerances, velocity_error_computable
 
-__all__ = ["CheckContext", "CheckedPlan", "CheckedStep"]
+__all__ = ["PLAN_PROFILE_SAMPLES", "CheckContext", "CheckedPlan", "CheckedStep"]
+
+PLAN_PROFILE_SAMPLES = 2_000_000
+"""The most points the profiles of all a plan's steps have together (32 MB of times and distances)."""
 
 
 class CheckedStep(Protocol):
@@ -69,9 +72,13 @@ class CheckContext:
         """Return the context of checking `recording` against `plan` with these settings."""
         samples = Samples.build(recording, controller.joints, continuous_joints)
         zone = max(ZONE_RAD, 2.0 * execution.allowed_start_tolerance)
+        # One grid for all steps, kept to PLAN_PROFILE_SAMPLES points in all: many long steps are
+        # profiled more coarsely, not in gigabytes (a plan under about half an hour keeps 1 ms).
+        total_s = sum(step.trajectory.duration_s for step in plan.steps)
+        resolution = max(1e-3, total_s / PLAN_PROFILE_SAMPLES)
         profiles = tuple(
             StepProfile.build(step.name, in_controller_order(step.trajectory, controller),
-                              samples.continuous, zone)
+                              samples.continuous, zone, resolution)
             for step in plan.steps
         )
         computable = velocity_error_computable(controller)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..types import SkippedData
 from .margins import merged_margins
 from .results import INCOMPLETE, SUCCESSFUL, ExecutionResult, ToleranceReport, Violation
 
@@ -113,6 +114,7 @@ class CheckReport:
             periods, start in [s] from the recording's first sample.
         warnings: Things the user should know: gaps, sparse samples, alignment fallbacks.
         recording_start_ns: Time of the recording's first sample in [ns].
+        skipped: The damaged parts of the recording its read skipped, as asked (--skip-damaged).
 
     """
 
@@ -129,6 +131,7 @@ class CheckReport:
     gaps: tuple[tuple[float, float], ...]
     warnings: tuple[str, ...]
     recording_start_ns: int
+    skipped: tuple[SkippedData, ...] = ()
 
     @property
     def complete(self) -> bool:

@@ -23,6 +23,7 @@ from .. import bag as recording
 from ..bag.jointstates import open_joint_states
 from ..config import JointGoal
 from ..config.controllers import ControllerConfig, ExecutionConfig, default_controller, parse_controllers
+from ..config.embed import check_carried
 from ..config.joint_units import check_joint_units
 from ..config.robot_config import RobotConfig, load_robot_config
 from ..config.sources import CONFIG_FILE
@@ -43,9 +44,13 @@ if TYPE_CHECKING:
 
 _TF_RATE_HZ = 30.0
 
+MAX_PLAN_S = 86_400.0
+"""The longest plan read, in [s] from its first step's start to its last step's end: a day."""
+
 __all__ = [
-    "CheckRequest", "CheckedRecording", "ExecuteRequest", "OpenRecorder", "PlanExecution", "StepExecution",
-    "StepRecorder", "check", "execute", "pick_controller", "plan_config", "plan_controller", "read_valid_plan",
+    "MAX_PLAN_S", "CheckRequest", "CheckedRecording", "ExecuteRequest", "OpenRecorder", "PlanExecution",
+    "StepExecution", "StepRecorder", "check", "execute", "pick_controller", "plan_config", "plan_controller",
+    "read_valid_plan",
 ]
 
 _LOG = logging.getLogger(__name__)
@@ -66,7 +71,7 @@ class ExecuteRequest:
 
 @dataclass(frozen=True)
 class CheckRequest:
-    """What `moveplan check-tolerances` was asked to check."""
+    """What `moveplan check-tolerances` was asked to check; `skip_damaged` reads past a recording's damaged chunks."""
 
     plan: Path
     recording: Path
@@ -74,6 +79,7 @@ class CheckRequest:
     controllers: Path | None = None
     start: str | float = "auto"
     time_source: str = "header"
+    skip_damaged: bool = False
 
 
 @dataclass(frozen=True)
@@ -158,39 +164,59 @@ OpenRecorder = Callable[[ControllerConfig, recording.PlanFile, bool], AbstractCo
 
 
 def plan_config(plan: recording.PlanFile, source: Path) -> RobotConfig:
-    """Return the robot config embedded in a plan file."""
+    """Return the robot config embedded in a plan file, read as data: no xacro, no substitution, no host file.
+
+    Raises:
+        InputError: The plan carries no config, carries xacro (written by an earlier moveplan:
+            planned again, it carries the expanded files), or a config that names a file it
+            does not carry or does not load; names the plan file.
+    """
     if CONFIG_FILE not in plan.attachments:
         raise InputError(f"{source}: the plan carries no robot config ({CONFIG_FILE} attachment missing)")
+    check_carried(plan.attachments, str(source))
     with tempfile.TemporaryDirectory(prefix="moveplan-") as folder:
         for name, data in plan.attachments.items():
             path = Path(folder) / name
             if not path.resolve().is_relative_to(Path(folder).resolve()):
                 raise InputError(f"{source}: attachment name '{name}' points outside the config")
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_bytes(data)
+            try:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                path.write_bytes(data)
+            except OSError as exc:  # names such as "." or both "a" and "a/b"
+                raise InputError(f"{source}: attachment name '{name}' is not a file name: {exc.strerror}") from None
         # Its warnings were given when the plan was made, and would name a temporary folder here.
         config_log = logging.getLogger("moveplan.core.config")
         level = config_log.level
         config_log.setLevel(logging.ERROR)
         try:
-            return load_robot_config(folder)
+            return load_robot_config(folder, embedded=True)
         except ConfigError as exc:
-            raise InputError(f"{source}: embedded config: {exc}") from None
+            # The files are the plan's: named as it carries them, not by the temporary folder.
+            message = str(exc).replace(f"{Path(folder).resolve()}/", "").replace(f"{folder}/", "")
+            raise InputError(f"{source}: embedded config: {message}") from None
         finally:
             config_log.setLevel(level)
 
 
 def read_valid_plan(path: Path) -> recording.PlanFile:
-    """Return the plan file at `path`, each step checked as JTC validates a goal.
+    """Return the plan file at `path`, each step checked as JTC validates a goal, the whole no longer than MAX_PLAN_S.
 
     Raises:
         InputError: The file is unreadable, or a step holds a NaN or infinite value or
-            times that are not strictly increasing (the message names step, point and joint).
+            times that are not strictly increasing (the message names step, point and joint),
+            or ends more than MAX_PLAN_S after the plan's start.
 
     """
     plan = recording.read_plan(path)
     for step in plan.steps:
         validate_goal(step.trajectory, f"{path}: step '{step.name}' on /planned_trajectory")
+    origin = min((step.start_s for step in plan.steps), default=0.0)
+    for step in plan.steps:
+        end_s = step.start_s - origin + step.trajectory.duration_s
+        if end_s > MAX_PLAN_S:
+            raise InputError(
+                f"{path}: step '{step.name}' ends {end_s:.6g} s after the plan's start, past the limit of "
+                f"{MAX_PLAN_S:.0f} s (a day) on a plan's length (a time_from_start or log time written wrong?)")
     return plan
 
 
@@ -337,9 +363,10 @@ def check(request: CheckRequest, then: Callable[[CheckedRecording], None] | None
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
     # The samples wait on disk and are read back a window at a time: memory does not grow with the recording.
     with open_joint_states(request.recording, request.topic, joints=controller.joints,
-                           time_source=request.time_source,
-                           velocities=uses_velocities(plan, controller)) as recorded:
+                           time_source=request.time_source, velocities=uses_velocities(plan, controller),
+                           skip_damaged=request.skip_damaged) as recorded:
         report = check_recording(plan, recorded, controller, config.execution, continuous, request.start)
+        report = replace(report, skipped=recorded.skipped)
         report = recorded_tracking(report, [s.trajectory for s in plan.steps], recorded, controller,
                                    np.array([j in continuous for j in controller.joints]))
         if then is not None:

@@ -60,14 +60,15 @@ class Inspection:
     end_states: tuple[RobotState, ...] = ()
 
 
-def inspect_file(path: Path) -> Inspection:
+def inspect_file(path: Path, skip_damaged: bool = False) -> Inspection:
     """Return the summary of any bag (MCAP, .db3 or a bag folder); a plan file (moveplan metadata) is read back too.
 
     The summary comes from an MCAP file's summary section, or is counted in one pass
     through the message indexes of an unfinished file, in memory that does not grow with
-    the file.
+    the file; every chunk and CRC is checked first. With `skip_damaged`, damaged chunks are
+    left out with a warning and listed in summary.skipped (a plan file is never read so).
     """
-    summary = summarize(path)
+    summary = summarize(path, skip_damaged)
     if "moveplan" not in summary.metadata or not path.is_file():
         return Inspection(path, summary, None)
     plan = read_valid_plan(path)

@@ -180,6 +180,7 @@ def check_document(report: CheckReport, recording: Path) -> dict[str, Any]:
     Keys: ok, result, violations and margins as in `execution_document`; duration_s and
     start_s (the first execution's start, from the recording's first sample); steps (name,
     ok, result, start_s, duration_s, aligned_by); gaps [{start_s, length_s}]; warnings;
+    skipped [{file, offset, part, reason}], the damaged parts of the recording left out (--skip-damaged);
     error, null unless no execution is complete: then {exit_code, kind, message}, the check
     could not be done on this recording (bad input). With `start="all"` also cycles
     [{index, start_s, ok, result, worst_margin}], failing_cycles and incomplete_cycles.
@@ -201,6 +202,7 @@ def check_document(report: CheckReport, recording: Path) -> dict[str, Any]:
                   for s in report.steps],
         "gaps": [{"start_s": start, "length_s": length} for start, length in report.gaps],
         "warnings": list(report.warnings),
+        "skipped": [part.as_dict() for part in report.skipped],
         "error": error,
     }
     tracked = [c for c in report.cycles if any(step.report.tracking for step in c.steps)]
