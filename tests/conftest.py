@@ -26,7 +26,7 @@ UR10E = ROOT / "configs" / "ur10e"
 SAMPLES = ROOT / "samples"
 TABLE_SCENE = SAMPLES / "ur10e_table_scene.yaml"
 # Real MoveIt 2 config packages as a colcon workspace's src/ (tools/get_realworld.sh builds one).
-REALWORLD = Path(os.environ.get("MOVEPLAN_REALWORLD") or ROOT.parent / "shared" / "realworld" / "src")
+REALWORLD = Path(os.environ.get("MOVEPLAN_REALWORLD") or ROOT.parent / "shared" / "realworld" / "src").resolve()
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:

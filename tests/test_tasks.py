@@ -94,7 +94,9 @@ def test_task_robot_beside_the_task_file_comes_before_a_shipped_config(tmp_path:
     (tmp_path / "ur10e").mkdir()
     assert load_task(write_task(tmp_path, "robot: ur10e\nsteps: [{named: home}]\n")).robot == tmp_path / "ur10e"
     shipped = load_task(write_task(tmp_path, "robot: panda\nsteps: [{named: home}]\n")).robot
-    assert shipped is not None and shipped.samefile(UR10E.parent / "panda")
+    # The installed copy of configs/panda (the clone's own folder only in an editable install).
+    assert shipped is not None and shipped.name == "panda" and shipped.parent.name == "configs"
+    assert (shipped / "moveplan.yaml").read_bytes() == (UR10E.parent / "panda" / "moveplan.yaml").read_bytes()
 
 
 def test_task_robot_by_unknown_bare_name_is_one_line_naming_it_and_the_shipped_configs(tmp_path: Path) -> None:
