@@ -251,6 +251,15 @@ main()
 """
 
 
+def _signals_by_default() -> None:
+    """Give the child the default SIGINT and SIGHUP: a suite run under nohup or as a background job ignores them.
+
+    moveplan leaves an ignored signal ignored, as a nohup'd command expects (cli/errors.py handle_signals).
+    """
+    for signum in (signal.SIGINT, signal.SIGHUP):
+        signal.signal(signum, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize(("signum", "command"), [
     (signal.SIGTERM, "plan"), (signal.SIGTERM, "execute"), (signal.SIGHUP, "execute"), (signal.SIGINT, "execute"),
 ])
@@ -263,7 +272,7 @@ def test_a_signal_while_writing_removes_the_temporary_file_and_exits_128_plus_si
     started = tmp_path / "started"
     process = subprocess.Popen(
         [sys.executable, "-c", _SLOW_WRITER, started, command, *map(str, args), "-o", out],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=_signals_by_default,
     )
     try:
         deadline = time.monotonic() + 120
