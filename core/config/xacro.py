@@ -31,8 +31,6 @@ from xacro import substitution_args as _substitution_args
 
 from ..errors import ConfigError, UsageError
 from .workspace import duplicate_packages, package_name, packages_under
-from .xacro_expressions import Refused
-from .xacro_sandbox import sandboxed
 
 __all__ = ["PackagePath", "XacroResult", "parse_xacro_args", "process_xacro"]
 
@@ -201,6 +199,10 @@ def process_xacro(path: Path, args: Mapping[str, str], packages: PackagePath, sh
             included it), a package `$(find)` cannot find, or an expression or a document that
             xacro_sandbox refuses (naming the expression).
     """
+    # Imported here: a command that expands no xacro (a plan file's config) does not pay for the guards.
+    from .xacro_expressions import Refused
+    from .xacro_sandbox import sandboxed
+
     table = _RecordingArgs(args)
     _xacro.all_includes.clear()
     captured = io.StringIO()  # xacro prints warnings to stderr; a library logs them instead
