@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError, UsageError, known
-from .fields import mapping
+from .fields import mapping, read_input_text
 from .xacro import PackagePath, process_xacro
 
 __all__ = ["check_xacro_args", "expand", "file_xacro_args"]
@@ -33,10 +33,7 @@ def expand(
         shown = path.relative_to(root) if path.is_relative_to(root) else Path(path.name)
         result = process_xacro(path, args, packages, str(shown))
         return result.text, (path, *(p for p in result.includes if p != path)), result.declared
-    try:
-        return path.read_text(encoding="utf-8"), (path,), frozenset()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{path}: cannot read: {exc}") from None
+    return read_input_text(path), (path,), frozenset()
 
 
 def check_xacro_args(

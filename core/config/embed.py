@@ -14,6 +14,7 @@ from typing import Any
 import yaml
 
 from ..errors import ConfigError
+from .fields import read_input
 from .sources import CONFIG_FILE, FILE_KEYS, stem
 
 __all__ = ["carried_paths", "check_carried", "embedded_files", "is_xacro"]
@@ -79,10 +80,10 @@ def embedded_files(
         written = {k: str(top[k]) for k in embed}
         if all("://" not in v and not is_xacro(v) and (root / v).resolve().is_relative_to(root.resolve())
                for v in written.values()):
-            files = {CONFIG_FILE: manifest.read_bytes()}
+            files = {CONFIG_FILE: read_input(manifest)}
             # Controller files go in substituted (texts); the rest as they are.
             files.update({written[k]: texts[k].encode("utf-8") if k in texts and k not in ("urdf", "srdf")
-                          else paths[k].read_bytes() for k in embed})
+                          else read_input(paths[k]) for k in embed})
             return files
     files = {}
     generated: dict[str, Any] = {"name": name}
@@ -93,7 +94,7 @@ def embedded_files(
         file_name = file_name[:-len(".xacro")] if is_xacro(file_name) else file_name
         if file_name in files or file_name == CONFIG_FILE:
             file_name = f"{key}_{file_name}"
-        files[file_name] = texts[key].encode("utf-8") if key in texts else path.read_bytes()
+        files[file_name] = texts[key].encode("utf-8") if key in texts else read_input(path)
         generated[key] = file_name
     generated["planning"] = dict(planning)
     origin = f"{root.name}/{CONFIG_FILE}" if manifest is not None else f"the config folder {root.name}"

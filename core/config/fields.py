@@ -9,7 +9,9 @@ import ast
 import itertools
 import math
 import operator
+import os
 import re
+import stat
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -26,6 +28,7 @@ except ImportError:  # a PyYAML built without libyaml
 __all__ = [
     "DEGREES", "MAX_ALIAS_EXPANSION", "MAX_EXPRESSION_LENGTH", "MAX_MAGNITUDE", "MAX_YAML_BYTES", "MAX_YAML_EVENTS",
     "TURN", "angle", "beyond_a_turn", "boolean", "check_keys", "coordinate", "expression", "load_yaml", "mapping",
+    "read_input", "read_input_text",
     "more_than_a_turn", "number", "parse_yaml", "pose_angle", "pose_angles", "string_list",
 ]
 
@@ -88,16 +91,44 @@ def load_yaml(path: Path) -> Any:
     document (and may not contain themselves), so that no reader of the result walks a billion
     shared copies.
     """
+    return parse_yaml(read_input_text(path), path)
+
+
+def read_input(path: Path, limit: int = MAX_YAML_BYTES) -> bytes:
+    """Return the bytes of the regular file `path`; ConfigError if it is missing, not a regular file or over `limit`.
+
+    A device (/dev/zero), FIFO or socket never ends or blocks: it is refused before it is read, and
+    the read itself stops after `limit` bytes whatever the file's size claims.
+    """
     try:
-        size = path.stat().st_size
-        if size > MAX_YAML_BYTES:
-            raise ConfigError(f"{path}: {size:,} bytes; moveplan reads YAML files of at most {MAX_YAML_BYTES:,} bytes")
-        text = path.read_text(encoding="utf-8")
+        # O_NONBLOCK: opening a FIFO must not wait for a writer; it is refused just below.
+        descriptor = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
     except FileNotFoundError:
         raise ConfigError(f"{path}: file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{path}: cannot read: {exc}") from None
-    return parse_yaml(text, path)
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    mode = os.fstat(descriptor).st_mode
+    if not stat.S_ISREG(mode):
+        os.close(descriptor)
+        if stat.S_ISDIR(mode):
+            raise ConfigError(f"{path}: a folder, not a file")
+        raise ConfigError(f"{path}: not a regular file (a device, FIFO or socket); moveplan reads files")
+    with os.fdopen(descriptor, "rb") as stream:
+        try:
+            data = stream.read(limit + 1)
+        except OSError as exc:
+            raise ConfigError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    if len(data) > limit:
+        raise ConfigError(f"{path}: more than {limit:,} bytes; moveplan reads files of at most {limit:,} bytes")
+    return data
+
+
+def read_input_text(path: Path, limit: int = MAX_YAML_BYTES) -> str:
+    """Return the UTF-8 text of the regular file `path`, read as read_input reads it."""
+    try:
+        return read_input(path, limit).decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{path}: cannot read: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
 
 
 def parse_yaml(text: str, path: Path, after: str = "") -> Any:

@@ -22,6 +22,7 @@ from ..errors import ConfigError, UnknownName
 from .controllers import ControllerConfig, ExecutionConfig, parse_controllers, parse_execution
 from .descriptions import check_xacro_args, expand, file_xacro_args
 from .embed import carried_paths, embedded_files
+from .fields import read_input
 from .initial_state import initial_state
 from .limits import DEFAULT_SOURCE, JointLimit, merge_limits, parse_joint_limits
 from .settings import parse_kinematics, planning_defaults
@@ -204,7 +205,7 @@ def load_robot_config(
     texts = {"urdf": model.urdf_text, "srdf": model.srdf_text}
     # A plan carries controller files with their launch substitutions made: execute reads them without args.
     texts.update({key: read_substituted(paths[key], model.xacro_args) for key in ("controllers", "moveit_controllers")
-                  if substitute and key in paths and b"$(" in paths[key].read_bytes()})
+                  if substitute and key in paths and b"$(" in read_input(paths[key])})
     config = RobotConfig(
         name=name,
         root=found.root,

@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError, UsageError, known
-from .fields import check_keys, load_yaml, mapping, string_list
+from .fields import check_keys, load_yaml, mapping, read_input_text, string_list
 from .setup_assistant import SETUP_ASSISTANT_FILE, builder_srdf, builder_urdf, read_setup_assistant, robot_names
 from .workspace import workspace_src
 from .xacro import PackagePath
@@ -307,7 +307,7 @@ def _included(path: Path) -> set[str]:
     if not path.name.endswith(".xacro"):
         return set()
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
+        text = read_input_text(path)
+    except ConfigError:
         return set()
     return {Path(name).name for name in _INCLUDE.findall(text)}

@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from .fields import MAX_YAML_BYTES, load_yaml, parse_yaml
+from .fields import MAX_YAML_BYTES, load_yaml, parse_yaml, read_input_text
 
 __all__ = ["load_substituted_yaml", "read_substituted", "substitute"]
 
@@ -60,12 +60,7 @@ def read_substituted(path: Path, launch_args: Mapping[str, str] | None = None) -
 
 def _read(path: Path) -> str:
     """Return a file's text; ConfigError names the file when it is missing or unreadable."""
-    try:
-        return path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{path}: cannot read: {exc}") from None
+    return read_input_text(path)
 
 
 def substitute(

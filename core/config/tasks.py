@@ -12,7 +12,17 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from .fields import MAX_MAGNITUDE, angle, check_keys, coordinate, load_yaml, mapping, number, pose_angle
+from .fields import (
+    MAX_MAGNITUDE,
+    angle,
+    check_keys,
+    coordinate,
+    load_yaml,
+    mapping,
+    number,
+    pose_angle,
+    read_input,
+)
 from .goals import GOAL_KINDS, SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
 from .sources import shipped_config
 
@@ -237,5 +247,5 @@ def load_task(path: Path) -> TaskFile:
         defaults=_defaults(defaults, f"{source}: defaults"),
         steps=tuple(steps),
         seed=seed,
-        raw=path.read_bytes(),
+        raw=read_input(path),
     )

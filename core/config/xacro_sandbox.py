@@ -22,6 +22,7 @@ import builtins
 import contextlib
 import math
 import os
+import stat
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -80,9 +81,12 @@ class _Budget:
         if len(_xacro.filestack or ()) > MAX_INCLUDE_DEPTH:
             raise Refused(f"files included more than {MAX_INCLUDE_DEPTH} deep (a file that includes itself?)")
         try:
-            size = os.stat(filename).st_size
+            status = os.stat(filename)
         except OSError:
             return  # xacro reports a missing file itself
+        if not stat.S_ISREG(status.st_mode):
+            raise Refused(f"{filename} is not a regular file (a device, FIFO or socket)")
+        size = status.st_size
         if size > MAX_FILE_BYTES:
             raise Refused(f"{filename} has {size:,} bytes; a file xacro reads may have {MAX_FILE_BYTES:,}")
         self.bytes += size

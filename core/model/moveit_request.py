@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config.fields import MAX_MAGNITUDE, check_keys, coordinate, load_yaml, mapping, number
+from ..config.fields import MAX_MAGNITUDE, check_keys, coordinate, load_yaml, mapping, number, read_input
 from ..config.goals import JointGoal, PoseGoal
 from ..config.planners import PLANNERS
 from ..config.tasks import MIN_SCALING, StepSpec
@@ -166,7 +166,7 @@ def load_motion_plan_request(path: Path) -> MotionPlanRequest:
         planning_time=planning_time or None,
         velocity_scaling=_scaling(top, "max_velocity_scaling_factor", source),
         acceleration_scaling=_scaling(top, "max_acceleration_scaling_factor", source),
-        raw=path.read_bytes(),
+        raw=read_input(path),
         attached=tuple(attached),
     )
 

@@ -23,6 +23,7 @@ from ..bag import write_plan
 from ..bag.plan_file import END_STATES_KEY
 from ..collision.motion import MotionChecker, exact_checks
 from ..config import JointGoal, NamedGoal, RobotConfig, StartFrom, load_robot_config, load_task
+from ..config.fields import read_input
 from ..config.joint_units import check_joint_units
 from ..config.limits import DEFAULT_ACCELERATION
 from ..errors import InputError, MoveplanError, StartInCollision, StartOutsideLimits, UnknownName, UsageError
@@ -312,7 +313,7 @@ def _attachments(config: RobotConfig, request: PlanRequest) -> dict[str, bytes]:
     """Return the files a plan embeds: the robot config's, and the scene, task and request given."""
     files = dict(config.files)
     if request.scene is not None:
-        files[f"scene{Path(request.scene).suffix}"] = Path(request.scene).read_bytes()
+        files[f"scene{Path(request.scene).suffix}"] = read_input(Path(request.scene))
     if request.task is not None:
         files["task.yaml"] = request.task.raw
     if request.motion_request is not None:

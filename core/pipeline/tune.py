@@ -21,6 +21,7 @@ import numpy as np
 from .. import bag as recording
 from ..config.controllers import ControllerConfig
 from ..config.controllers_write import tuned_controllers_text, write_text_atomically
+from ..config.fields import read_input_text
 from ..control.plant_fit import PlantFit, RecordedStep, fit_plant
 from ..control.plants import pid_gains, pid_interface, pid_parameters
 from ..control.step_tracking import sample_index
@@ -136,10 +137,7 @@ def tune(request: TuneRequest) -> TuneResult:
 def _controllers_text(request: TuneRequest, plan: recording.PlanFile, embedded: Path | None) -> tuple[str, str]:
     """Return the controllers file's text and how to name it: `--controllers`, else the plan's embedded file."""
     if request.controllers is not None:
-        try:
-            return request.controllers.read_text(encoding="utf-8"), str(request.controllers)
-        except (OSError, UnicodeDecodeError) as exc:
-            raise InputError(f"{request.controllers}: cannot read: {exc}") from None
+        return read_input_text(request.controllers), str(request.controllers)
     if embedded is not None:
         for name, data in plan.attachments.items():
             if embedded.as_posix().endswith("/" + name):

@@ -1,0 +1,68 @@
+"""Hostile input that never ends: a device, a FIFO or a folder given where a file is read.
+
+Each is refused before it is read, with one line naming it (exit 3), and no output is written
+(docs/formats.md, Limits).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+from conftest import SAMPLES, UR10E, Cli
+
+from moveplan.core.config.fields import read_input
+from moveplan.core.errors import ConfigError
+
+SHIPPED_PLAN = SAMPLES / "recordings" / "tool_up_plan.mcap"
+NOT_FILES = ["/dev/zero", "/dev/urandom", "FIFO", "FOLDER"]
+
+
+@pytest.fixture()
+def not_a_file(tmp_path: Path, request: pytest.FixtureRequest) -> str:
+    """Return the path of what the test's parameter names: a device, or a FIFO or folder made in tmp_path."""
+    kind = request.param
+    if kind == "FIFO":
+        os.mkfifo(tmp_path / "fifo.yaml")  # no writer: reading it would wait forever
+        return str(tmp_path / "fifo.yaml")
+    if kind == "FOLDER":
+        (tmp_path / "folder.yaml").mkdir()
+        return str(tmp_path / "folder.yaml")
+    return kind
+
+
+def _command(kind: str, path: str, tmp_path: Path) -> list[object]:
+    """Return the command line reading `path` as the input `kind`."""
+    shutil.copy(SHIPPED_PLAN, tmp_path / "p.mcap")
+    out = tmp_path / "out"
+    return {
+        "scene": ["plan", "--robot", UR10E, "--scene", path, "--named", "home", "-o", out],
+        "request": ["plan", "--robot", UR10E, "--request", path, "-o", out],
+        "task": ["plan", path, "-o", out],
+        "controllers": ["execute", tmp_path / "p.mcap", "--fake", "--controllers", path, "-o", out],
+        "tune-pid controllers": ["tune-pid", tmp_path / "p.mcap", "--controllers", path, "-o", out],
+        "state scene": ["state", "--robot", UR10E, "--scene", path],
+    }[kind]
+
+
+@pytest.mark.parametrize("not_a_file", NOT_FILES, indirect=True)
+@pytest.mark.parametrize("kind", ["scene", "request", "task", "controllers", "tune-pid controllers", "state scene"])
+def test_a_device_fifo_or_folder_given_as_an_input_file_is_refused_at_once(
+    cli: Cli, tmp_path: Path, not_a_file: str, kind: str
+) -> None:
+    result = cli(*_command(kind, not_a_file, tmp_path), "-q")
+    assert result.exit_code == 3, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"moveplan: error: {not_a_file}"), result.stderr
+    assert "not a regular file" in lines[0] or "a folder, not a file" in lines[0]
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_file_is_read_no_further_than_the_limit_whatever_it_claims(tmp_path: Path) -> None:
+    big = tmp_path / "big.yaml"
+    big.write_bytes(b"a: 1\n" * 100)
+    assert read_input(big, limit=500) == b"a: 1\n" * 100
+    with pytest.raises(ConfigError, match=r"big.yaml: more than 499 bytes; moveplan reads files of at most 499"):
+        read_input(big, limit=499)
