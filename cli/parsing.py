@@ -82,6 +82,11 @@ def parse_joints(text: str, what: str) -> JointGoal:
         raise UsageError(f"{what}: expected comma-separated values like '0,-1.57,...' or 'elbow_joint=1.2'")
     if all("=" in item for item in items):
         pairs = [(name.strip(), value) for name, value in (item.split("=", 1) for item in items)]
+        names = [name for name, _ in pairs]
+        twice = next((name for name in names if names.count(name) > 1), None)
+        if twice is not None:
+            # A dict would keep the last value silently: which one the user meant is unknown.
+            raise UsageError(f"{what}: joint '{twice}' is given twice")
         read = {name: parse_angle(value, f"{what} {name}") for name, value in pairs}
         return JointGoal.by_name({name: v for name, (v, _) in read.items()}, [d for _, d in read.values()], what)
     if any("=" in item for item in items):

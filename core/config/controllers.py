@@ -48,6 +48,8 @@ _SCALED_JTC_KEYS = frozenset({
     "speed_scaling_sim_mode",
 })
 _SPEED_SCALING_KEYS = frozenset({"initial_scaling_factor", "state_interface", "command_interface"})
+_COMMAND_INTERFACES = ("position", "velocity", "acceleration", "effort")
+_STATE_INTERFACES = ("position", "velocity", "acceleration")
 _CONSTRAINT_KEYS = frozenset({"stopped_velocity_tolerance", "goal_time", "decelerate_on_cancel"})
 _JOINT_CONSTRAINT_KEYS = frozenset({"trajectory", "goal", "max_deceleration_on_cancel"})
 # gains.<joint>: numbers (kept in ControllerConfig.gains), flags, and the anti-windup strategy's name.
@@ -83,6 +85,8 @@ class ExecutionConfig:
     allowed_execution_duration_scaling: float = 1.1
     allowed_goal_duration_margin: float = 0.5
     execution_duration_monitoring: bool = True
+    default_controllers: tuple[str, ...] = ()
+    """moveit_simple_controller_manager's controllers marked `default: true`: MoveIt prefers them."""
 
 
 def parse_controllers(
@@ -159,7 +163,19 @@ def parse_execution(
             section.get("execution_duration_monitoring", defaults.execution_duration_monitoring),
             f"{where}.execution_duration_monitoring",
         ),
+        default_controllers=_default_controllers(top.get("moveit_simple_controller_manager"), path),
     )
+
+
+def _default_controllers(value: Any, path: Path) -> tuple[str, ...]:
+    """Return the controllers moveit_simple_controller_manager lists with `default: true`."""
+    where = f"{path}: moveit_simple_controller_manager"
+    manager = mapping(value, where)
+    names = manager.get("controller_names") or []
+    if not isinstance(names, list):
+        raise ConfigError(f"{where}.controller_names: expected a list of names, got {str(names)[:60]}")
+    return tuple(str(name) for name in names if isinstance(manager.get(name), dict)
+                 and boolean(manager[name].get("default", False), f"{where}.{name}.default"))
 
 
 def _ros_parameters(
@@ -213,8 +229,9 @@ def _joint_trajectory_controller(
         name=name,
         joints=joints,
         update_rate_hz=rate,
-        command_interfaces=tuple(params.get("command_interfaces") or ("position",)),
-        state_interfaces=tuple(params.get("state_interfaces") or ("position",)),
+        command_interfaces=_interfaces(params.get("command_interfaces"), _COMMAND_INTERFACES,
+                                       f"{where}.command_interfaces"),
+        state_interfaces=_interfaces(params.get("state_interfaces"), _STATE_INTERFACES, f"{where}.state_interfaces"),
         goal_time_s=number(constraints.get("goal_time", 0.0), f"{where}.constraints.goal_time"),
         stopped_velocity_tolerance=number(
             constraints.get("stopped_velocity_tolerance", 0.01), f"{where}.constraints.stopped_velocity_tolerance"
@@ -223,6 +240,40 @@ def _joint_trajectory_controller(
         goal_tolerance=goal,
         gains=_gains(params.get("gains"), joints, f"{where}.gains"),
     )
+
+
+def _interfaces(value: Any, allowed: tuple[str, ...], where: str) -> tuple[str, ...]:
+    """Return a JointTrajectoryController's command or state interfaces, checked as it checks them when configured.
+
+    ros2_controllers' joint_trajectory_controller_parameters.yaml declares both lists `unique` and
+    a subset of `allowed`; validate_jtc_parameters.hpp refuses the combinations below. A list left
+    out is position, moveplan's default.
+    """
+    if value is None or value == []:
+        return ("position",)
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise ConfigError(f"{where}: expected a list of interface names, got {str(value)[:60]}")
+    unknown = [v for v in value if v not in allowed]
+    if unknown:
+        raise ConfigError(f"{where}: {unknown[0][:40]!r} is not an interface a JointTrajectoryController uses; "
+                          f"expected some of {', '.join(allowed)}")
+    if len(set(value)) < len(value):
+        raise ConfigError(f"{where}: {value} names an interface twice")
+    has = set(value)
+    if allowed is _COMMAND_INTERFACES:
+        problem = ("'velocity' is used alone or with 'position'" if "velocity" in has and len(has) > 1
+                   and "position" not in has else
+                   "'acceleration' needs 'velocity' or 'position'" if "acceleration" in has
+                   and not has & {"velocity", "position"} else
+                   "'effort' is used alone" if "effort" in has and len(has) > 1 else "")
+    else:
+        # The controller reads the joints' positions: without them it has no state to follow from.
+        problem = ("'position' is required" if "position" not in has else
+                   "'acceleration' needs 'position' and 'velocity'" if "acceleration" in has
+                   and "velocity" not in has else "")
+    if problem:
+        raise ConfigError(f"{where}: {value}: {problem} (ros2_controllers' validate_jtc_parameters.hpp)")
+    return tuple(value)
 
 
 def _gains(value: Any, joints: tuple[str, ...], where: str) -> dict[str, dict[str, float]]:

@@ -174,6 +174,10 @@ class _Tree:
         up_from_tip = self._ancestors(tip)
         if base in up_from_tip:
             return self._parent_joints(up_from_tip[: up_from_tip.index(base)])
+        if tip in self._ancestors(base):
+            # MoveIt would collect the same joints and take `base` as the tip: pose goals would then move the base.
+            raise ConfigError(f"{where}: chain base_link '{base}' is below tip_link '{tip}' (given tip-to-base?): "
+                              "swap base_link and tip_link")
         # base is not above tip (a chain from one gripper to another): MoveIt walks up from base to
         # the first link on tip's path and, as it does, keeps that link's own parent joint too.
         up_from_base = self._ancestors(base)

@@ -221,14 +221,29 @@ def read_valid_plan(path: Path) -> recording.PlanFile:
 
 
 def pick_controller(
-    controllers: Mapping[str, ControllerConfig], joints: Sequence[str], source: str
+    controllers: Mapping[str, ControllerConfig], joints: Sequence[str], source: str, preferred: Sequence[str] = ()
 ) -> ControllerConfig:
-    """Return the JointTrajectoryController that drives all of `joints`."""
+    """Return the JointTrajectoryController that drives all of `joints`, chosen as MoveIt chooses.
+
+    MoveIt's TrajectoryExecutionManager takes the controller with the fewest joints and, of several,
+    the one moveit_controllers.yaml marks `default: true` (`preferred`). Several left that differ
+    (tolerances, gains, interfaces, rate) are an error: ros2_control activates only one of them,
+    and which one the launch file spawns active is not in the files.
+    """
     fitting = [c for c in controllers.values() if set(joints) <= set(c.joints)]
     if not fitting:
         raise ConfigError(f"{source}: no JointTrajectoryController drives all of {', '.join(joints)}; "
                           f"controllers: {', '.join(controllers) or '(none)'}")
-    return min(fitting, key=lambda c: len(c.joints))
+    fewest = min(len(c.joints) for c in fitting)
+    candidates = [c for c in fitting if len(c.joints) == fewest]
+    defaults = [c for c in candidates if c.name in preferred]
+    candidates = defaults or candidates
+    if any(replace(c, name="") != replace(candidates[0], name="") for c in candidates[1:]):
+        names = ", ".join(f"'{c.name}'" for c in candidates)
+        raise ConfigError(f"{source}: controllers {names} all drive {', '.join(joints)} with different settings; "
+                          "keep one, mark one `default: true` in moveit_controllers.yaml, or pass "
+                          "--controllers FILE holding one")
+    return candidates[0]
 
 
 def execute(
@@ -393,4 +408,5 @@ def _controller(config: RobotConfig, plan: recording.PlanFile, path: Path, overr
                      "JointTrajectoryController at ros2_controllers' defaults (100 Hz, position interface, "
                      "no path or goal tolerances); --controllers FILE gives yours", path)
         return default_controller(joints)
-    return pick_controller(config.controllers, joints, f"{path}: embedded {config.sources['controllers'].name}")
+    return pick_controller(config.controllers, joints, f"{path}: embedded {config.sources['controllers'].name}",
+                           config.execution.default_controllers)

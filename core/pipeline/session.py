@@ -253,7 +253,8 @@ def _controller(config: RobotConfig, joints: Sequence[str], override: Path | Non
         logger.info("%s: no ros2_controllers.yaml; executing with a JointTrajectoryController at ros2_controllers' "
                     "defaults", config.name)
         return default_controller(joints)
-    return pick_controller(config.controllers, joints, str(config.sources["controllers"]))
+    return pick_controller(config.controllers, joints, str(config.sources["controllers"]),
+                           config.execution.default_controllers)
 
 
 def session_plan(
