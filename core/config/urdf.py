@@ -9,10 +9,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import ConfigError
+from .fields import MAX_MAGNITUDE
 from .xacro import PackagePath
 
 __all__ = [
-    "JOINT_TYPES", "MOVABLE_JOINT_TYPES", "CollisionMesh", "UrdfJoint", "float_attr", "parse_urdf",
+    "JOINT_TYPES", "MAX_LINKS", "MOVABLE_JOINT_TYPES", "CollisionMesh", "UrdfJoint", "float_attr", "parse_urdf",
     "resolve_collision_meshes", "xml_root",
 ]
 
@@ -66,6 +67,16 @@ def float_attr(element: ET.Element, name: str, path: Path, default: float = math
         raise ConfigError(f"{path}: <{element.tag}> {name}='{text}' is not a number") from None
 
 
+MAX_LINKS = 256
+"""Links a URDF may have: checking collisions costs memory per pair of links (a 400-link chain took
+7 GB, 1,000 links more than 24 GB); PR2 and TIAGo have fewer than 100."""
+
+
+# Attributes holding numbers in a URDF's links and joints: poses, axes, shapes, mesh scales, inertia.
+_NUMERIC_ATTRIBUTES = frozenset({"xyz", "rpy", "size", "radius", "length", "scale", "value",
+                                 "ixx", "ixy", "ixz", "iyy", "iyz", "izz"})
+
+
 def parse_urdf(text: str, path: Path) -> dict[str, UrdfJoint]:
     """Return the URDF's joints by name, in file order, checked as urdfdom checks a model.
 
@@ -80,7 +91,11 @@ def parse_urdf(text: str, path: Path) -> dict[str, UrdfJoint]:
     links = _names(root.findall("link"), "link", path)
     if not links:
         raise ConfigError(f"{path}: defines no <link>; a URDF needs at least one")
+    if len(links) > MAX_LINKS:
+        raise ConfigError(f"{path}: {len(links):,} links; moveplan loads robots of at most {MAX_LINKS} links")
     _names(root.findall("joint"), "joint", path)
+    for element in (*root.findall("link"), *root.findall("joint")):
+        _check_numbers(element, path)
     joints = {joint.name: joint for joint in (_joint(element, links, path) for element in root.findall("joint"))}
     _check_mimics(joints, path)
     _check_tree(joints, path, links)
@@ -133,6 +148,28 @@ def _joint(element: ET.Element, links: list[str], path: Path) -> UrdfJoint:
         offset = _finite_attr(mimic, "offset", path, where, 0.0)
     return UrdfJoint(name, kind, parent.get("link", ""), child.get("link", ""), lower, upper, velocity,
                      leader, multiplier, offset)
+
+
+def _check_numbers(element: ET.Element, path: Path) -> None:
+    """Raise ConfigError for a number in a link's or joint's poses, shapes or inertia that is not finite or too large.
+
+    urdfdom refuses NaN with a log on stderr and a message naming nothing; a huge origin
+    (1e300) loads and overflows the planner's geometry.
+    """
+    owner = f"{element.tag} '{element.get('name', '')}'"
+    for child in element.iter():
+        for attribute in _NUMERIC_ATTRIBUTES & child.attrib.keys():
+            text = child.attrib[attribute]
+            for word in text.split():
+                try:
+                    value = float(word)
+                except ValueError:
+                    continue  # urdfdom's own message names a word that is no number
+                if not math.isfinite(value) or abs(value) > MAX_MAGNITUDE:
+                    shown = text if len(text) <= 60 else f"{text[:57]}..."
+                    problem = "is not a finite number" if not math.isfinite(value) else \
+                        f"is beyond moveplan's bound of {MAX_MAGNITUDE:g} (m, rad, kg)"
+                    raise ConfigError(f"{path}: {owner} <{child.tag} {attribute}='{shown}'>: {word[:40]!r} {problem}")
 
 
 def _finite_attr(element: ET.Element, name: str, path: Path, where: str, default: float | None = None) -> float:

@@ -149,13 +149,27 @@ class _RecordingArgs(dict[str, str]):
         return super().__contains__(key)
 
 
+MAX_ARG_LENGTH = 4096
+"""Characters of one --xacro-arg value: a name, a prefix, a path or a number is far shorter."""
+
+
 def parse_xacro_args(items: Sequence[str]) -> dict[str, str]:
     """Return `name:=value` strings (the --xacro-arg flag, as ros2 launch writes them) as a mapping."""
     args: dict[str, str] = {}
     for item in items:
+        shown = item.encode("utf-8", "backslashreplace").decode("utf-8")
+        shown = shown if len(shown) <= 80 else f"{shown[:77]}..."
         name, sep, value = item.partition(":=")
         if not sep or not name.strip():
-            raise UsageError(f"--xacro-arg '{item}': expected name:=value")
+            raise UsageError(f"--xacro-arg '{shown}': expected name:=value")
+        try:
+            item.encode("utf-8")
+        except UnicodeEncodeError:  # bytes the shell passed that are no UTF-8 arrive as surrogates
+            raise UsageError(f"--xacro-arg '{shown}': not UTF-8 text") from None
+        if len(value) > MAX_ARG_LENGTH:
+            raise UsageError(f"--xacro-arg '{shown}': {len(value):,} characters; at most {MAX_ARG_LENGTH:,}")
+        if name.strip() in args:
+            raise UsageError(f"--xacro-arg {name.strip()}: given twice")
         args[name.strip()] = value
     return args
 
@@ -241,7 +255,10 @@ def process_xacro(path: Path, args: Mapping[str, str], packages: PackagePath, sh
 def _location(path: Path) -> str:
     """Return where xacro stopped: the file (and its includers), or the macro being expanded."""
     stack: list[str] = [str(f) for f in (_xacro.filestack or []) if f] or [str(path)]
-    where = stack[-1] + "".join(f" (included from {f})" for f in reversed(stack[:-1]))
+    links = [f" (included from {f})" for f in reversed(stack[:-1])]
+    if len(links) > 4:  # an include cycle is 32 files deep: its first links say which files loop
+        links = [*links[:3], f" ... {len(links) - 4} more", links[-1]]
+    where = stack[-1] + "".join(links)
     macros = [str(m.body.getAttribute("name")) for m in reversed(_xacro.macrostack or [])]  # not popped on failure
     if macros:
         # xacro records where a macro was grabbed, which for a macro defined inside another

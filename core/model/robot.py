@@ -7,6 +7,12 @@ works on the group's joint values (`values`, one per active joint, in [rad] or
 
 from __future__ import annotations
 
+import contextlib
+import os
+import sys
+import tempfile
+from collections.abc import Iterator
+
 import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
@@ -27,10 +33,17 @@ class Robot:
         self.config = config
         self.group: Group = config.group(group)
         config.srdf.plannable(self.group.name, config.srdf_path)  # a floating or planar base: refused
-        try:
-            self.model = pin.buildModelFromXML(config.urdf)
-        except (RuntimeError, ValueError) as exc:
-            raise ConfigError(f"{config.urdf_path}: pinocchio cannot load the URDF: {exc}") from None
+        with _stderr_of_c_code() as log:
+            try:
+                self.model = pin.buildModelFromXML(config.urdf)
+            except (RuntimeError, ValueError) as exc:
+                error = exc
+            else:
+                error = None
+        if error is not None:
+            # urdfdom says what is wrong only in its log: its first line, not the generic exception, names it.
+            first = next((line.removeprefix("Error:").strip() for line in log if line.startswith("Error:")), "")
+            raise ConfigError(f"{config.urdf_path}: pinocchio cannot load the URDF: {first or error}")
         self.data = self.model.createData()
         self.joint_names: tuple[str, ...] = self.group.joints
         if not self.joint_names:
@@ -160,3 +173,20 @@ def _readonly(values: list[float]) -> NDArray[np.float64]:
     array = np.array(values, dtype=float)
     array.setflags(write=False)
     return array
+
+
+@contextlib.contextmanager
+def _stderr_of_c_code() -> Iterator[list[str]]:
+    """Yield a list that gets the lines C++ code (urdfdom's log) wrote on file descriptor 2 meanwhile, not shown."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    lines: list[str] = []
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield lines
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            lines.extend(sink.read(65536).decode("utf-8", "replace").splitlines())
