@@ -105,6 +105,19 @@ class GuardedGroup(TyperGroup):
             code, message = _interrupt_message(exc)
             print(f"moveplan: error: {message}", file=sys.stderr)
             raise typer.Exit(code) from None
+        except OSError as exc:
+            # The work's errors are turned into exit codes inside the command (exit_codes): what
+            # arrives here failed writing stdout (/dev/full, a full disk under `> file`).
+            _stdout_failed(exc)
+
+
+def _stdout_failed(exc: OSError) -> None:
+    """Exit 3 with one line on stderr: stdout could not be written; later writes to it are dropped."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)
+    os.close(devnull)
+    print(f"moveplan: error: cannot write to standard output: {exc.strerror or exc}", file=sys.stderr)
+    raise typer.Exit(3) from None
 
 
 def _pipe_closed() -> None:

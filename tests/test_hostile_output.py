@@ -221,14 +221,22 @@ def test_a_stale_temporary_file_of_this_process_id_is_no_obstacle(cli: Cli, inpu
     assert (inputs / "out.mcap").stat().st_size > 0
 
 
-def test_the_output_gets_the_users_umask_permissions(cli: Cli, inputs: Path) -> None:
+@pytest.mark.parametrize(("args", "output"), [
+    (["execute", "p.mcap", "--fake"], "out.mcap"),
+    (["tune-pid", "p.mcap", "--controllers", SAMPLES / "ur10e_velocity_controllers.yaml"], "tuned.yaml"),
+])
+def test_the_output_gets_the_users_umask_permissions(
+    cli: Cli, inputs: Path, args: list[Any], output: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(inputs)
     old = os.umask(0o027)
     try:
-        result = cli("execute", inputs / "p.mcap", "--fake", "-o", inputs / "out.mcap")
+        result = cli(*args, "-o", output, "-q")
     finally:
         os.umask(old)
     assert result.exit_code == 0, result.stderr
-    assert stat.S_IMODE((inputs / "out.mcap").stat().st_mode) == 0o640
+    assert stat.S_IMODE((inputs / output).stat().st_mode) == 0o640
+    assert not list(inputs.glob(".*.tmp"))
 
 
 # -- 3. signals while writing: cleaned up like Ctrl-C, exit 128 + signal ------------------------------------------
@@ -309,6 +317,15 @@ def test_a_reader_that_closed_stdout_gets_exit_141_and_no_traceback(args: list[A
         os.close(writing)
     assert result.returncode == PIPE_CLOSED == 141
     assert result.stderr == ""
+
+
+@pytest.mark.parametrize("args", [["inspect", SHIPPED_PLAN], ["robot", UR10E, "--json"]])
+def test_a_full_stdout_is_one_line_and_exit_3_without_traceback(args: list[Any]) -> None:
+    with open("/dev/full", "w") as full:  # every write fails with ENOSPC, as on a full disk under `> file`
+        result = subprocess.run([sys.executable, "-m", "moveplan.cli.app", *map(str, args)],
+                                stdout=full, stderr=subprocess.PIPE, text=True, timeout=300)
+    assert result.returncode == 3
+    assert result.stderr == "moveplan: error: cannot write to standard output: No space left on device\n"
 
 
 # -- 4. the on-disk cache: versioned, checksummed, rebuilt with one warning, no partial files ----------------------

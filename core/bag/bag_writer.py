@@ -22,7 +22,7 @@ from ..errors import InputError, UsageError
 from ..version import moveplan_version
 from .qos import offered_qos_profiles
 
-__all__ = ["BagStream", "atomic_file", "open_bag", "output_problem", "write_bag"]
+__all__ = ["BagStream", "atomic_file", "open_bag", "output_problem", "staged_file", "write_bag"]
 
 _MEDIA_TYPES = {".urdf": "application/xml", ".srdf": "application/xml", ".yaml": "application/yaml"}
 
@@ -158,6 +158,37 @@ def atomic_file(path: Path) -> Iterator[BinaryIO]:
         if isinstance(exc, OSError):
             raise InputError(f"{path}: cannot write: {exc.strerror or exc}") from exc
         raise
+
+
+@contextmanager
+def staged_file(path: Path, data: bytes) -> Iterator[Path]:
+    """Yield a temporary file beside `path` holding `data`; when the block ends well, rename it to `path`.
+
+    For an output read back before it replaces `path` (tune-pid verifies its gains file); named,
+    created and removed as atomic_file's, with the user's umask permissions.
+
+    Raises:
+        UsageError: `path` cannot be an output file (`output_problem`).
+        InputError: `path` cannot be written (missing or read-only folder, full disk).
+
+    """
+    problem = output_problem(path)
+    if problem:
+        raise UsageError(f"{path}: {problem}")
+    temporary: Path | None = None
+    try:
+        temporary, stream = _create_beside(path)
+        with stream:
+            stream.write(data)
+    except OSError as exc:
+        if temporary is not None:
+            temporary.unlink(missing_ok=True)
+        raise InputError(f"{path}: cannot write: {exc.strerror or exc}") from None
+    try:
+        yield temporary
+        temporary.replace(path)
+    finally:
+        temporary.unlink(missing_ok=True)
 
 
 def _create_beside(path: Path) -> tuple[Path, BinaryIO]:

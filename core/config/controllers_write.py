@@ -10,19 +10,17 @@ point: ROS 2 refuses an integer for a double parameter.
 from __future__ import annotations
 
 import math
-import os
 import re
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
 
-from ..errors import ConfigError, InputError
+from ..errors import ConfigError
 from .substitutions import substitute
 
-__all__ = ["tuned_controllers_text", "write_text_atomically", "yaml_float"]
+__all__ = ["tuned_controllers_text", "yaml_float"]
 
 Edit = tuple[int, int, str]
 """Replace text[start:end] by the string."""
@@ -85,27 +83,6 @@ def yaml_float(value: float) -> str:
     if "." not in mantissa:
         mantissa += ".0"
     return f"{mantissa}e{exponent}" if exponent else mantissa
-
-
-def write_text_atomically(path: Path, text: str) -> None:
-    """Write `text` to `path` through a temporary file beside it, renamed into place; return None.
-
-    Raises:
-        InputError: The file cannot be written (the message names it and why).
-    """
-    try:
-        handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent or Path("."))
-    except OSError as exc:
-        raise InputError(f"{path}: cannot write: {exc.strerror or exc}") from None
-    try:
-        with os.fdopen(handle, "w", encoding="utf-8") as stream:
-            stream.write(text)
-        os.replace(temporary, path)
-    except BaseException as exc:
-        Path(temporary).unlink(missing_ok=True)
-        if isinstance(exc, OSError):
-            raise InputError(f"{path}: cannot write: {exc.strerror or exc}") from None
-        raise
 
 
 def _sections(root: yaml.Node | None, controller: str, source: str, args: Mapping[str, str]) -> list[_Section]:

@@ -8,10 +8,7 @@ plan through it under the same plant, as `execute --fake --plant pid --controlle
 
 from __future__ import annotations
 
-import os
-import tempfile
-from collections.abc import Iterator, Mapping, Sequence
-from contextlib import contextmanager
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, cast
@@ -19,8 +16,9 @@ from typing import Any, cast
 import numpy as np
 
 from .. import bag as recording
+from ..bag.bag_writer import staged_file
 from ..config.controllers import ControllerConfig
-from ..config.controllers_write import tuned_controllers_text, write_text_atomically
+from ..config.controllers_write import tuned_controllers_text
 from ..config.fields import read_input_text
 from ..control.plant_fit import PlantFit, RecordedStep, fit_plant
 from ..control.plants import pid_gains, pid_interface, pid_parameters
@@ -128,7 +126,7 @@ def tune(request: TuneRequest) -> TuneResult:
     tuned = tuple(_tune_joint(controller, joint, interface, values, request) for joint in joints)
     gains = {t.setup.joint: {k: v for k, v in t.gains.as_dict().items() if k != "ff_velocity_scale"} for t in tuned}
     written = tuned_controllers_text(text, source, controller.name, gains)
-    with _staged(request.output, written) as staged:
+    with staged_file(request.output, written.encode("utf-8")) as staged:
         verification = execute(ExecuteRequest(plan=request.plan, plant="pid", plant_params=params,
                                               controllers=staged, seed=request.seed))
     return TuneResult(controller.name, source, request.output, interface, tuned, params, fit, verification)
@@ -199,23 +197,6 @@ def _recorded_steps(checked: CheckedRecording) -> list[RecordedStep]:
         positions = samples.read_positions(first, stop)[:, columns]
         steps.append(RecordedStep(trajectory, samples.read_times(first, stop) - step.start_s, positions))
     return steps
-
-
-@contextmanager
-def _staged(output: Path, text: str) -> Iterator[Path]:
-    """Yield a temporary file beside `output` holding `text`; renamed to `output` when the block ends well."""
-    try:
-        handle, name = tempfile.mkstemp(prefix=f".{output.name}.", suffix=".yaml", dir=output.parent)
-    except OSError as exc:
-        raise InputError(f"{output}: cannot write: {exc.strerror or exc}") from None
-    os.close(handle)
-    staged = Path(name)
-    try:
-        write_text_atomically(staged, text)
-        yield staged
-        os.replace(staged, output)
-    finally:
-        staged.unlink(missing_ok=True)
 
 
 def tuning_document(result: TuneResult) -> dict[str, Any]:
