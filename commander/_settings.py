@@ -6,6 +6,7 @@ joint_limits.yaml's default scaling factors until set.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from moveplan.core.config.planners import PLANNERS
@@ -53,19 +54,19 @@ class PlanningSettings:
 
     def set_goal_tolerance(self, value: float) -> None:
         """Set all three goal tolerances (kept; moveplan reaches goals within 1e-4 m and 1e-3 rad); return None."""
-        self._tolerances = dict.fromkeys(self._tolerances, float(value))
+        self._tolerances = dict.fromkeys(self._tolerances, _tolerance(value, "set_goal_tolerance"))
 
     def set_goal_joint_tolerance(self, value: float) -> None:
         """Set the joint goal tolerance (kept, see set_goal_tolerance); return None."""
-        self._tolerances["joint"] = float(value)
+        self._tolerances["joint"] = _tolerance(value, "set_goal_joint_tolerance")
 
     def set_goal_position_tolerance(self, value: float) -> None:
         """Set the position goal tolerance (kept, see set_goal_tolerance); return None."""
-        self._tolerances["position"] = float(value)
+        self._tolerances["position"] = _tolerance(value, "set_goal_position_tolerance")
 
     def set_goal_orientation_tolerance(self, value: float) -> None:
         """Set the orientation goal tolerance (kept, see set_goal_tolerance); return None."""
-        self._tolerances["orientation"] = float(value)
+        self._tolerances["orientation"] = _tolerance(value, "set_goal_orientation_tolerance")
 
     def get_planning_time(self) -> float:
         """Return the time a plan may search, in [s] (default 5, MoveIt's)."""
@@ -73,7 +74,7 @@ class PlanningSettings:
 
     def set_planning_time(self, seconds: float) -> None:
         """Set the time a plan may search, in [s]; return None."""
-        self._planning_time = check_planning_time(float(seconds), "set_planning_time")
+        self._planning_time = check_planning_time(_number(seconds, "set_planning_time"), "set_planning_time")
 
     def get_planner_id(self) -> str:
         """Return the planner set, or the robot config's when none was."""
@@ -84,6 +85,8 @@ class PlanningSettings:
 
         "" goes back to the robot config's planner.
         """
+        if not isinstance(planner_id, str):
+            raise UsageError(f"set_planner_id: expected a planner's name, got {planner_id!r}")
         name = planner_id.removeprefix("geometric::").removesuffix("kConfigDefault")
         if name and name not in PLANNERS:
             raise UsageError(f"set_planner_id: unknown planner '{planner_id}'; OMPL geometric planners: "
@@ -92,6 +95,9 @@ class PlanningSettings:
 
     def set_num_planning_attempts(self, num_planning_attempts: int) -> None:
         """Accept MoveIt's number of attempts; a moveplan plan is one attempt, certified; return None."""
+        if isinstance(num_planning_attempts, bool) or not isinstance(num_planning_attempts, int) \
+                or num_planning_attempts < 0:
+            raise UsageError(f"set_num_planning_attempts: expected an integer >= 0, got {num_planning_attempts!r}")
 
     def set_max_velocity_scaling_factor(self, value: float) -> None:
         """Scale the joints' velocity limits by `value` in (0, 1] (default: joint_limits.yaml's); return None."""
@@ -113,3 +119,18 @@ def _scaling(value: Any, where: str) -> float:
         raise UsageError(f"{where}: expected a value in the range from {MIN_SCALING:g} to 1 for scaling factor, "
                          f"got {value!r}")
     return float(value)
+
+
+def _number(value: Any, where: str) -> float:
+    """Return `value` as a float if it is a finite number, else raise UsageError naming `where`."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise UsageError(f"{where}: expected a finite number, got {value!r}")
+    return float(value)
+
+
+def _tolerance(value: Any, where: str) -> float:
+    """Return a goal tolerance checked to be a finite number >= 0, else raise UsageError naming `where`."""
+    tolerance = _number(value, where)
+    if tolerance < 0:
+        raise UsageError(f"{where}: expected a tolerance >= 0, got {value!r}")
+    return tolerance

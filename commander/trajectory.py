@@ -82,6 +82,9 @@ def from_message(message: Any, joints: Sequence[str], where: str) -> StepResult:
             do not increase; the message begins with `where`.
     """
     source = message.joint_trajectory if hasattr(message, "joint_trajectory") else message
+    if not hasattr(source, "joint_names") or not hasattr(source, "points"):
+        raise UsageError(f"{where}: expected a RobotTrajectory or a trajectory_msgs JointTrajectory, "
+                         f"got {type(message).__name__}")
     names = [str(n) for n in source.joint_names]
     points = list(source.points)
     if not points:

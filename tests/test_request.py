@@ -56,7 +56,7 @@ def test_start_flags_become_typed_starts() -> None:
     ({"pose": PoseGoal(), "shift_frame": "base"}, "--shift-frame goes with --shift"),
     ({"named": "home", "linear": True}, "--linear goes with --pose or --shift"),
     ({"named": "home", "min_fraction": 1.5}, r"--min-fraction: expected a number in \[0, 1\], got 1.5"),
-    ({"named": "home", "planning_time": 0.0}, "--planning-time: expected a positive number of seconds, got 0"),
+    ({"named": "home", "planning_time": 0.0}, r"--planning-time: expected a positive number of seconds .*, got 0"),
     ({"named": "home", "velocity_scaling": 0.0}, r"--velocity-scaling: expected a factor in \[0.001, 1\], got 0"),
     ({"named": "home", "acceleration_scaling": 1.5}, r"--acceleration-scaling: .* got 1.5"),
 ])
@@ -67,7 +67,7 @@ def test_flags_that_break_a_rule_are_a_usage_error(flags: dict[str, object], mes
 
 def test_planning_time_check_names_the_flag() -> None:
     assert check_planning_time(0.5) == 0.5
-    with pytest.raises(UsageError, match="--time: expected a positive number of seconds, got -1"):
+    with pytest.raises(UsageError, match=r"--time: expected a positive number of seconds up to 1e\+06, got -1"):
         check_planning_time(-1.0, "--time")
 
 

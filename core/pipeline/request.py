@@ -24,6 +24,7 @@ from ..config import (
     TaskFile,
     load_robot_config,
 )
+from ..config.fields import MAX_MAGNITUDE
 from ..config.tasks import MIN_SCALING
 from ..errors import UsageError
 from ..model.moveit_request import MotionPlanRequest, load_motion_plan_request
@@ -34,9 +35,9 @@ _T = TypeVar("_T")
 
 
 def check_planning_time(seconds: float, flag: str = "--planning-time") -> float:
-    """Return `seconds` if it is a positive planning time, else raise UsageError naming `flag`."""
-    if seconds <= 0:
-        raise UsageError(f"{flag}: expected a positive number of seconds, got {seconds:g}")
+    """Return `seconds` if it is a positive, finite planning time of at most MAX_MAGNITUDE, else raise UsageError."""
+    if not 0 < seconds <= MAX_MAGNITUDE:  # NaN too: it compares false
+        raise UsageError(f"{flag}: expected a positive number of seconds up to {MAX_MAGNITUDE:g}, got {seconds:g}")
     return seconds
 
 
