@@ -66,3 +66,28 @@ def test_a_file_is_read_no_further_than_the_limit_whatever_it_claims(tmp_path: P
     assert read_input(big, limit=500) == b"a: 1\n" * 100
     with pytest.raises(ConfigError, match=r"big.yaml: more than 499 bytes; moveplan reads files of at most 499"):
         read_input(big, limit=499)
+
+
+def test_a_trajectory_beyond_the_control_cycle_limit_is_refused_before_it_is_simulated(
+    cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A plan of hours at a kHz rate would take gigabytes: the limit is stated, and raised by the variable."""
+    monkeypatch.setenv("MOVEPLAN_MAX_CONTROL_CYCLES", "100")
+    result = cli("execute", SHIPPED_PLAN, "--fake", "-o", tmp_path / "e.mcap")
+    assert result.exit_code == 3
+    line = result.stderr.strip()
+    assert line.startswith(f"moveplan: error: {SHIPPED_PLAN}: step 'up': a ") and "\n" not in line
+    assert "control cycles; moveplan simulates at most 100 per trajectory (MOVEPLAN_MAX_CONTROL_CYCLES" in line
+    assert not (tmp_path / "e.mcap").exists()
+    monkeypatch.setenv("MOVEPLAN_MAX_CONTROL_CYCLES", "10000000")
+    assert cli("execute", SHIPPED_PLAN, "--fake", "-o", tmp_path / "e.mcap", "-q").exit_code == 0
+
+
+def test_a_control_cycle_limit_that_is_no_number_is_a_usage_error(
+    cli: Cli, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("MOVEPLAN_MAX_CONTROL_CYCLES", "lots")
+    result = cli("execute", SHIPPED_PLAN, "--fake", "-o", tmp_path / "e.mcap")
+    assert result.exit_code == 2
+    assert result.stderr == ("moveplan: error: MOVEPLAN_MAX_CONTROL_CYCLES='lots': expected a positive number of "
+                             "control cycles\n")

@@ -13,6 +13,7 @@ runs as fast as the computer does.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, replace
 
@@ -21,7 +22,7 @@ import numpy.typing as npt
 from numpy.typing import NDArray
 
 from ..config.controllers import ControllerConfig, ExecutionConfig
-from ..errors import UsageError, known
+from ..errors import InputError, UsageError, known
 from ..trajectory import PointBefore, sample
 from ..types import JointTrajectory, frozen_array
 from .judging import judge
@@ -38,7 +39,10 @@ from .results import (
 )
 from .tolerances import in_controller_order, position_error, segment_tolerances, velocity_error_computable
 
-__all__ = ["WAIT_LIMIT_S", "Disturbance", "ExecutionReport", "simulate"]
+__all__ = [
+    "DEFAULT_MAX_CYCLES", "MAX_CYCLES_ENV", "WAIT_LIMIT_S", "Disturbance", "ExecutionReport", "max_control_cycles",
+    "simulate",
+]
 
 _FIRST_CHUNK = 256
 # Cycle times sampled at a time: the spline's temporaries (a dozen arrays) stay this size.
@@ -53,6 +57,14 @@ WAIT_LIMIT_S = 10.0
 With constraints.goal_time 0 a Jazzy JTC waits for the goal tolerance forever
 (ros2_controllers#548); 10 s is the goal_time default newer JTC versions adopted.
 """
+
+MAX_CYCLES_ENV = "MOVEPLAN_MAX_CONTROL_CYCLES"
+"""The environment variable that sets the most control cycles one trajectory's simulation may take."""
+
+DEFAULT_MAX_CYCLES = 1_000_000
+"""Control cycles one trajectory's simulation may take without MOVEPLAN_MAX_CONTROL_CYCLES: 2.8 h at 100 Hz,
+16 min at 1 kHz. The simulation keeps a trajectory's samples, ~1 kB a cycle (a 24 min step at 500 Hz
+peaked at 630 MB): a plan of a day at 1 kHz would need 90 GB."""
 
 
 @dataclass(frozen=True)
@@ -163,6 +175,11 @@ def simulate(
     dt = 1.0 / controller.update_rate_hz
     timeout = _timeout(trajectory.duration_s, controller, execution)
     grid = _time_grid(trajectory.duration_s, controller.goal_time_s, timeout, dt)
+    limit = max_control_cycles()
+    if len(grid) > limit:
+        raise InputError(f"a {trajectory.duration_s:.6g} s trajectory at {controller.update_rate_hz:g} Hz is "
+                         f"{len(grid):,} control cycles; moveplan simulates at most {limit:,} per trajectory "
+                         f"({MAX_CYCLES_ENV} raises the limit; memory grows ~1 kB a cycle)")
     bumps = _bumps(disturbances, joints, grid[:-1], dt)
     p0, v0 = plant.reset(start, seed)
     if np.any(bumps[0]):
@@ -290,6 +307,21 @@ def _run(
         if stop == count or verdict.result.code != TIMED_OUT or verdict.end_index < stop - 1:
             return actual_p[:stop], actual_v[:stop], output[:stop], verdict
         done, size = stop, 2 * size
+
+
+def max_control_cycles() -> int:
+    """Return the most control cycles one trajectory's simulation may take: MOVEPLAN_MAX_CONTROL_CYCLES, else 1e6.
+
+    Raises:
+        UsageError: The variable is set to something that is not a positive integer.
+
+    """
+    text = os.environ.get(MAX_CYCLES_ENV, "").strip()
+    if not text:
+        return DEFAULT_MAX_CYCLES
+    if not text.isdigit() or int(text) == 0:
+        raise UsageError(f"{MAX_CYCLES_ENV}={text[:40]!r}: expected a positive number of control cycles")
+    return int(text)
 
 
 def _time_grid(

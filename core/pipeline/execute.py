@@ -324,8 +324,11 @@ def _simulated_steps(
         last = step is plan.steps[-1]
         bumps = [Disturbance(d.time_s - step.start_s, d.joint, d.delta)
                  for d in request.disturbances if step.start_s <= d.time_s < end or (d.time_s >= end and last)]
-        report = simulate(step.trajectory, controller, execution, plant, continuous_joints=continuous,
-                          start_positions=start, disturbances=bumps, seed=request.seed)
+        try:
+            report = simulate(step.trajectory, controller, execution, plant, continuous_joints=continuous,
+                              start_positions=start, disturbances=bumps, seed=request.seed)
+        except InputError as exc:
+            raise InputError(f"{request.plan}: step '{step.name}': {exc}") from None
         ok = report.ok
         # A copy, not a view: a view would keep the step's samples alive through the next step.
         start = report.actual_positions[-1].copy() if len(report.times_s) else start
