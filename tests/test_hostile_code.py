@@ -307,6 +307,52 @@ def test_embedded_controllers_get_no_launch_substitutions(cli: Cli, tmp_path: Pa
     assert result.exit_code == 0, result.stderr
 
 
+def test_tune_pid_of_a_plans_own_controllers_gets_no_launch_substitutions(
+    cli: Cli, tmp_path: Path, monkeypatch: Any
+) -> None:
+    monkeypatch.delenv("MOVEPLAN_UNSET_VARIABLE", raising=False)
+    config = tmp_path / "ur10e"
+    config.mkdir()
+    for file in UR10E.iterdir():
+        if file.is_file():
+            (config / file.name).write_bytes(file.read_bytes())
+    (config / "ros2_controllers.yaml").write_bytes((SAMPLES / "ur10e_velocity_controllers.yaml").read_bytes())
+    planned = tmp_path / "plan.mcap"
+    assert cli("plan", "--robot", config, "--start-joints", "0,-1,-1,0,0,0", "--named", "home", "-o", planned,
+               "-q").exit_code == 0
+    with planned.open("rb") as stream:
+        controllers = next(a.data for a in make_reader(stream).iter_attachments() if a.name == "ros2_controllers.yaml")
+    plan = rewrite_plan(planned, tmp_path / "hostile.mcap",
+                        {"ros2_controllers.yaml": b"# $(env MOVEPLAN_UNSET_VARIABLE)\n" + controllers})
+    result = cli("tune-pid", plan, "-o", tmp_path / "tuned.yaml", "-q")
+    assert result.exit_code == 0, result.stderr
+    assert (tmp_path / "tuned.yaml").read_text().startswith("# $(env MOVEPLAN_UNSET_VARIABLE)\n")
+
+
+def test_state_of_a_plan_reads_no_mesh_file_its_embedded_scene_names(
+    cli: Cli, tmp_path: Path, monkeypatch: Any
+) -> None:
+    """A PlanningScene's mesh `resource` names a file of the machine that planned; the plan carries none."""
+    mesh = tmp_path / "tray.stl"
+    mesh.write_text("solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0.1 0 0\nvertex 0 0.1 0\n"
+                    "endloop\nendfacet\nendsolid t\n")
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(
+        "world:\n  collision_objects:\n  - id: tray\n    header: {frame_id: base_link}\n"
+        "    pose: {position: {x: 2.0, y: 0.0, z: 0.0}, orientation: {w: 1.0}}\n"
+        f"    meshes: [{{resource: {mesh}}}]\n    mesh_poses: [{{orientation: {{w: 1.0}}}}]\n")
+    plan = tmp_path / "plan.mcap"
+    assert cli("plan", "--robot", UR10E, "--scene", scene, "--start-joints", "0,-1,-1,0,0,0", "--named", "home",
+               "-o", plan, "-q").exit_code == 0
+    mesh.unlink()  # had state opened it, the tray would now be "mesh file not found"
+    opened: list[str] = []
+    real_open = os.open
+    monkeypatch.setattr(os, "open", lambda path, *args, **kw: opened.append(str(path)) or real_open(path, *args, **kw))
+    code, document = cli.json("state", "--from", plan)
+    assert code == 0, document
+    assert str(mesh) not in opened
+
+
 def test_plan_of_a_xacro_config_carries_the_expanded_urdf(cli: Cli, tmp_path: Path) -> None:
     config = tmp_path / "ur10e"
     config.mkdir()

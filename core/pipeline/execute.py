@@ -67,6 +67,8 @@ class ExecuteRequest:
     start_joints: JointGoal | None = None
     controllers: Path | None = None
     seed: int = 0
+    controllers_as_data: bool = False
+    """The `controllers` file is a plan's own (tune-pid's gains written into it): read without launch substitutions."""
 
 
 @dataclass(frozen=True)
@@ -268,7 +270,7 @@ def execute(
     config = plan_config(plan, request.plan)
     if request.start_joints is not None:
         check_joint_units(request.start_joints, config, ())
-    controller = _controller(config, plan, request.plan, request.controllers)
+    controller = _controller(config, plan, request.plan, request.controllers, not request.controllers_as_data)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
     plant = make_plant(request.plant, dict(request.plant_params or {}), controller, continuous)
     reports = _simulated_steps(request, plan, controller, config.execution, plant, continuous)
@@ -399,11 +401,13 @@ def plan_controller(
     return _controller(config, plan, path, override)
 
 
-def _controller(config: RobotConfig, plan: recording.PlanFile, path: Path, override: Path | None) -> ControllerConfig:
-    """Return the controller driving the plan's joints, from `override` or the plan's own config."""
+def _controller(
+    config: RobotConfig, plan: recording.PlanFile, path: Path, override: Path | None, substitute: bool = True
+) -> ControllerConfig:
+    """Return the controller driving the plan's joints, from `override` (substituted or not) or the plan's config."""
     joints = plan.steps[0].trajectory.joint_names
     if override is not None:
-        return pick_controller(parse_controllers(override), joints, str(override))
+        return pick_controller(parse_controllers(override, substitute=substitute), joints, str(override))
     if "controllers" not in config.sources:
         # A config without ros2_controllers.yaml (ABB's, most Setup Assistant packages before Humble): the
         # controller ros2_control would load with no parameters file, as users get from mock hardware.

@@ -6,8 +6,10 @@ for a state given by joint values, a named state, the config's start, or a time 
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -200,5 +202,28 @@ def _plan_scene(scene: Path | None, attachments: dict[str, bytes], path: Path, r
     except UnicodeDecodeError:
         raise InputError(f"{shown}: not UTF-8 text") from None
     if PLANNING_SCENE_KEYS & set(top):
-        return planning_scene(top, shown, robot)
+        return planning_scene(_without_mesh_files(top), shown, robot)
     return moveplan_scene({"frames": top.get("frames")}, shown, robot)
+
+
+# A triangle standing in for a mesh file: an object's frames do not depend on its shapes.
+_STAND_IN = {"vertices": [[0.0, 0.0, 0.0], [1e-3, 0.0, 0.0], [0.0, 1e-3, 0.0]], "triangles": [[0, 1, 2]]}
+
+
+def _without_mesh_files(top: dict[str, Any]) -> dict[str, Any]:
+    """Return an embedded PlanningScene with each mesh file (`resource`) replaced by a stand-in triangle.
+
+    A plan carries no mesh file: a `resource` names a path or package of the machine that
+    planned, and opening a plan file must read nothing of this machine's.
+    """
+    def objects(section: Any, key: str) -> list[Any]:
+        return section.get(key) if isinstance(section, dict) and isinstance(section.get(key), list) else []
+
+    copied = copy.deepcopy(top)
+    attached = [a.get("object") for a in objects(copied.get("robot_state"), "attached_collision_objects")
+                if isinstance(a, dict)]
+    for obj in [*objects(copied.get("world"), "collision_objects"), *attached]:
+        for k, mesh in enumerate(objects(obj, "meshes")):
+            if isinstance(mesh, dict) and ("resource" in mesh or "dimensions" in mesh):
+                obj["meshes"][k] = copy.deepcopy(_STAND_IN)
+    return copied

@@ -128,7 +128,8 @@ def tune(request: TuneRequest) -> TuneResult:
     written = tuned_controllers_text(text, source, controller.name, gains)
     with staged_file(request.output, written.encode("utf-8")) as staged:
         verification = execute(ExecuteRequest(plan=request.plan, plant="pid", plant_params=params,
-                                              controllers=staged, seed=request.seed))
+                                              controllers=staged, seed=request.seed,
+                                              controllers_as_data=request.controllers is None))
     return TuneResult(controller.name, source, request.output, interface, tuned, params, fit, verification)
 
 
