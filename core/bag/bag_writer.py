@@ -141,23 +141,8 @@ def atomic_file(path: Path) -> Iterator[BinaryIO]:
         InputError: `path` cannot be written (missing or read-only folder, full disk).
 
     """
-    problem = output_problem(path)
-    if problem:
-        raise UsageError(f"{path}: {problem}")
-    try:
-        temporary, stream = _create_beside(path)
-    except OSError as exc:
-        raise InputError(f"{path}: cannot write: {exc.strerror or exc}") from None
-    try:
-        with stream:
-            yield stream
-        temporary.replace(path)
-    except BaseException as exc:
-        with suppress(OSError):
-            temporary.unlink()
-        if isinstance(exc, OSError):
-            raise InputError(f"{path}: cannot write: {exc.strerror or exc}") from exc
-        raise
+    with _temporary_beside(path) as (_, stream):
+        yield stream
 
 
 @contextmanager
@@ -165,30 +150,34 @@ def staged_file(path: Path, data: bytes) -> Iterator[Path]:
     """Yield a temporary file beside `path` holding `data`; when the block ends well, rename it to `path`.
 
     For an output read back before it replaces `path` (tune-pid verifies its gains file); named,
-    created and removed as atomic_file's, with the user's umask permissions.
-
-    Raises:
-        UsageError: `path` cannot be an output file (`output_problem`).
-        InputError: `path` cannot be written (missing or read-only folder, full disk).
-
+    created and removed as atomic_file's, and raising what it raises.
     """
+    with _temporary_beside(path) as (temporary, stream):
+        stream.write(data)
+        stream.close()
+        yield temporary
+
+
+@contextmanager
+def _temporary_beside(path: Path) -> Iterator[tuple[Path, BinaryIO]]:
+    """Yield atomic_file's temporary file and its stream; renamed to `path` when the block ends well, else removed."""
     problem = output_problem(path)
     if problem:
         raise UsageError(f"{path}: {problem}")
-    temporary: Path | None = None
     try:
         temporary, stream = _create_beside(path)
-        with stream:
-            stream.write(data)
     except OSError as exc:
-        if temporary is not None:
-            temporary.unlink(missing_ok=True)
         raise InputError(f"{path}: cannot write: {exc.strerror or exc}") from None
     try:
-        yield temporary
+        with stream:
+            yield temporary, stream
         temporary.replace(path)
-    finally:
-        temporary.unlink(missing_ok=True)
+    except BaseException as exc:
+        with suppress(OSError):
+            temporary.unlink()
+        if isinstance(exc, OSError):
+            raise InputError(f"{path}: cannot write: {exc.strerror or exc}") from exc
+        raise
 
 
 def _create_beside(path: Path) -> tuple[Path, BinaryIO]:
