@@ -188,12 +188,23 @@ def exit_codes(as_json: bool, report: Callable[[MoveplanError], dict[str, Any]] 
         _report(*_interrupt_message(exc), as_json, kind="Interrupted")
     except BrokenPipeError:
         raise  # stdout or stderr closed: GuardedGroup exits quietly
+    except OSError as exc:
+        if exc.filename is None:
+            _report(1, _internal(exc), as_json, kind="InternalError")
+        # A path the system refuses to look at (too long a name, a loop of links): bad input, named.
+        name = str(exc.filename)
+        name = name if len(name) <= 120 else f"{name[:60]}...{name[-40:]}"
+        _report(3, f"{name}: cannot use it: {exc.strerror or exc}", as_json, kind="InputError")
     except Exception as exc:  # noqa: BLE001 - the last line of defence: a bug must still exit cleanly
-        logger.debug("internal error", exc_info=True)
-        detail = traceback.extract_tb(exc.__traceback__)[-1]
-        message = (f"internal error (a bug in moveplan, please report it): {type(exc).__name__}: {exc} "
-                   f"[{detail.filename.rsplit('/', 1)[-1]}:{detail.lineno}]")
-        _report(1, message, as_json, kind="InternalError")
+        _report(1, _internal(exc), as_json, kind="InternalError")
+
+
+def _internal(exc: BaseException) -> str:
+    """Return the one line describing an unexpected exception (a bug), logged with its traceback at debug."""
+    logger.debug("internal error", exc_info=exc)
+    detail = traceback.extract_tb(exc.__traceback__)[-1]
+    return (f"internal error (a bug in moveplan, please report it): {type(exc).__name__}: {exc} "
+            f"[{detail.filename.rsplit('/', 1)[-1]}:{detail.lineno}]")
 
 
 def _report(code: int, message: str, as_json: bool, *, kind: str, **document: Any) -> None:

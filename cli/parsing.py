@@ -138,6 +138,8 @@ def parse_shift(text: str, what: str) -> ShiftGoal:
         if name not in SHIFT_AXES or not value.strip():
             raise UsageError(f"{what}: expected axis=value pairs with axes {', '.join(SHIFT_AXES)}, "
                              f"got '{item.strip()}'")
+        if name in offsets:
+            raise UsageError(f"{what}: axis '{name}' is given twice")
         read = parse_number if name in ("x", "y", "z") else parse_pose_angle
         offsets[name] = read(value, f"{what} {name}")
     return ShiftGoal.of(offsets)
@@ -150,6 +152,8 @@ def parse_params(items: list[str], what: str) -> dict[str, float]:
         key, _, value = item.partition("=")
         if not key.strip() or not value.strip():
             raise UsageError(f"{what}: expected key=value, got '{item}'")
+        if key.strip() in params:
+            raise UsageError(f"{what}: '{key.strip()}' is given twice")
         params[key.strip()] = parse_number(value, f"{what} {key.strip()}")
     return params
 
@@ -158,9 +162,9 @@ def parse_disturbance(text: str) -> Any:
     """Return a Disturbance from "t=1.2,joint=elbow_joint,delta=0.05"."""
     from moveplan.core.control.controller import Disturbance
 
-    fields = dict(item.partition("=")[::2] for item in text.split(","))
-    fields = {k.strip(): v.strip() for k, v in fields.items()}
-    if set(fields) != {"t", "joint", "delta"} or not fields["joint"]:
+    pairs = [item.partition("=")[::2] for item in text.split(",")]
+    fields = {k.strip(): v.strip() for k, v in pairs}
+    if set(fields) != {"t", "joint", "delta"} or len(pairs) != len(fields) or not fields["joint"]:
         raise UsageError(f"--disturb: expected 't=SECONDS,joint=NAME,delta=RAD', got '{text}'")
     time_s = parse_time(fields["t"], "--disturb t")
     return Disturbance(time_s, fields["joint"], parse_number(fields["delta"], "--disturb delta"))

@@ -91,3 +91,21 @@ def test_a_control_cycle_limit_that_is_no_number_is_a_usage_error(
     assert result.exit_code == 2
     assert result.stderr == ("moveplan: error: MOVEPLAN_MAX_CONTROL_CYCLES='lots': expected a positive number of "
                              "control cycles\n")
+
+
+@pytest.mark.parametrize("kind", ["--robot", "inspect", "task robot", "--scene"])
+def test_a_name_too_long_for_the_system_is_bad_input_naming_it_shortened(cli: Cli, tmp_path: Path, kind: str) -> None:
+    name = "x" * 300  # beyond NAME_MAX (255): the system refuses to look it up
+    if kind == "task robot":
+        (tmp_path / "task.yaml").write_text(f"robot: {name}\nsteps:\n  - {{name: home, named: home}}\n")
+        args: list[object] = ["plan", tmp_path / "task.yaml", "-o", tmp_path / "out"]
+    elif kind == "inspect":
+        args = ["inspect", name]
+    else:
+        args = ["plan", "--robot", UR10E if kind == "--scene" else name, *([kind, name] if kind == "--scene" else []),
+                "--named", "home", "-o", tmp_path / "out"]
+    result = cli(*args)
+    assert result.exit_code == 3, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "internal error" not in lines[0] and len(lines[0]) < 400, result.stderr
+    assert lines[0].endswith("File name too long")

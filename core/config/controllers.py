@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from .fields import boolean, check_keys, load_yaml, mapping, number
+from .fields import boolean, check_keys, load_yaml, mapping, number, string_list
 from .substitutions import load_substituted_yaml
 
 __all__ = [
@@ -171,10 +171,8 @@ def _default_controllers(value: Any, path: Path) -> tuple[str, ...]:
     """Return the controllers moveit_simple_controller_manager lists with `default: true`."""
     where = f"{path}: moveit_simple_controller_manager"
     manager = mapping(value, where)
-    names = manager.get("controller_names") or []
-    if not isinstance(names, list):
-        raise ConfigError(f"{where}.controller_names: expected a list of names, got {str(names)[:60]}")
-    return tuple(str(name) for name in names if isinstance(manager.get(name), dict)
+    names = string_list(manager.get("controller_names"), f"{where}.controller_names", "controller names")
+    return tuple(name for name in names if isinstance(manager.get(name), dict)
                  and boolean(manager[name].get("default", False), f"{where}.{name}.default"))
 
 
@@ -214,7 +212,7 @@ def _joint_trajectory_controller(
     check_keys(params, _JTC_KEYS | _NODE_KEYS | scaled, where)
     check_keys(mapping(params.get("speed_scaling"), f"{where}.speed_scaling"), _SPEED_SCALING_KEYS,
                f"{where}.speed_scaling")
-    joints = tuple(params.get("joints") or ())
+    joints = tuple(string_list(params.get("joints"), f"{where}.joints", "joint names"))
     if not joints:
         raise ConfigError(f"{where}.joints: a JointTrajectoryController needs joints")
     constraints = mapping(params.get("constraints"), f"{where}.constraints")
@@ -225,13 +223,19 @@ def _joint_trajectory_controller(
         check_keys(entry, _JOINT_CONSTRAINT_KEYS, f"{where}.constraints.{joint}")
         trajectory[joint] = number(entry.get("trajectory", 0.0), f"{where}.constraints.{joint}.trajectory")
         goal[joint] = number(entry.get("goal", 0.0), f"{where}.constraints.{joint}.goal")
+    commands = _interfaces(params.get("command_interfaces"), _COMMAND_INTERFACES, f"{where}.command_interfaces")
+    states = _interfaces(params.get("state_interfaces"), _STATE_INTERFACES, f"{where}.state_interfaces")
+    if (commands == ("velocity",) or "effort" in commands) and "velocity" not in states:
+        # JTC's on_configure checks this, across the two lists its parameter validators see one at a time.
+        raise ConfigError(f"{where}.state_interfaces: {list(states)}: command_interfaces {list(commands)} need "
+                          "'position' and 'velocity' state interfaces (ros2_controllers' joint_trajectory_controller"
+                          ".cpp, on_configure)")
     return ControllerConfig(
         name=name,
         joints=joints,
         update_rate_hz=rate,
-        command_interfaces=_interfaces(params.get("command_interfaces"), _COMMAND_INTERFACES,
-                                       f"{where}.command_interfaces"),
-        state_interfaces=_interfaces(params.get("state_interfaces"), _STATE_INTERFACES, f"{where}.state_interfaces"),
+        command_interfaces=commands,
+        state_interfaces=states,
         goal_time_s=number(constraints.get("goal_time", 0.0), f"{where}.constraints.goal_time"),
         stopped_velocity_tolerance=number(
             constraints.get("stopped_velocity_tolerance", 0.01), f"{where}.constraints.stopped_velocity_tolerance"
@@ -245,14 +249,14 @@ def _joint_trajectory_controller(
 def _interfaces(value: Any, allowed: tuple[str, ...], where: str) -> tuple[str, ...]:
     """Return a JointTrajectoryController's command or state interfaces, checked as it checks them when configured.
 
-    ros2_controllers' joint_trajectory_controller_parameters.yaml declares both lists `unique` and
-    a subset of `allowed`; validate_jtc_parameters.hpp refuses the combinations below. A list left
-    out is position, moveplan's default.
+    ros2_controllers' joint_trajectory_controller_parameters.yaml declares both lists `unique`, not
+    empty and a subset of `allowed`; validate_jtc_parameters.hpp refuses the combinations below, as
+    of Jazzy (which added `[position, effort]`). A list left out is position, moveplan's default.
     """
-    if value is None or value == []:
+    if value is None:
         return ("position",)
-    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-        raise ConfigError(f"{where}: expected a list of interface names, got {str(value)[:60]}")
+    if not isinstance(value, list) or not value or not all(isinstance(v, str) for v in value):
+        raise ConfigError(f"{where}: expected a non-empty list of interface names, got {str(value)[:60]}")
     unknown = [v for v in value if v not in allowed]
     if unknown:
         raise ConfigError(f"{where}: {unknown[0][:40]!r} is not an interface a JointTrajectoryController uses; "
@@ -265,7 +269,8 @@ def _interfaces(value: Any, allowed: tuple[str, ...], where: str) -> tuple[str, 
                    and "position" not in has else
                    "'acceleration' needs 'velocity' or 'position'" if "acceleration" in has
                    and not has & {"velocity", "position"} else
-                   "'effort' is used alone" if "effort" in has and len(has) > 1 else "")
+                   "'effort' is used alone or with 'position'" if "effort" in has and has - {"effort", "position"}
+                   else "")
     else:
         # The controller reads the joints' positions: without them it has no state to follow from.
         problem = ("'position' is required" if "position" not in has else

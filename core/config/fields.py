@@ -352,5 +352,6 @@ def string_list(value: Any, where: str, what: str = "names") -> list[str]:
     if value is None:
         return []
     if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-        raise ConfigError(f"{where}: expected a list of {what}, got {value!r}")
+        shown = repr(value) if len(repr(value)) <= 80 else f"{repr(value)[:77]}..."
+        raise ConfigError(f"{where}: expected a list of {what}, got {shown}")
     return value

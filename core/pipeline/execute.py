@@ -227,8 +227,8 @@ def pick_controller(
 ) -> ControllerConfig:
     """Return the JointTrajectoryController that drives all of `joints`, chosen as MoveIt chooses.
 
-    MoveIt's TrajectoryExecutionManager takes the controller with the fewest joints and, of several,
-    the one moveit_controllers.yaml marks `default: true` (`preferred`). Several left that differ
+    MoveIt's TrajectoryExecutionManager ranks the controllers that fit by whether moveit_controllers.yaml
+    marks them `default: true` (`preferred`), then by fewest joints. Several left that differ
     (tolerances, gains, interfaces, rate) are an error: ros2_control activates only one of them,
     and which one the launch file spawns active is not in the files.
     """
@@ -236,11 +236,11 @@ def pick_controller(
     if not fitting:
         raise ConfigError(f"{source}: no JointTrajectoryController drives all of {', '.join(joints)}; "
                           f"controllers: {', '.join(controllers) or '(none)'}")
-    fewest = min(len(c.joints) for c in fitting)
-    candidates = [c for c in fitting if len(c.joints) == fewest]
-    defaults = [c for c in candidates if c.name in preferred]
-    candidates = defaults or candidates
-    if any(replace(c, name="") != replace(candidates[0], name="") for c in candidates[1:]):
+    best = min((c.name not in preferred, len(c.joints)) for c in fitting)
+    candidates = [c for c in fitting if (c.name not in preferred, len(c.joints)) == best]
+    # The same joints listed in another order drive the robot the same way.
+    settings = [replace(c, name="", joints=tuple(sorted(c.joints))) for c in candidates]
+    if any(other != settings[0] for other in settings[1:]):
         names = ", ".join(f"'{c.name}'" for c in candidates)
         raise ConfigError(f"{source}: controllers {names} all drive {', '.join(joints)} with different settings; "
                           "keep one, mark one `default: true` in moveit_controllers.yaml, or pass "
