@@ -138,3 +138,13 @@ def test_a_spoiled_task_plans_or_is_refused_in_one_line(cli: Cli, data: st.DataO
         path = Path(folder) / "task.yaml"
         path.write_text(yaml.safe_dump(data.draw(spoiled(task))))
         assert_clean(cli("plan", path, "--planning-time", "0.05", "-o", Path(folder) / "p.mcap", "-q"), {0, 2, 3, 4})
+
+
+@FUZZ
+@given(data=st.data(), scene=st.sampled_from(["ur10e_table_scene.yaml", "ur10e_workshop_scene.yaml"]))
+def test_a_spoiled_scene_loads_or_is_refused_in_one_line(cli: Cli, data: st.DataObject, scene: str) -> None:
+    document = yaml.safe_load((SAMPLES / scene).read_text())
+    with tempfile.TemporaryDirectory(prefix="moveplan-fuzz-") as folder:
+        path = Path(folder) / scene
+        path.write_text(yaml.safe_dump(data.draw(spoiled(document))))
+        assert_clean(cli("state", "--robot", UR10E, "--scene", path, "-q"), {0, 3})
