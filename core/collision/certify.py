@@ -14,16 +14,26 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from ..errors import ConfigError, InputError
 from ..model.robot import Robot
 from ..trajectory import peak_rates, sample, sampler, straight_states
 from ..types import JointTrajectory
 
 __all__ = [
-    "PIECE", "farthest_point", "is_prismatic", "path_states", "reach", "segment_states", "trajectory_states",
-    "uniform_states",
+    "MAX_REACH_M", "MAX_STATES", "PIECE", "farthest_point", "is_prismatic", "path_states", "reach", "segment_states",
+    "state_count", "trajectory_states", "uniform_states",
 ]
 
 PIECE = 4  # states at the peak speed per piece whose speed bound is taken from its ends
+
+MAX_REACH_M = 1_000.0
+"""Farthest [m] collision geometry may lie from a group joint's axis, prismatic travel below it included:
+a 50 m crane boom is far within; a kilometre is a description not in metres, whose every motion would
+take millions of checks."""
+
+MAX_STATES = 2_000_000
+"""States one certified motion may take: a robot point moving 10 km at 5 mm apart (a 50 m boom turning
+32 times), some 400 MB while they are checked."""
 
 
 def reach(robot: Robot, geometry: pin.GeometryModel) -> NDArray[np.float64]:
@@ -53,7 +63,26 @@ def reach(robot: Robot, geometry: pin.GeometryModel) -> NDArray[np.float64]:
     for name in robot.joint_names:
         jid = model.getJointId(name)
         out.append(1.0 if is_prismatic(model.joints[jid].shortname()) else below[jid])
+    worst = int(np.argmax(out))
+    if not out[worst] <= MAX_REACH_M:
+        raise ConfigError(f"{robot.config.urdf_path}: joint '{robot.joint_names[worst]}' carries collision geometry "
+                          f"up to {out[worst]:.6g} m from its axis (prismatic travel below it included); moveplan "
+                          f"plans for robots within {MAX_REACH_M:,.0f} m of each joint: are the lengths in metres?")
     return np.array(out)
+
+
+def state_count(motion_m: float, step_m: float) -> int:
+    """Return the states that certify a motion moving robot points `motion_m` [m], `step_m` apart; at least 1.
+
+    Raises:
+        InputError: More than MAX_STATES, before any is placed (a goal far beyond a turn, a huge robot).
+    """
+    count = motion_m / step_m
+    if not count <= MAX_STATES:  # NaN too
+        raise InputError(f"a motion moves robot points up to {motion_m:.6g} m: certifying it {step_m * 1000:g} mm "
+                         f"at a time takes {count:.6g} collision checks, more than moveplan's {MAX_STATES:,} "
+                         "(a goal many turns away, or joint limits far apart?)")
+    return max(1, int(np.ceil(count)))
 
 
 def is_prismatic(kind: str) -> bool:
@@ -76,8 +105,7 @@ def segment_states(
     a: NDArray[np.float64], b: NDArray[np.float64], reach_m: NDArray[np.float64], step_m: float
 ) -> NDArray[np.float64]:
     """Return states from `a` to `b` (both included) along the straight segment, at most `step_m` of motion apart."""
-    motion = float(np.abs(b - a) @ reach_m)
-    return straight_states(a, b, max(1, int(np.ceil(motion / step_m))))
+    return straight_states(a, b, state_count(float(np.abs(b - a) @ reach_m), step_m))
 
 
 def path_states(
@@ -90,6 +118,7 @@ def path_states(
     """
     if len(waypoints) < 2:
         return np.asarray(waypoints), np.zeros(len(waypoints))
+    state_count(float(np.abs(np.diff(waypoints, axis=0)).sum(axis=0) @ reach_m), step_m)  # all segments together
     states = np.concatenate([segment_states(a, b, reach_m, step_m)[:-1] for a, b in zip(waypoints[:-1], waypoints[1:],
                                                                                      strict=True)] + [waypoints[-1:]])
     travel = np.concatenate(([0.0], np.cumsum(np.abs(np.diff(states, axis=0)) @ reach_m)))
@@ -116,6 +145,7 @@ def trajectory_states(
     peak_v, peak_a = peak_rates(trajectory)
     at = sampler(trajectory)
     speed, duration = float(peak_v @ reach_m), float(knots[-1] - knots[0])  # [m/s], bounds every point's speed
+    state_count(speed * duration, step_m)
     pieces = max(1, int(np.ceil(speed * duration / (PIECE * step_m))))
     h = duration / pieces
     ends = np.linspace(knots[0], knots[-1], pieces + 1)
@@ -144,7 +174,7 @@ def uniform_states(
     if len(knots) == 1:
         return np.asarray(trajectory.positions)
     speed = float(peak_rates(trajectory)[0] @ reach_m)  # [m/s], bounds every point's speed
-    count = max(1, int(np.ceil(speed * (knots[-1] - knots[0]) / step_m)))
+    count = state_count(speed * float(knots[-1] - knots[0]), step_m)
     times = np.linspace(knots[0], knots[-1], count + 1)
     positions, _, _ = sample(trajectory, times, derivatives=0)
     return positions

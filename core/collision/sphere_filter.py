@@ -166,6 +166,7 @@ class SphereFilter:
         knots, p, v, a = (_plain(x) for x in (trajectory.times_s, trajectory.positions, trajectory.velocities,
                                               trajectory.accelerations))
         peak_v, peak_a = self._timing.quintic_peak_rates(knots, p, v, a)
+        certify.state_count(float(peak_v @ reach_m) * float(knots[-1] - knots[0]), step_m)  # before numba places them
         return self._states.trajectory_states(knots, p, v, a, peak_v, peak_a, _plain(reach_m), step_m, certify.PIECE)
 
     def edge(

@@ -13,7 +13,8 @@ from .fields import MAX_MAGNITUDE
 from .xacro import PackagePath
 
 __all__ = [
-    "JOINT_TYPES", "MAX_LINKS", "MOVABLE_JOINT_TYPES", "CollisionMesh", "UrdfJoint", "float_attr", "parse_urdf",
+    "JOINT_TYPES", "MAX_DEGREES_OF_FREEDOM", "MAX_LINKS", "MOVABLE_JOINT_TYPES", "CollisionMesh", "UrdfJoint",
+    "float_attr", "parse_urdf",
     "resolve_collision_meshes", "xml_root",
 ]
 
@@ -68,13 +69,24 @@ def float_attr(element: ET.Element, name: str, path: Path, default: float = math
 
 
 MAX_LINKS = 256
-"""Links a URDF may have: checking collisions costs memory per pair of links (a 400-link chain took
-7 GB, 1,000 links more than 24 GB); PR2 and TIAGo have fewer than 100."""
+"""Links a URDF may have: collision checks cost memory and time per pair of links; PR2 and TIAGo have
+fewer than 100."""
 
+MAX_DEGREES_OF_FREEDOM = 128
+"""Joint coordinates a URDF may have (revolute, continuous and prismatic joints 1, planar 3, floating 6):
+pinocchio's model data holds tables of their cube (32 bytes each), and a plan several of them: 67 MB
+each at 128, 560 MB at 255, 32 GB at 1,000. A humanoid with two hands has about 80."""
+
+_DEGREES_OF_FREEDOM = {"revolute": 1, "continuous": 1, "prismatic": 1, "planar": 3, "floating": 6}
 
 # Attributes holding numbers in a URDF's links and joints: poses, axes, shapes, mesh scales, inertia.
 _NUMERIC_ATTRIBUTES = frozenset({"xyz", "rpy", "size", "radius", "length", "scale", "value",
                                  "ixx", "ixy", "ixz", "iyy", "iyz", "izz"})
+# Joint numbers urdfdom refuses when not finite, in a message naming neither the joint nor the file (those
+# of <limit> and <mimic> are read in _joint). Not bounded: a large gain or friction is valid URDF.
+_FINITE_ATTRIBUTES = frozenset({"soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity", "damping",
+                                "friction", "rising", "falling"})
+_SHAPES = frozenset({"box", "cylinder", "sphere"})
 
 
 def parse_urdf(text: str, path: Path) -> dict[str, UrdfJoint]:
@@ -94,6 +106,10 @@ def parse_urdf(text: str, path: Path) -> dict[str, UrdfJoint]:
     if len(links) > MAX_LINKS:
         raise ConfigError(f"{path}: {len(links):,} links; moveplan loads robots of at most {MAX_LINKS} links")
     _names(root.findall("joint"), "joint", path)
+    freedom = sum(_DEGREES_OF_FREEDOM.get(joint.get("type", ""), 0) for joint in root.findall("joint"))
+    if freedom > MAX_DEGREES_OF_FREEDOM:
+        raise ConfigError(f"{path}: {freedom:,} degrees of freedom in its joints; moveplan loads robots of at most "
+                          f"{MAX_DEGREES_OF_FREEDOM}")
     for element in (*root.findall("link"), *root.findall("joint")):
         _check_numbers(element, path)
     joints = {joint.name: joint for joint in (_joint(element, links, path) for element in root.findall("joint"))}
@@ -151,25 +167,31 @@ def _joint(element: ET.Element, links: list[str], path: Path) -> UrdfJoint:
 
 
 def _check_numbers(element: ET.Element, path: Path) -> None:
-    """Raise ConfigError for a number in a link's or joint's poses, shapes or inertia that is not finite or too large.
+    """Raise ConfigError for a number of a link or joint that is not finite, too large, or a negative shape size.
 
-    urdfdom refuses NaN with a log on stderr and a message naming nothing; a huge origin
-    (1e300) loads and overflows the planner's geometry.
+    Poses, axes, shapes, mesh scales and inertia are bounded by MAX_MAGNITUDE. urdfdom refuses NaN
+    with a log on stderr and a message naming nothing; a huge origin (1e300) loads and overflows the
+    planner's geometry; a box or sphere of negative size loads and never collides.
     """
     owner = f"{element.tag} '{element.get('name', '')}'"
     for child in element.iter():
-        for attribute in _NUMERIC_ATTRIBUTES & child.attrib.keys():
+        for attribute in (_NUMERIC_ATTRIBUTES | _FINITE_ATTRIBUTES) & child.attrib.keys():
             text = child.attrib[attribute]
             for word in text.split():
                 try:
                     value = float(word)
                 except ValueError:
                     continue  # urdfdom's own message names a word that is no number
-                if not math.isfinite(value) or abs(value) > MAX_MAGNITUDE:
-                    shown = text if len(text) <= 60 else f"{text[:57]}..."
-                    problem = "is not a finite number" if not math.isfinite(value) else \
-                        f"is beyond moveplan's bound of {MAX_MAGNITUDE:g} (m, rad, kg)"
-                    raise ConfigError(f"{path}: {owner} <{child.tag} {attribute}='{shown}'>: {word[:40]!r} {problem}")
+                if not math.isfinite(value):
+                    problem = "is not a finite number"
+                elif abs(value) > MAX_MAGNITUDE and attribute in _NUMERIC_ATTRIBUTES:
+                    problem = f"is beyond moveplan's bound of {MAX_MAGNITUDE:g} (m, rad, kg)"
+                elif value < 0 and child.tag in _SHAPES:
+                    problem = "is negative; a shape's size is a length"
+                else:
+                    continue
+                shown = text if len(text) <= 60 else f"{text[:57]}..."
+                raise ConfigError(f"{path}: {owner} <{child.tag} {attribute}='{shown}'>: {word[:40]!r} {problem}")
 
 
 def _finite_attr(element: ET.Element, name: str, path: Path, where: str, default: float | None = None) -> float:
@@ -259,6 +281,8 @@ def resolve_collision_meshes(
     for link in root.findall("link"):
         for mesh in link.findall("collision/geometry/mesh"):
             uri = mesh.get("filename", "")
+            if not uri:
+                raise ConfigError(f"{urdf_path}: link '{link.get('name', '')}': collision <mesh> has no filename")
             where = f"{urdf_path}: link '{link.get('name', '')}': collision mesh {uri}"
             path, package = packages.resolve_uri(uri, urdf_path.parent, where)
             if not path.is_file():

@@ -3,8 +3,8 @@
 Packages are found as colcon finds them in a workspace's src/ folder: every folder holding a
 package.xml is a package, and its subfolders are its own (not searched further); hidden
 folders, build/, install/, log/ and folders marked COLCON_IGNORE, AMENT_IGNORE or
-CATKIN_IGNORE are skipped. The walk is bounded (MAX_DEPTH levels, MAX_FOLDERS folders) and
-done once per folder and process.
+CATKIN_IGNORE are skipped, and folders that cannot be read with a warning. The walk is bounded
+(MAX_DEPTH levels, MAX_FOLDERS folders) and done once per folder and process.
 """
 
 from __future__ import annotations
@@ -40,9 +40,9 @@ def package_name(folder: Path, warn: bool = False) -> str | None:
     refuses such a workspace, moveplan only skips the package.
     """
     manifest = folder / "package.xml"
-    if not manifest.is_file():
-        return None
     try:
+        if not manifest.is_file():
+            return None
         name = (ET.parse(manifest).getroot().findtext("name") or "").strip()
     except (ET.ParseError, OSError) as exc:
         problem = f"cannot be read ({exc})"
@@ -116,14 +116,22 @@ def _walk(folder: Path, depth: int, budget: list[int]) -> list[Path]:
     budget[0] -= 1
     try:
         children = sorted(p for p in folder.iterdir() if p.is_dir() and not p.name.startswith("."))
-    except OSError:
+    except OSError as exc:
+        # Another user's folder in a shared workspace must not stop a run that needs none of its packages.
+        _log.warning("%s: cannot be read (%s); packages in it are not looked at", folder, exc.strerror or exc)
         return []
     packages: list[Path] = []
     for child in children:
-        if child.name in _SKIPPED or any((child / marker).exists() for marker in _IGNORE_MARKERS):
+        if child.name in _SKIPPED:
             continue
-        if (child / "package.xml").is_file():
+        try:
+            ignored = any((child / marker).exists() for marker in _IGNORE_MARKERS)
+            package = not ignored and (child / "package.xml").is_file()
+        except OSError as exc:  # a folder that may be listed but not entered
+            _log.warning("%s: cannot be read (%s); packages in it are not looked at", child, exc.strerror or exc)
+            continue
+        if package:
             packages.append(child)  # a package: its subfolders are its own, not other packages
-        else:
+        elif not ignored:
             packages.extend(_walk(child, depth - 1, budget))
     return packages

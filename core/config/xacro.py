@@ -234,7 +234,13 @@ def process_xacro(path: Path, args: Mapping[str, str], packages: PackagePath, sh
             raise ConfigError(f"{where}: xacro: {cause}") from None
         if isinstance(exc, xml.parsers.expat.ExpatError):
             raise ConfigError(f"{where}: malformed XML: {exc}") from None
+        if isinstance(cause, UnicodeDecodeError):
+            raise ConfigError(f"{where}: cannot read: not UTF-8 text ({cause.reason} at byte {cause.start})") from None
+        if isinstance(cause, OSError) and cause.filename:  # an include or xacro.load_yaml file; xacro says it twice
+            raise ConfigError(f"{where}: cannot read {cause.filename}: {cause.strerror or cause}") from None
         message = "; ".join(line.strip() for line in str(exc).splitlines() if line.strip())
+        if isinstance(cause, OverflowError):  # its text is errno's: (34, 'Numerical result out of range')
+            message = message.replace(str(cause), "a number beyond a float's range", 1)
         if isinstance(cause, RecursionError) or "maximum recursion depth" in message:
             message = "a macro expands itself without end"
         elif len(message) > 300:

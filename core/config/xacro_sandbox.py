@@ -84,6 +84,8 @@ class _Budget:
             status = os.stat(filename)
         except OSError:
             return  # xacro reports a missing file itself
+        if stat.S_ISDIR(status.st_mode):
+            raise Refused(f"{filename} is a folder, not a file")
         if not stat.S_ISREG(status.st_mode):
             raise Refused(f"{filename} is not a regular file (a device, FIFO or socket)")
         size = status.st_size

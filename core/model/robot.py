@@ -33,17 +33,19 @@ class Robot:
         self.config = config
         self.group: Group = config.group(group)
         config.srdf.plannable(self.group.name, config.srdf_path)  # a floating or planar base: refused
+        error: Exception | None = None
         with _stderr_of_c_code() as log:
             try:
                 self.model = pin.buildModelFromXML(config.urdf)
             except (RuntimeError, ValueError) as exc:
                 error = exc
-            else:
-                error = None
+        # urdfdom says what is wrong only in its log (the exception names nothing), and logs an element it
+        # drops (a collision shape it cannot read) yet loads the rest: a robot missing a shape.
+        errors = list(dict.fromkeys(line.removeprefix("Error:").strip() for line in log if line.startswith("Error:")))
         if error is not None:
-            # urdfdom says what is wrong only in its log: its first line, not the generic exception, names it.
-            first = next((line.removeprefix("Error:").strip() for line in log if line.startswith("Error:")), "")
-            raise ConfigError(f"{config.urdf_path}: pinocchio cannot load the URDF: {first or error}")
+            raise ConfigError(f"{config.urdf_path}: pinocchio cannot load the URDF: {_joined(errors) or error}")
+        if errors:
+            raise ConfigError(f"{config.urdf_path}: urdfdom cannot read part of the URDF: {_joined(errors)}")
         self.data = self.model.createData()
         self.joint_names: tuple[str, ...] = self.group.joints
         if not self.joint_names:
@@ -173,6 +175,12 @@ def _readonly(values: list[float]) -> NDArray[np.float64]:
     array = np.array(values, dtype=float)
     array.setflags(write=False)
     return array
+
+
+def _joined(errors: list[str]) -> str:
+    """Return urdfdom's first error messages on one line: the first says what, the next which link or joint."""
+    text = "; ".join(errors[:2])
+    return text if len(text) <= 400 else f"{text[:397]}..."
 
 
 @contextlib.contextmanager
