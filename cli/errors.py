@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import re
 import signal
 import sys
 import traceback
@@ -207,7 +208,12 @@ def _internal(exc: BaseException) -> str:
             f"[{detail.filename.rsplit('/', 1)[-1]}:{detail.lineno}]")
 
 
+# Control characters a hostile file put into a name would reach the terminal: shown escaped, as repr shows them.
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
+
+
 def _report(code: int, message: str, as_json: bool, *, kind: str, **document: Any) -> None:
+    message = _CONTROL.sub(lambda found: repr(found.group())[1:-1], message)
     if as_json:
         print(json.dumps({"ok": False, **document, "error": {"exit_code": code, "kind": kind, "message": message}}))
     else:

@@ -109,3 +109,11 @@ def test_a_name_too_long_for_the_system_is_bad_input_naming_it_shortened(cli: Cl
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "internal error" not in lines[0] and len(lines[0]) < 400, result.stderr
     assert lines[0].endswith("File name too long")
+
+
+def test_control_characters_from_a_file_reach_the_terminal_escaped(cli: Cli, tmp_path: Path) -> None:
+    task = tmp_path / "task.yaml"
+    task.write_text('"\\x1b[31mred\\x07": 1\nsteps: []\n')  # an escape sequence and a bell as a key
+    result = cli("plan", task, "-o", tmp_path / "out")
+    assert result.exit_code == 3
+    assert r"unknown key '\x1b[31mred\x07'" in result.stderr and "\x1b" not in result.stderr
