@@ -117,3 +117,39 @@ def test_control_characters_from_a_file_reach_the_terminal_escaped(cli: Cli, tmp
     result = cli("plan", task, "-o", tmp_path / "out")
     assert result.exit_code == 3
     assert r"unknown key '\x1b[31mred\x07'" in result.stderr and "\x1b" not in result.stderr
+
+
+def test_a_scene_coordinate_beyond_the_bound_is_refused_naming_it(cli: Cli, tmp_path: Path) -> None:
+    """A box at 1e18 m broke coal's bounding volumes (an internal error); 1e300 was called a collision."""
+    scene = tmp_path / "scene.yaml"
+    scene.write_text("objects:\n  - {name: box, frame: base_link, xyz: [0.6, 1.0e18, 0.2], box: [0.1, 0.1, 0.1]}\n")
+    result = cli("plan", "--robot", UR10E, "--scene", scene, "--named", "home", "-o", tmp_path / "out")
+    assert result.exit_code == 3
+    assert "scene.yaml: objects[0].xyz[1]: 1e+18 is out of range; values are limited to |value| <= 1,000,000" \
+        in result.stderr
+
+
+@pytest.mark.parametrize("group", ["{manipulator: 1}", "[manipulator]"])
+def test_a_planning_group_that_is_no_name_is_refused(cli: Cli, tmp_path: Path, group: str) -> None:
+    config = tmp_path / "ur10e"
+    shutil.copytree(UR10E, config)
+    manifest = config / "moveplan.yaml"
+    manifest.write_text(manifest.read_text().replace("group: manipulator", f"group: {group}"))
+    result = cli("robot", config)
+    assert result.exit_code == 3
+    assert "moveplan.yaml: planning.group: expected a name, got" in result.stderr
+
+
+def test_a_huge_goal_duration_margin_is_refused_before_memory_is_spent(cli: Cli, tmp_path: Path) -> None:
+    """MoveIt's duration monitor waits the margin out: 1e12 s asked for terabytes of control cycles."""
+    controllers = tmp_path / "moveit_controllers.yaml"
+    controllers.write_text("trajectory_execution: {allowed_goal_duration_margin: 1.0e12}\n")
+    config = tmp_path / "ur10e"
+    shutil.copytree(UR10E, config)
+    shutil.copy(controllers, config / "moveit_controllers.yaml")
+    plan = tmp_path / "plan.mcap"
+    assert cli("plan", "--robot", config, "--start-joints", "0,-1,-1,0,0,0", "--named", "home", "-o", plan,
+               "-q").exit_code == 0
+    result = cli("execute", plan, "--fake", "-o", tmp_path / "e.mcap")
+    assert result.exit_code == 3
+    assert "control cycles; moveplan simulates at most 1,000,000 per trajectory" in result.stderr

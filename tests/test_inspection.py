@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from moveplan.core.bag import PlanFile, PlanStepRecord
@@ -15,7 +17,7 @@ def test_peak_rates_are_fractions_of_each_joints_limit_and_the_largest_joint_cou
                                  np.array([[1.0, 0.0], [1.0, 0.0]]), np.zeros((2, 2)))
     limits = {"a": {"max_velocity": 4.0, "max_acceleration": 2.0}, "b": {"max_velocity": 0.1, "max_acceleration": 0.1}}
     plan = PlanFile("r", "g", "base", "jazzy", (PlanStepRecord("go", 2.5, trajectory),), {}, {}, limits)
-    (peaks,) = step_peaks(plan)
+    (peaks,) = step_peaks(plan, Path("plan.mcap"))
     assert peaks == StepPeaks("go", 2.5, 1.0, 2, peaks.peak_velocity_fraction, peaks.peak_acceleration_fraction)
     np.testing.assert_allclose(peaks.peak_velocity_fraction, 0.25, atol=1e-12)
     np.testing.assert_allclose(peaks.peak_acceleration_fraction, 0.0, atol=1e-12)

@@ -26,6 +26,10 @@ def planning_defaults(
     """
     planning = mapping(top.get("planning"), f"{manifest}: planning")
     check_keys(planning, _PLANNING_KEYS, f"{manifest}: planning")
+    for key in ("group", "planner", "collision"):
+        if key in planning and not isinstance(planning[key], str):
+            shown = repr(planning[key]) if len(repr(planning[key])) <= 60 else f"{repr(planning[key])[:57]}..."
+            raise ConfigError(f"{manifest}: planning.{key}: expected a name, got {shown}")
     source = manifest if manifest is not None and "group" in planning else srdf_path
     if ompl is not None:
         group, planner = _ompl_defaults(ompl, srdf)

@@ -174,12 +174,14 @@ def simulate(
 
     dt = 1.0 / controller.update_rate_hz
     timeout = _timeout(trajectory.duration_s, controller, execution)
-    grid = _time_grid(trajectory.duration_s, controller.goal_time_s, timeout, dt)
-    limit = max_control_cycles()
-    if len(grid) > limit:
-        raise InputError(f"a {trajectory.duration_s:.6g} s trajectory at {controller.update_rate_hz:g} Hz is "
-                         f"{len(grid):,} control cycles; moveplan simulates at most {limit:,} per trajectory "
-                         f"({MAX_CYCLES_ENV} raises the limit; memory grows ~1 kB a cycle)")
+    horizon_s = _horizon_s(trajectory.duration_s, controller.goal_time_s, timeout)
+    cycles, limit = horizon_s / dt, max_control_cycles()
+    if not cycles <= limit:  # counted before the grid is built: a margin of 1e12 s would ask for terabytes
+        raise InputError(f"a {trajectory.duration_s:.6g} s trajectory watched for up to {horizon_s:.6g} s (goal time, "
+                         f"MoveIt's duration monitor) at {controller.update_rate_hz:g} Hz is {cycles:,.0f} control "
+                         f"cycles; moveplan simulates at most {limit:,} per trajectory ({MAX_CYCLES_ENV} raises the "
+                         "limit; memory grows ~1 kB a cycle)")
+    grid = _time_grid(horizon_s, dt)
     bumps = _bumps(disturbances, joints, grid[:-1], dt)
     p0, v0 = plant.reset(start, seed)
     if np.any(bumps[0]):
@@ -324,13 +326,13 @@ def max_control_cycles() -> int:
     return int(text)
 
 
-def _time_grid(
-    duration_s: float, goal_time_s: float, timeout: Timeout, dt: float
-) -> NDArray[np.float64]:
-    """Return cycle times [s] through the last cycle that can decide, plus one for its command."""
-    horizon_s = timeout.time_s
-    if goal_time_s > 0.0:
-        horizon_s = min(horizon_s, duration_s + goal_time_s)
+def _horizon_s(duration_s: float, goal_time_s: float, timeout: Timeout) -> float:
+    """Return the last time [s] at which a cycle can decide the execution's verdict."""
+    return min(timeout.time_s, duration_s + goal_time_s) if goal_time_s > 0.0 else timeout.time_s
+
+
+def _time_grid(horizon_s: float, dt: float) -> NDArray[np.float64]:
+    """Return cycle times [s] through the last cycle that can decide (at `horizon_s`), plus one for its command."""
     # Two cycles past the deciding time, so rounding never cuts the cycle that decides.
     return np.asarray(np.arange(math.floor(horizon_s / dt) + 3) * dt, dtype=np.float64)
 

@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
-from ..config.fields import number
+from ..config.fields import MAX_MAGNITUDE, number
 from ..errors import ConfigError
 
 __all__ = ["pose_matrix", "vector"]
@@ -33,7 +33,9 @@ def pose_matrix(xyz: Any, rpy: Any, quat: Any, where: str) -> NDArray[np.float64
 
 
 def vector(value: Any, size: int, where: str) -> NDArray[np.float64]:
-    """Return a list of `size` numbers from a YAML file as an array; `where` names it in errors."""
+    """Return a list of `size` numbers from a YAML file, each within MAX_MAGNITUDE, as an array; `where` names it."""
     if not isinstance(value, list | tuple) or len(value) != size:
-        raise ConfigError(f"{where}: expected a list of {size} numbers, got {value!r}")
-    return np.array([number(v, f"{where}[{i}]") for i, v in enumerate(value)])
+        shown = repr(value) if len(repr(value)) <= 80 else f"{repr(value)[:77]}..."
+        raise ConfigError(f"{where}: expected a list of {size} numbers, got {shown}")
+    # A coordinate of 1e18 m breaks the collision library's bounding volumes: a thousand kilometres is plenty.
+    return np.array([number(v, f"{where}[{i}]", bound=MAX_MAGNITUDE) for i, v in enumerate(value)])

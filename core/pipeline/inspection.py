@@ -72,7 +72,7 @@ def inspect_file(path: Path, skip_damaged: bool = False) -> Inspection:
     if "moveplan" not in summary.metadata or not path.is_file():
         return Inspection(path, summary, None)
     plan = read_valid_plan(path)
-    return Inspection(path, summary, plan, step_peaks(plan), end_states(plan, path))
+    return Inspection(path, summary, plan, step_peaks(plan, path), end_states(plan, path))
 
 
 def end_states(plan: PlanFile, path: Path) -> tuple[RobotState, ...]:
@@ -112,14 +112,18 @@ def end_states(plan: PlanFile, path: Path) -> tuple[RobotState, ...]:
     return tuple(states)
 
 
-def step_peaks(plan: PlanFile) -> tuple[StepPeaks, ...]:
+def step_peaks(plan: PlanFile, path: Path) -> tuple[StepPeaks, ...]:
     """Return each step's duration and peak velocity and acceleration as fractions of the plan's limits."""
     steps = []
     for step in plan.steps:
         peak_v, peak_a = peak_rates(step.trajectory)
         names = step.trajectory.joint_names
-        v_limit = np.array([plan.limits[j]["max_velocity"] for j in names])
-        a_limit = np.array([plan.limits[j]["max_acceleration"] for j in names])
+        unknown = next((j for j in names if j not in plan.limits), None)
+        if unknown is not None:
+            raise InputError(f"{path}: step '{step.name}' moves joint '{unknown}', which the plan's "
+                             "limits do not name")
+        v_limit = np.array([plan.limits[j].get("max_velocity", np.nan) for j in names])
+        a_limit = np.array([plan.limits[j].get("max_acceleration", np.nan) for j in names])
         steps.append(StepPeaks(
             name=step.name, start_s=step.start_s, duration_s=step.trajectory.duration_s,
             points=len(step.trajectory.times_s),
