@@ -163,7 +163,7 @@ def db3_info(connection: sqlite3.Connection, path: Path) -> Db3Info:
         row = connection.execute("SELECT schema_version, ros_distro FROM schema "
                                  "ORDER BY schema_version DESC LIMIT 1").fetchone()
         if row is not None:
-            version, distro = int(row[0]), str(row[1])
+            version, distro = _integer(row[0], "the schema table's schema_version"), str(row[1])
     definitions: dict[str, tuple[str, bytes]] = {}
     if "message_definitions" in tables:
         for topic_type, encoding, text in connection.execute(
@@ -175,9 +175,22 @@ def db3_info(connection: sqlite3.Connection, path: Path) -> Db3Info:
     for topic_id, name, kind, encoding, offered in connection.execute(
             f"SELECT id, name, type, serialization_format, {qos} FROM topics ORDER BY id"):
         definition_encoding, definition = definitions.get(str(kind), ("", b""))
-        topics.append(Db3Topic(int(topic_id), str(name), str(kind), str(encoding), str(offered),
-                               definition_encoding, definition))
+        topics.append(Db3Topic(_integer(topic_id, f"the id of topic {_shown(name)}"), str(name), str(kind),
+                               str(encoding), str(offered), definition_encoding, definition))
     return Db3Info(version, distro, tuple(topics))
+
+
+def _integer(value: object, what: str) -> int:
+    """Return `value`, a column rosbag2 declares INTEGER, as an int.
+
+    Raises:
+        CorruptData: It holds something else (SQLite stores any value in any column of a table
+            declared without types, as a damaged or hand-made bag may be).
+
+    """
+    if isinstance(value, int) and not isinstance(value, bool):
+        return value
+    raise CorruptData(f"{what} is {_shown(value)}, not an integer (rosbag2 writes one)")
 
 
 def _bytes(value: object) -> bytes:
@@ -240,7 +253,7 @@ def db3_messages(
               "count(*), {} FROM messages WHERE id BETWEEN ? AND ? AND topic_id IN ({})")
     with_times = select.format("group_concat(timestamp, ',')", wanted)
     without_times = select.format("''", wanted)
-    begin, last = int(first), int(last)
+    begin, last = _integer(first, "the smallest message row id"), _integer(last, "the largest message row id")
     while begin <= last:
         end = min(begin + _BATCH_IDS - 1, last)  # inclusive: ids may reach SQLite's largest integer
         data, shortest, longest, count, times = connection.execute(

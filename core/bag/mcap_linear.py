@@ -189,7 +189,8 @@ class Definitions:
                 raise damage
             self.stream.seek(record.position)
             raw = self.stream.read(RECORD_HEAD + record.length)
-            (size,) = struct.unpack_from("<Q", raw, RECORD_HEAD + 16)
+            # The size a chunk declares, to size the buffer (chunk_records refuses a chunk too short to hold it).
+            size = struct.unpack_from("<Q", raw, RECORD_HEAD + 16)[0] if len(raw) >= RECORD_HEAD + 24 else 0
             if reuse and len(self.out) < size <= self.codecs.limit:
                 self.out = bytearray(size)
             return chunk_records(memoryview(raw), record.position, self.codecs, self.out if reuse else None)

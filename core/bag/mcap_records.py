@@ -23,6 +23,7 @@ __all__ = [
     "ATTACHMENT",
     "CHANNEL",
     "CHUNK",
+    "CHUNK_FIXED",
     "DATA_AT",
     "FOOTER",
     "HEADER",
@@ -53,6 +54,9 @@ MAGIC = b"\x89MCAP0\r\n"
 HEADER, FOOTER, SCHEMA, CHANNEL, MESSAGE, CHUNK, MESSAGE_INDEX, CHUNK_INDEX = 1, 2, 3, 4, 5, 6, 7, 8
 ATTACHMENT, STATISTICS, METADATA = 9, 11, 12
 RECORD_HEAD = 9  # opcode u8 + length u64
+# A Chunk record's content before its records: start and end times, uncompressed size u64, CRC u32,
+# compression (a string: u32 length, here empty) and the records' length u64.
+CHUNK_FIXED = 8 + 8 + 8 + 4 + 4 + 8
 FOOTER_SIZE = RECORD_HEAD + 20 + len(MAGIC)
 # A Message record: head, channel_id u16, sequence u32, log_time u64, publish_time u64, data.
 MESSAGE_FIXED = 22
@@ -222,15 +226,20 @@ def chunk_records(
         CorruptData: There is no chunk at all where `raw` begins.
 
     """
-    opcode, _ = struct.unpack_from("<BQ", raw)
-    if opcode != CHUNK:
+    if len(raw) < RECORD_HEAD or raw[0] != CHUNK:
         raise CorruptData(f"no chunk at byte {chunk_at}, where the chunk index points")
+    if len(raw) < RECORD_HEAD + CHUNK_FIXED:
+        raise Damage("chunk", chunk_at, f"holds {len(raw) - RECORD_HEAD} bytes, fewer than the {CHUNK_FIXED} of a "
+                                        "chunk's header")
     uncompressed_size, uncompressed_crc = struct.unpack_from("<QI", raw, RECORD_HEAD + 16)
     damage = codecs.too_large(chunk_at, uncompressed_size)
     if damage is not None:
         raise damage
-    compression, offset = _string(raw, RECORD_HEAD + 28)
-    (length,) = struct.unpack_from("<Q", raw, offset)
+    try:
+        compression, offset = _string(raw, RECORD_HEAD + 28)
+        (length,) = struct.unpack_from("<Q", raw, offset)
+    except (CorruptData, struct.error, UnicodeDecodeError):
+        raise Damage("chunk", chunk_at, "has a malformed header: its compression name runs past it") from None
     records = raw[offset + 8 : offset + 8 + length]
     if len(records) != length:
         raise Damage("chunk", chunk_at, f"holds {len(records)} bytes of records where it declares {length}")

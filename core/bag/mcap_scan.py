@@ -26,11 +26,12 @@ from mcap.stream_reader import MAGIC_SIZE, StreamReader
 from ..errors import InputError
 from .bag_files import check_regular
 
-__all__ = ["DAMAGE", "Contents", "Kept", "open_mcap", "scan"]
+__all__ = ["DAMAGE", "ClampedReads", "Contents", "Kept", "open_mcap", "scan"]
 
 _MAGIC = b"\x89MCAP0\r\n"
-DAMAGE = (McapError, EOFError, ValueError, struct.error, RuntimeError, zstandard.ZstdError)
-"""What mcap and the decompressors raise on a damaged file (lz4 raises RuntimeError)."""
+DAMAGE = (McapError, EOFError, ValueError, struct.error, RuntimeError, zstandard.ZstdError, OverflowError)
+"""What mcap and the decompressors raise on a damaged file (lz4 raises RuntimeError; a record inside a
+chunk whose length is 2**63 or more, read from the chunk's bytes, raises OverflowError)."""
 
 Kept = tuple[Channel, Schema | None, Message]
 """A kept message with its channel and the channel's schema (None if it has none)."""
@@ -121,10 +122,39 @@ def scan(path: Path, stream: IO[bytes], keep_topics: Collection[str]) -> Content
     )
 
 
+class ClampedReads:
+    """A file as the mcap package reads it: no read asks for more bytes than the file has left.
+
+    mcap reads a record's content, strings and padding with stream.read(length), the length as
+    the file states it; a BufferedReader allocates `length` bytes before it reads (4 GiB for a
+    damaged u32 or record length, an OverflowError for a u64). Clamped to what is left, a read
+    returns the same bytes and a damaged length costs nothing.
+    """
+
+    def __init__(self, stream: IO[bytes], size: int) -> None:
+        self._stream, self._size = stream, size
+
+    def read(self, length: int | None = -1) -> bytes:
+        """Return up to `length` bytes (all that is left if negative), never asking for more than is left."""
+        left = max(self._size - self._stream.tell(), 0)
+        return self._stream.read(left if length is None or length < 0 else min(length, left))
+
+    def seek(self, offset: int, whence: int = os.SEEK_SET) -> int:
+        """Move to `offset` as the file's seek does."""
+        return self._stream.seek(offset, whence)
+
+    def tell(self) -> int:
+        """Return the position in the file."""
+        return self._stream.tell()
+
+
 def _records(path: Path, stream: IO[bytes]) -> Iterator[McapRecord]:
     """Yield every record of an MCAP file in file order, chunks opened and CRCs checked."""
+    size = stream.seek(0, os.SEEK_END)
     stream.seek(0)
-    records = StreamReader(stream, validate_crcs=True).records
+    # No record is longer than the file: a length beyond it is damage, never a read of that size.
+    records = StreamReader(ClampedReads(stream, size), validate_crcs=True,  # type: ignore[arg-type]
+                           record_size_limit=size).records
     while True:
         try:
             record = next(records)
@@ -136,6 +166,8 @@ def _records(path: Path, stream: IO[bytes]) -> Iterator[McapRecord]:
                 return
             if cut is not None:
                 message = f"file is truncated (the record at byte {cut} runs past its end)"
+            elif isinstance(exc, OverflowError):
+                message = "corrupt MCAP data: a record declares a length of 2**63 bytes or more"
             else:
                 message = f"corrupt MCAP data: {type(exc).__name__}: {exc}".removesuffix(": ")
             raise InputError(f"{path}: {message}") from exc

@@ -259,12 +259,20 @@ def quaternions_xyzw(transforms: NDArray[np.float64]) -> NDArray[np.float64]:
 def trajectory_from_message(message: Any) -> JointTrajectory:
     """Return a decoded trajectory_msgs/JointTrajectory (any object with its fields) as a value.
 
-    Raises ValueError if the points do not make a valid JointTrajectory.
+    Raises ValueError if the points do not make a valid JointTrajectory, or a joint name is empty,
+    given twice or holds a control character (what no planner writes, and a damaged message
+    decodes to). NaN and infinite values are left to the plan's checks, which name joint and point.
     """
     points = message.points
     times_ns = [p.time_from_start.sec * 1_000_000_000 + p.time_from_start.nanosec for p in points]
+    names = tuple(message.joint_names)
+    for name in names:
+        if not name or any(ord(c) < 0x20 or ord(c) == 0x7F for c in name):
+            raise ValueError(f"joint name {name[:40]!r} is empty or holds a control character")
+    if len(set(names)) < len(names):
+        raise ValueError(f"joint {next(n for i, n in enumerate(names) if n in names[:i])!r} is named twice")
     return JointTrajectory(
-        joint_names=tuple(message.joint_names),
+        joint_names=names,
         times_s=np.array(times_ns, dtype=np.float64) / 1e9,
         positions=np.array([list(p.positions) for p in points], dtype=np.float64),
         velocities=np.array([list(p.velocities) for p in points], dtype=np.float64),

@@ -8,10 +8,17 @@ names, limits, distro) and the robot's config files as attachments.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
+import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
+from mcap.records import Channel, Schema
+from mcap_ros2._vendor.rosidl_adapter.parser import InvalidSpecification, InvalidValue
 from mcap_ros2.decoder import DecoderFactory
 
 from ..errors import InputError
@@ -56,7 +63,10 @@ END_STATES_KEY = "end_states"
 """The "moveplan" metadata key under which a plan records where each step ends: a JSON list, one
 {"joints", "pose"} per step (RobotState.as_dict), read by `inspect` without loading the robot."""
 
-_UNREADABLE = (*DAMAGE, TypeError, IndexError, AttributeError)
+_UNREADABLE = (*DAMAGE, TypeError, IndexError, AttributeError, KeyError, RecursionError)
+# What parsing a ros2msg schema raises on text that is no valid definition (mcap_ros2's vendored
+# rosidl parser), besides _UNREADABLE's (McapError, ValueError: UnicodeDecodeError among them).
+_BAD_SCHEMA = (*_UNREADABLE, InvalidSpecification, InvalidValue)
 
 
 @dataclass(frozen=True)
@@ -103,10 +113,7 @@ def read_plan(path: Path) -> PlanFile:
         raise InputError(f"{path}: not a moveplan plan file (no complete 'moveplan' metadata)")
     try:
         step_names = [str(name) for name in json.loads(info["step_names"])]
-        limits = {
-            joint: {key: float(value) for key, value in joint_limits.items()}
-            for joint, joint_limits in json.loads(info["limits"]).items()
-        }
+        limits = _limits(json.loads(info["limits"]))
     except (ValueError, TypeError, AttributeError) as exc:
         raise InputError(f"{path}: 'moveplan' metadata is malformed: {exc}") from exc
     factory = DecoderFactory()
@@ -122,6 +129,38 @@ def read_plan(path: Path) -> PlanFile:
         limits=limits,
         urdf=_robot_description(path, factory, descriptions),
     )
+
+
+def _limits(parsed: object) -> dict[str, dict[str, float]]:
+    """Return the "limits" metadata value `parsed` (JSON) as floats, checked as plan_writer writes them.
+
+    Raises:
+        ValueError: It is no object of joints, each an object of numbers; or a joint's lower
+            limit is above its upper one, or its max_velocity or max_acceleration is missing or
+            not a positive finite number.
+
+    """
+    if not isinstance(parsed, dict):
+        raise ValueError(f"limits: expected an object of joints, got {type(parsed).__name__}")
+    limits = {}
+    for joint, given in parsed.items():
+        if not isinstance(given, dict):
+            raise ValueError(f"limits of joint {joint}: expected an object, got {type(given).__name__}")
+        values = {}
+        for key, value in given.items():
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ValueError(f"limits of joint {joint}: {key} is {str(value)[:40]!r}, not a number")
+            values[str(key)] = float(value)
+        lower, upper = values.get("lower", -math.inf), values.get("upper", math.inf)
+        if not lower <= upper:  # NaN fails too
+            raise ValueError(f"limits of joint {joint}: lower {lower} is not at most upper {upper}")
+        for key in ("max_velocity", "max_acceleration"):  # what a plan's limits are for (core.types.Plan)
+            if key not in values:
+                raise ValueError(f"limits of joint {joint}: no {key}")
+            if not 0.0 < values[key] < math.inf:
+                raise ValueError(f"limits of joint {joint}: {key} {values[key]} is not a positive finite number")
+        limits[str(joint)] = values
+    return limits
 
 
 def plan_urdf(plan: PlanFile) -> str:
@@ -149,12 +188,7 @@ def _steps(
         )
     steps = []
     for name, (channel, schema, message) in zip(step_names, kept, strict=True):
-        decode = factory.decoder_for(channel.message_encoding, schema)
-        if decode is None or schema is None or schema.name != PLAN_TOPICS[TRAJECTORY][0]:
-            raise InputError(
-                f"{path}: {TRAJECTORY} must hold CDR trajectory_msgs/msg/JointTrajectory "
-                "messages with a ros2msg schema"
-            )
+        decode = _decoder(path, factory, channel, schema, TRAJECTORY)
         try:
             trajectory = trajectory_from_message(decode(message.data))
         except _UNREADABLE as exc:
@@ -173,10 +207,36 @@ def _robot_description(path: Path, factory: DecoderFactory, kept: list[Kept]) ->
     if not kept:
         return ""
     channel, schema, message = kept[0]
-    decode = factory.decoder_for(channel.message_encoding, schema)
-    if decode is None or schema is None or schema.name != STRING:
-        raise InputError(f"{path}: {ROBOT_DESCRIPTION} must hold a CDR {STRING} with a ros2msg schema")
+    decode = _decoder(path, factory, channel, schema, ROBOT_DESCRIPTION)
     try:
         return str(decode(message.data).data)
     except _UNREADABLE as exc:
         raise InputError(f"{path}: {ROBOT_DESCRIPTION} is unreadable: {exc}") from exc
+
+
+def _decoder(
+    path: Path, factory: DecoderFactory, channel: Channel, schema: Schema | None, topic: str
+) -> Callable[[bytes], Any]:
+    """Return the decoder of `topic`'s messages: CDR with a ros2msg schema of the type a plan file gives it.
+
+    The schema's name is checked before its text is parsed: a plan's own topics need no other type.
+
+    Raises:
+        InputError: The channel is not CDR, the schema missing, of another type or encoding, or
+            its text no valid ros2msg definition.
+
+    """
+    kind = PLAN_TOPICS[topic][0]
+    problem = f"{path}: {topic} must hold CDR {kind} messages with a ros2msg schema"
+    if schema is None or schema.name != kind:
+        raise InputError(problem)
+    try:
+        # The vendored rosidl parser prints the line it fails on to stderr: the error says it once.
+        with contextlib.redirect_stderr(io.StringIO()):
+            decode = factory.decoder_for(channel.message_encoding, schema)
+    except _BAD_SCHEMA as exc:
+        raise InputError(f"{path}: the schema of {topic} ({kind}) is no valid ros2msg definition: "
+                         f"{type(exc).__name__}: {exc}") from None
+    if decode is None:
+        raise InputError(problem)
+    return decode

@@ -21,7 +21,7 @@ from .bag_files import bag_files
 from .chunk_codecs import Skips
 from .db3 import check_pages, db3_info, open_db3, topic_counts
 from .mcap_linear import survey
-from .mcap_scan import DAMAGE, open_mcap
+from .mcap_scan import DAMAGE, ClampedReads, open_mcap
 from .mcap_verify import verify_mcap
 from .qos import durability
 
@@ -137,9 +137,11 @@ def _summary_from_index(stream: IO[bytes], lost: dict[int, int]) -> BagSummary |
 
     `lost` counts per channel id the messages of chunks skipped as damaged: not counted.
     """
+    size = stream.seek(0, 2)
     stream.seek(0)
     try:
-        reader = SeekingReader(stream)
+        # Reads clamped to the file: a damaged record length is never a read (an allocation) of that size.
+        reader = SeekingReader(ClampedReads(stream, size), record_size_limit=size)  # type: ignore[arg-type]
         header = reader.get_header()
         summary = reader.get_summary()
     except (*DAMAGE, OSError):

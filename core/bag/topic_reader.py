@@ -386,7 +386,8 @@ def _read_linear(stream: IO[bytes], size: int, reader: _Reader) -> None:
             data = np.frombuffer(b"".join(batch), dtype=np.uint8)
             lengths = np.array([len(b) for b in batch], dtype=np.int64)
             starts = np.concatenate(([0], np.cumsum(lengths)[:-1]))
-            reader.add(data, starts, lengths, np.array(batch_times, dtype=np.int64))
+            # Log times are u64: the same int64 view as the indexed path's (_decode_records), never an overflow.
+            reader.add(data, starts, lengths, np.array(batch_times, dtype=np.uint64).astype(np.int64))
             batch.clear()
             batch_times.clear()
 
