@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import logging
 import os
-import re
 import signal
 import sys
 import traceback
@@ -28,6 +27,7 @@ try:  # typer 0.28 parses with its own copy of click
 except ImportError:
     from click import UsageError as ClickUsageError
 
+from moveplan.cli.tables import escape_controls
 from moveplan.core.errors import MoveplanError, UsageError
 
 __all__ = [
@@ -208,12 +208,8 @@ def _internal(exc: BaseException) -> str:
             f"[{detail.filename.rsplit('/', 1)[-1]}:{detail.lineno}]")
 
 
-# Control characters a hostile file put into a name would reach the terminal: shown escaped, as repr shows them.
-_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
-
-
 def _report(code: int, message: str, as_json: bool, *, kind: str, **document: Any) -> None:
-    message = _CONTROL.sub(lambda found: repr(found.group())[1:-1], message)
+    message = escape_controls(message)
     if as_json:
         print(json.dumps({"ok": False, **document, "error": {"exit_code": code, "kind": kind, "message": message}}))
     else:

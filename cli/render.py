@@ -19,7 +19,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from moveplan.cli.tables import console as _console
 from moveplan.cli.tables import emit as _emit
-from moveplan.cli.tables import is_terminal, show, table
+from moveplan.cli.tables import escape_controls, is_terminal, show, table
 from moveplan.cli.tables import number as _number
 
 if TYPE_CHECKING:  # each command imports only the core modules it runs
@@ -216,7 +216,8 @@ def inspect_summary(inspection: Inspection, as_json: bool, quiet: bool) -> None:
     topics = table(f"{path}  ({summary.profile}, {summary.duration_s:.3f} s)",
                    ("topic", "type", "count", "durability"), left=2)
     for t in summary.topics:
-        topics.add_row(t.topic, t.type, str(t.count), t.qos_durability)
+        # Names come from the file: control characters in them must not reach the terminal.
+        topics.add_row(*(escape_controls(text) for text in (t.topic, t.type, str(t.count), t.qos_durability)))
     show(topics)
     if steps:
         rows = table(f"plan: {plan.robot_name if plan else ''}",

@@ -9,6 +9,7 @@ every table takes that form and no line is wrapped: one record, one line, whatev
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Sequence
 from typing import IO, Any
 
@@ -78,3 +79,12 @@ def emit(document: dict[str, Any]) -> None:
 def number(value: float | None, spec: str) -> str:
     """Return a document's number formatted, or "inf/nan" for its null: not finite (a diverged plant)."""
     return "inf/nan" if value is None else format(value, spec)
+
+
+# Control characters a hostile file put into a name would reach the terminal: shown escaped, as repr shows them.
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
+
+
+def escape_controls(text: str) -> str:
+    """Return `text` with its control characters (escape sequences, newlines, bells) written as escapes."""
+    return _CONTROL.sub(lambda found: repr(found.group())[1:-1], text)

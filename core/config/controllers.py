@@ -109,6 +109,8 @@ def parse_controllers(
     manager = _ros_parameters(top, "controller_manager", path)
     where = f"{path}: controller_manager.ros__parameters.update_rate"
     rate = number(manager.get("update_rate", 100), where, positive=True)
+    if rate < 1.0:  # controller_manager's update_rate is a whole number of Hz; 5e-324 made the period infinite
+        raise ConfigError(f"{where}: {rate:g} Hz is below 1 Hz (controller_manager runs at a whole number of Hz)")
     if rate > MAX_UPDATE_RATE_HZ:
         # Each simulated second costs `rate` control cycles of state: 1e9 Hz asked for 24 GB.
         raise ConfigError(f"{where}: {rate:g} Hz is beyond moveplan's limit of {MAX_UPDATE_RATE_HZ:g} Hz "
