@@ -69,6 +69,7 @@ from hypothesis.control import currently_in_test_context
 from mcap.records import Attachment, Channel, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, Writer
+from test_db3 import HUMBLE_SCHEMA
 
 RECORDINGS = SAMPLES / "recordings"
 SAMPLE_PLAN = RECORDINGS / "tool_up_plan.mcap"
@@ -541,15 +542,6 @@ class Files:
         printer.text(repr(self))
 
 
-HUMBLE_SCHEMA = """
-CREATE TABLE schema(schema_version INTEGER PRIMARY KEY,ros_distro TEXT NOT NULL);
-CREATE TABLE metadata(id INTEGER PRIMARY KEY,metadata_version INTEGER NOT NULL,metadata TEXT NOT NULL);
-CREATE TABLE topics(id INTEGER PRIMARY KEY,name TEXT NOT NULL,type TEXT NOT NULL,
-  serialization_format TEXT NOT NULL,offered_qos_profiles TEXT NOT NULL);
-CREATE TABLE messages(id INTEGER PRIMARY KEY,topic_id INTEGER NOT NULL,timestamp INTEGER NOT NULL, data BLOB NOT NULL);
-CREATE INDEX timestamp_idx ON messages (timestamp ASC);
-INSERT INTO schema (schema_version, ros_distro) VALUES (3, 'humble');
-"""
 
 
 def write_db3(path: Path, content: McapContent, topic: str = "/joint_states") -> Path:
