@@ -12,7 +12,14 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from moveplan.cli import state_command, tune_command
-from moveplan.cli.errors import GuardedGroup, check_outputs, description_inputs, exit_codes, handle_signals
+from moveplan.cli.errors import (
+    GuardedGroup,
+    all_or_none,
+    check_outputs,
+    description_inputs,
+    exit_codes,
+    handle_signals,
+)
 from moveplan.cli.options import (
     ROBOT_HELP,
     JsonOpt,
@@ -335,6 +342,10 @@ def benchmark(
 
         check_outputs({"--csv": csv, "--plot": plot},
                       {"PROBLEMS": problems, "--robot": robot, **description_inputs(urdf, srdf)})
+        if plot is not None:
+            from moveplan.core.pipeline.plots import check_plot_path
+
+            check_plot_path(plot)
         seed_list = parse_seeds(seeds)
         time_s = check_planning_time(parse_number(planning_time, "--planning-time"))
         timeout_s = parse_optional(parse_number, timeout, "--timeout")
@@ -346,10 +357,13 @@ def benchmark(
         planners = [p.strip() for text in planner or [config.planning["planner"]] for p in text.split(",")]
         with render.benchmark_progress(len(found) * len(planners) * len(seed_list), quiet) as advance:
             runs = bench.run_benchmark(source, found, planners, seed_list, time_s, jobs, advance, timeout_s)
-        if csv is not None:
-            bench.write_csv(runs, csv)
-        if plot is not None:
-            bench.plot(runs, plot)
+        with all_or_none() as written:
+            if csv is not None:
+                bench.write_csv(runs, csv)
+                written.append(csv)
+            if plot is not None:
+                bench.plot(runs, plot)
+                written.append(plot)
     render.benchmark_summary(runs, bench.summarize(runs), as_json, quiet)
 
 

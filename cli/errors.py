@@ -14,10 +14,10 @@ import signal
 import sys
 import traceback
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from types import FrameType
-from typing import Any
+from typing import Any, NoReturn
 
 import typer
 from typer.core import TyperGroup
@@ -31,7 +31,8 @@ from moveplan.cli.tables import escape_controls
 from moveplan.core.errors import MoveplanError, UsageError
 
 __all__ = [
-    "PIPE_CLOSED", "GuardedGroup", "Interrupted", "check_outputs", "description_inputs", "exit_codes", "handle_signals",
+    "PIPE_CLOSED", "GuardedGroup", "Interrupted", "all_or_none", "check_outputs", "description_inputs", "exit_codes",
+    "handle_signals",
 ]
 
 logger = logging.getLogger("moveplan")
@@ -82,52 +83,94 @@ class GuardedGroup(TyperGroup):
         ctx.meta[_QUIET] = "--quiet" in args or "-q" in args
         return super().resolve_command(ctx, args)
 
+    def make_context(self, info_name: str | None, args: list[str], parent: Any = None, **extra: Any) -> Any:
+        """Parse the app's own options, as click does; --help or --version meeting a closed or full stdout too."""
+        with _output_guarded():
+            try:
+                return super().make_context(info_name, args, parent, **extra)
+            except ClickUsageError as exc:
+                _usage_error(exc, quiet=False)
+
     def invoke(self, ctx: Any) -> Any:
         """Invoke the command; then flush stdout, so that a closed pipe is noticed here, not at exit."""
-        try:
+        with _output_guarded():
             try:
-                return super().invoke(ctx)
-            finally:
-                if sys.stdout is not None:  # None when started with stdout closed
-                    sys.stdout.flush()
-        except BrokenPipeError:
+                try:
+                    return super().invoke(ctx)
+                finally:
+                    if sys.stdout is not None:  # None when started with stdout closed
+                        sys.stdout.flush()
+            except ClickUsageError as exc:
+                _usage_error(exc, quiet=bool(ctx.meta.get(_QUIET)))
+
+
+def _usage_error(exc: ClickUsageError, quiet: bool) -> NoReturn:
+    """Exit with click's usage error code, after click's usage text (one line with --quiet) on stderr."""
+    if quiet:
+        _say(f"moveplan: error: {exc.format_message()}")
+    else:
+        try:
+            exc.show()
+        except OSError:  # stderr full or gone: the exit code alone tells
+            _to_devnull(2)
+    raise typer.Exit(exc.exit_code) from None
+
+
+@contextmanager
+def _output_guarded() -> Iterator[None]:
+    """Exit PIPE_CLOSED on a closed stdout, 3 on one that cannot be written, 128 + signal on an interrupt."""
+    try:
+        yield
+    except BrokenPipeError:
+        _pipe_closed()
+    except SystemExit as exc:
+        # rich's Console.on_broken_pipe exits 1 while handling the BrokenPipeError: same case.
+        if isinstance(exc.__context__, BrokenPipeError):
             _pipe_closed()
-        except ClickUsageError as exc:
-            if not ctx.meta.get(_QUIET):
-                raise
-            print(f"moveplan: error: {exc.format_message()}", file=sys.stderr)
-            raise typer.Exit(exc.exit_code) from None
-        except SystemExit as exc:
-            # rich's Console.on_broken_pipe exits 1 while handling the BrokenPipeError: same case.
-            if isinstance(exc.__context__, BrokenPipeError):
-                _pipe_closed()
-            raise
-        except KeyboardInterrupt as exc:
-            code, message = _interrupt_message(exc)
-            print(f"moveplan: error: {message}", file=sys.stderr)
-            raise typer.Exit(code) from None
-        except OSError as exc:
-            # The work's errors are turned into exit codes inside the command (exit_codes): what
-            # arrives here failed writing stdout (/dev/full, a full disk under `> file`).
-            _stdout_failed(exc)
+        raise
+    except KeyboardInterrupt as exc:
+        code, message = _interrupt_message(exc)
+        _say(f"moveplan: error: {message}")
+        raise typer.Exit(code) from None
+    except OSError as exc:
+        # The work's errors are turned into exit codes inside the command (exit_codes): what
+        # arrives here failed writing stdout (/dev/full, a full disk under `> file`).
+        _stdout_failed(exc)
 
 
 def _stdout_failed(exc: OSError) -> None:
     """Exit 3 with one line on stderr: stdout could not be written; later writes to it are dropped."""
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    os.dup2(devnull, 1)
-    os.close(devnull)
-    print(f"moveplan: error: cannot write to standard output: {exc.strerror or exc}", file=sys.stderr)
+    _to_devnull(1)
+    _say(f"moveplan: error: cannot write to standard output: {exc.strerror or exc}")
     raise typer.Exit(3) from None
 
 
 def _pipe_closed() -> None:
     """Exit PIPE_CLOSED, quietly: later writes (the interpreter's last flush too) go to /dev/null."""
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    os.dup2(devnull, 1)
-    os.dup2(devnull, 2)
-    os.close(devnull)
+    _to_devnull(1, 2)
     raise typer.Exit(PIPE_CLOSED) from None
+
+
+def _say(line: str) -> None:
+    """Print `line` on stderr; return None.
+
+    A stderr that is closed, full or gone is nowhere to say it: the exit code alone tells, and
+    later writes to stderr (the interpreter's last flush too) go to /dev/null.
+    """
+    if sys.stderr is None:  # started with stderr closed: print(file=None) would write to stdout
+        return
+    try:
+        print(line, file=sys.stderr, flush=True)
+    except OSError:
+        _to_devnull(2)
+
+
+def _to_devnull(*descriptors: int) -> None:
+    """Point the file descriptors at /dev/null; return None."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    for descriptor in descriptors:
+        os.dup2(devnull, descriptor)
+    os.close(devnull)
 
 
 def check_outputs(outputs: Mapping[str, Path | None], inputs: Mapping[str, Path | Sequence[Path] | None]) -> None:
@@ -160,6 +203,23 @@ def check_outputs(outputs: Mapping[str, Path | None], inputs: Mapping[str, Path 
         if where in seen:
             raise UsageError(f"{flag} '{path}': is also {seen[where]}; name two different files")
         seen[where] = flag
+
+
+@contextmanager
+def all_or_none() -> Iterator[list[Path]]:
+    """Yield a list to note each output in once written; if the block then fails, those noted are removed.
+
+    For a command writing several files one after the other (benchmark --csv and --plot): each is
+    written atomically, but a failure or a signal on the second must not leave the first.
+    """
+    written: list[Path] = []
+    try:
+        yield written
+    except BaseException:
+        for path in written:
+            with suppress(OSError):
+                path.unlink()
+        raise
 
 
 def description_inputs(urdf: str | None, srdf: str | None) -> dict[str, Path]:
@@ -213,5 +273,5 @@ def _report(code: int, message: str, as_json: bool, *, kind: str, **document: An
     if as_json:
         print(json.dumps({"ok": False, **document, "error": {"exit_code": code, "kind": kind, "message": message}}))
     else:
-        print(f"moveplan: error: {message}", file=sys.stderr)
+        _say(f"moveplan: error: {message}")
     raise typer.Exit(code)

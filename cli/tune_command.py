@@ -41,6 +41,7 @@ def tune_pid(
                       {"PLAN": plan_file, "--controllers": controllers, "--recording": recording})
         from moveplan.cli.render_tuning import tuning_summary
         from moveplan.core.pipeline.tune import TuneRequest, tune
+        from moveplan.core.pipeline.tune_plot import write_tuning_plot
 
         if plot is not None:
             from moveplan.core.pipeline.plots import check_plot_path
@@ -49,10 +50,6 @@ def tune_pid(
         names = tuple(j.strip() for j in (joints or "").split(",") if j.strip())
         result = tune(TuneRequest(plan_file, output, controllers, names,
                                   parse_params(plant_param or [], "--plant-param"), oscillations, recording, topic,
-                                  seed))
-        if plot is not None:
-            from moveplan.core.pipeline.tune_plot import write_tuning_plot
-
-            write_tuning_plot(result, plot)
+                                  seed, plot), write_tuning_plot)
     tuning_summary(result, plot, as_json, quiet)
     raise typer.Exit(0 if result.ok else 5)

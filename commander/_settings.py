@@ -7,6 +7,8 @@ joint_limits.yaml's default scaling factors until set.
 from __future__ import annotations
 
 import math
+import numbers
+import reprlib
 from typing import Any
 
 from moveplan.core.config.planners import PLANNERS
@@ -17,7 +19,7 @@ from moveplan.core.pipeline.session import MotionSettings
 
 from ._world import World
 
-__all__ = ["PLANNING_TIME_S", "PlanningSettings"]
+__all__ = ["PLANNING_TIME_S", "PlanningSettings", "real_number"]
 
 PLANNING_TIME_S = 5.0
 """MoveGroupCommander's default planning time in [s], MoveIt's."""
@@ -74,7 +76,7 @@ class PlanningSettings:
 
     def set_planning_time(self, seconds: float) -> None:
         """Set the time a plan may search, in [s]; return None."""
-        self._planning_time = check_planning_time(_number(seconds, "set_planning_time"), "set_planning_time")
+        self._planning_time = check_planning_time(real_number(seconds, "set_planning_time"), "set_planning_time")
 
     def get_planner_id(self) -> str:
         """Return the planner set, or the robot config's when none was."""
@@ -95,7 +97,7 @@ class PlanningSettings:
 
     def set_num_planning_attempts(self, num_planning_attempts: int) -> None:
         """Accept MoveIt's number of attempts; a moveplan plan is one attempt, certified; return None."""
-        if isinstance(num_planning_attempts, bool) or not isinstance(num_planning_attempts, int) \
+        if isinstance(num_planning_attempts, bool) or not isinstance(num_planning_attempts, numbers.Integral) \
                 or num_planning_attempts < 0:
             raise UsageError(f"set_num_planning_attempts: expected an integer >= 0, got {num_planning_attempts!r}")
 
@@ -115,22 +117,29 @@ class PlanningSettings:
 
 def _scaling(value: Any, where: str) -> float:
     """Return a scaling factor checked to lie in [MIN_SCALING, 1], else raise UsageError naming `where`."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not MIN_SCALING <= value <= 1.0:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not MIN_SCALING <= value <= 1.0:
         raise UsageError(f"{where}: expected a value in the range from {MIN_SCALING:g} to 1 for scaling factor, "
                          f"got {value!r}")
     return float(value)
 
 
-def _number(value: Any, where: str) -> float:
-    """Return `value` as a float if it is a finite number, else raise UsageError naming `where`."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise UsageError(f"{where}: expected a finite number, got {value!r}")
-    return float(value)
+def real_number(value: Any, where: str) -> float:
+    """Return `value` as a float if it is a finite number (no string), else raise UsageError naming `where`."""
+    # numbers.Real: a numpy scalar, as a script computes it, is a number too.
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise UsageError(f"{where}: expected a finite number, got {reprlib.repr(value)}")
+    try:
+        number = float(value)
+    except OverflowError:  # an integer of 400 digits
+        number = math.inf
+    if not math.isfinite(number):
+        raise UsageError(f"{where}: expected a finite number, got {reprlib.repr(value)}")
+    return number
 
 
 def _tolerance(value: Any, where: str) -> float:
     """Return a goal tolerance checked to be a finite number >= 0, else raise UsageError naming `where`."""
-    tolerance = _number(value, where)
+    tolerance = real_number(value, where)
     if tolerance < 0:
         raise UsageError(f"{where}: expected a tolerance >= 0, got {value!r}")
     return tolerance

@@ -7,12 +7,14 @@ angles in [rad]).
 from __future__ import annotations
 
 import math
+import reprlib
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from moveplan.core.config.fields import MAX_MAGNITUDE
 from moveplan.core.errors import UsageError
 
 from .msgs import Point, Pose, PoseStamped, Quaternion, Transform, Vector3
@@ -92,6 +94,10 @@ def matrix_to_transform(matrix: NDArray[np.float64]) -> Transform:
 def _matrix(values: list[float], where: str) -> NDArray[np.float64]:
     """Return the 4x4 matrix of [x, y, z, qx, qy, qz, qw]."""
     numbers = _numbers(values, where)
+    # A scene file's coordinates have the same bound: at 1e18 m the collision library's bounding volumes break.
+    if any(abs(v) > MAX_MAGNITUDE for v in numbers[:3]):
+        raise UsageError(f"{where}: position {numbers[:3]} is out of range; coordinates are limited to "
+                         f"|value| <= {MAX_MAGNITUDE:,.0f} m")
     try:
         matrix = quaternion_matrix(numbers[3:])
     except UsageError:
@@ -105,8 +111,8 @@ def _numbers(values: Any, where: str) -> list[float]:
     """Return `values` as a list of finite floats, else raise UsageError naming `where`."""
     try:
         numbers = [float(v) for v in values]
-    except (TypeError, ValueError):
-        raise UsageError(f"{where}: expected numbers, got {values!r}") from None
+    except (TypeError, ValueError, OverflowError):  # OverflowError: an integer of 400 digits
+        raise UsageError(f"{where}: expected numbers, got {reprlib.repr(values)}") from None
     if not all(math.isfinite(v) for v in numbers):
         raise UsageError(f"{where}: expected finite numbers, got {numbers}")
     return numbers

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
+import numbers
 import time
 from collections.abc import Sequence
 from typing import Any
@@ -25,8 +26,8 @@ from moveplan.core.pipeline.session import cartesian_motion, execute_motion, pla
 from moveplan.core.planning.goals import joint_target
 from moveplan.core.types import StepResult
 
-from ._settings import PlanningSettings
-from ._targets import joint_goal, pose_goal
+from ._settings import PlanningSettings, real_number
+from ._targets import finite_number, joint_goal, pose_goal
 from ._world import current_world
 from .conversions import matrix_to_pose, pose_to_list
 from .msgs import JointState, MoveItErrorCodes, Pose, PoseStamped, RobotState, RobotTrajectory
@@ -131,6 +132,8 @@ class MoveGroupCommander(PlanningSettings):
 
     def set_start_state(self, msg: RobotState) -> None:
         """Plan from the joint positions of a RobotState (joints it leaves out: current); return None."""
+        if not isinstance(msg, RobotState):
+            raise UsageError(f"set_start_state: expected a RobotState, got {type(msg).__name__}")
         state = msg.joint_state
         if len(state.name) != len(state.position):
             raise UsageError(f"set_start_state: joint_state has {len(state.name)} names and {len(state.position)} "
@@ -139,7 +142,8 @@ class MoveGroupCommander(PlanningSettings):
         for joint in state.name:
             if joint not in names:
                 raise UnknownName("joint", joint, "set_start_state (the robot's movable joints)", names)
-        self._start = {str(n): float(v) for n, v in zip(state.name, state.position, strict=True)}
+        pairs = zip(state.name, state.position, strict=True)
+        self._start = {str(n): finite_number(v, f"set_start_state: {n}") for n, v in pairs}
 
     # Targets ------------------------------------------------------------------------------------
 
@@ -179,6 +183,8 @@ class MoveGroupCommander(PlanningSettings):
     def set_position_target(self, xyz: Sequence[float], end_effector_link: str = "") -> None:
         """Set a position target in the pose reference frame, any orientation; return None."""
         link = self._link(end_effector_link or self._eef, "set_position_target")
+        if isinstance(xyz, str) or not hasattr(xyz, "__len__") or len(xyz) != 3:
+            raise UsageError(f"set_position_target: expected [x, y, z], got {xyz!r}")
         goal = pose_goal([*xyz, 0.0, 0.0, 0.0], link, self._reference, "set_position_target")
         self._target = PositionGoal(xyz=goal.xyz, frame=goal.frame, link=link)
 
@@ -189,10 +195,9 @@ class MoveGroupCommander(PlanningSettings):
         pose's fixed-axis roll, pitch and yaw (roll turns about the tool's own x axis, yaw about
         the planning frame's z axis). The pose is read where the motion starts.
         """
-        if isinstance(axis, bool) or not isinstance(axis, int) or not 0 <= axis < len(SHIFT_AXES):
+        if isinstance(axis, bool) or not isinstance(axis, numbers.Integral) or not 0 <= axis < len(SHIFT_AXES):
             raise UsageError(f"shift_pose_target: an axis value between 0 and 5 expected, got {axis!r}")
-        if not isinstance(value, int | float) or not math.isfinite(value):
-            raise UsageError(f"shift_pose_target: expected a finite number, got {value!r}")
+        value = real_number(value, "shift_pose_target")
         link = self._link(end_effector_link or self._eef, "shift_pose_target")
         if link == self._robot.group.tip:
             self._target = ShiftGoal.of({SHIFT_AXES[axis]: float(value)}, "moveit")
@@ -305,8 +310,10 @@ class MoveGroupCommander(PlanningSettings):
                              "motion is certified collision-free (allow a contact with touch_links instead)")
         if path_constraints is not None:
             raise UsageError("compute_cartesian_path: path_constraints are not supported")
-        if not isinstance(eef_step, int | float) or not 0.0 < eef_step < math.inf:
+        if isinstance(eef_step, bool) or not isinstance(eef_step, numbers.Real) or not 0.0 < eef_step < math.inf:
             raise UsageError(f"compute_cartesian_path: eef_step must be a positive distance in [m], got {eef_step!r}")
+        if isinstance(waypoints, str) or not hasattr(waypoints, "__len__"):
+            raise UsageError(f"compute_cartesian_path: waypoints: expected a list of poses, got {waypoints!r}")
         if not waypoints:
             raise UsageError("compute_cartesian_path: no waypoints: give the poses the end-effector goes through")
         q = self._start_q()
@@ -331,7 +338,8 @@ class MoveGroupCommander(PlanningSettings):
 
     def attach_object(self, object_name: str, link_name: str = "", touch_links: Sequence[str] = ()) -> bool:
         """Return True once the scene object `object_name` is attached to `link_name` (default: the end-effector)."""
-        attach_existing(self._world, object_name, link_name or self._eef, list(touch_links) or None)
+        attach_existing(self._world, object_name, link_name or self._eef, touch_links or None,
+                        f"attach_object('{object_name}')")
         return True
 
     def detach_object(self, name: str = "") -> bool:

@@ -8,15 +8,18 @@ when they are not given one (as they would talk to the one move_group of a ROS g
 
 from __future__ import annotations
 
+import numbers
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
+from moveplan.core.config.tasks import MAX_SEED
 from moveplan.core.errors import UsageError
 from moveplan.core.pipeline.request import RobotSource
 from moveplan.core.pipeline.session import ExecutionSettings, check_execution
 
+from ._targets import finite_number
 from ._world import World, make_current
 from .msgs import JointState, RobotState
 
@@ -63,10 +66,19 @@ class RobotCommander:
             if robot is None:
                 raise UsageError(f"RobotCommander(): no robot: give a config (RobotCommander('ur10e')) or set "
                                  f"{ROBOT_VARIABLE}")
+        where = "RobotCommander"
         paths = [] if package_path is None else [package_path] if isinstance(package_path, str | Path) else package_path
-        source = RobotSource(robot, tuple(Path(p) for p in paths), dict(xacro_args or {}), urdf, srdf, strict_limits)
-        execution = ExecutionSettings(plant, dict(plant_params or {}), Path(controllers) if controllers else None, seed)
-        self.world = World(source, Path(scene) if scene is not None else None, execution, seed)
+        if not hasattr(paths, "__iter__"):
+            raise UsageError(f"{where}: package_path: expected a folder or a list of folders, got {package_path!r}")
+        _check_arguments(robot, {"urdf": urdf, "srdf": srdf}, {"xacro_args": xacro_args, "plant_params": plant_params},
+                         seed)
+        params = {str(k): finite_number(v, f"{where}: plant_params['{k}']") for k, v in (plant_params or {}).items()}
+        source = RobotSource(robot, tuple(_path(p, f"{where}: package_path") for p in paths), dict(xacro_args or {}),
+                             urdf, srdf, strict_limits)
+        controllers_path = _path(controllers, f"{where}: controllers") if controllers else None
+        execution = ExecutionSettings(plant, params, controllers_path, int(seed))
+        scene_path = _path(scene, f"{where}: scene") if scene is not None else None
+        self.world = World(source, scene_path, execution, int(seed))
         check_execution(self.world.config, self.world.robot(None).joint_names, execution)
         make_current(self.world)
 
@@ -126,5 +138,24 @@ class RobotCommander:
                 (or cannot be written as one: a folder, a device).
             InputError: `path` cannot be written.
         """
-        self.world.save(Path(path), distro)
+        self.world.save(_path(path, "save"), distro)
 
+
+def _path(value: Any, where: str) -> Path:
+    """Return `value` as a Path if it is a name or a path, else raise UsageError naming `where`."""
+    if not isinstance(value, str | os.PathLike) or not str(value):
+        raise UsageError(f"{where}: expected a file or folder name, got {value!r}")
+    return Path(value)
+
+
+def _check_arguments(robot: Any, descriptions: Mapping[str, Any], mappings: Mapping[str, Any], seed: Any) -> None:
+    """Raise UsageError naming the RobotCommander argument that has the wrong type (or a seed out of range)."""
+    _path(robot, "RobotCommander: robot")  # kept as given by the caller: a shipped config's name is no path
+    for flag, value in descriptions.items():
+        if value is not None and not isinstance(value, str):
+            raise UsageError(f"RobotCommander: {flag}: expected a file name or package:// URI, got {value!r}")
+    for flag, given in mappings.items():
+        if given is not None and not isinstance(given, Mapping):
+            raise UsageError(f"RobotCommander: {flag}: expected a mapping of names to values, got {given!r}")
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or not 0 <= int(seed) <= MAX_SEED:
+        raise UsageError(f"RobotCommander: seed: expected an integer in 0..{MAX_SEED}, got {seed!r}")

@@ -9,7 +9,7 @@ name in use replaces it. Calls apply at once (MoveIt's `synchronous=True`).
 from __future__ import annotations
 
 import logging
-import math
+import reprlib
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
@@ -17,10 +17,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from moveplan.core.config.fields import MAX_MAGNITUDE
 from moveplan.core.errors import UnknownName, UsageError
 from moveplan.core.model.scene import mesh_file
 from moveplan.core.types import CollisionObject, Shape
 
+from ._targets import frame_name
 from ._world import World, current_world
 from .conversions import matrix_to_pose, pose_to_matrix
 from .msgs import AttachedCollisionObject, Header, Pose, PoseStamped
@@ -69,7 +71,7 @@ class PlanningSceneInterface:
         name = object if isinstance(object, str) else str(getattr(object, "id", ""))
         if not link:
             raise UsageError(f"attach_object('{name}'): give the link to attach it to")
-        attach_existing(self._world, name, link, touch_links)
+        attach_existing(self._world, name, link, touch_links, f"attach_object('{name}')")
 
     def attach_box(self, link: str, name: str, pose: PoseStamped | Pose | None = None,
                    size: Sequence[float] = (1, 1, 1), touch_links: Sequence[str] | None = None) -> None:
@@ -126,18 +128,19 @@ class PlanningSceneInterface:
     def get_object_poses(self, object_ids: Iterable[str]) -> dict[str, Pose]:
         """Return name -> pose in the planning frame of the world objects among `object_ids`."""
         objects = self._world.objects
-        return {n: matrix_to_pose(objects[n].transform) for n in object_ids if n in objects and not objects[n].link}
+        wanted = _names(object_ids, "get_object_poses")
+        return {n: matrix_to_pose(objects[n].transform) for n in wanted if n in objects and not objects[n].link}
 
     def get_objects(self, object_ids: Iterable[str] = ()) -> dict[str, CollisionObjectMsg]:
         """Return name -> CollisionObject (pose in the planning frame) of the world objects asked (all for none)."""
         frame = self._world.robot(None).root_link
-        wanted = set(object_ids)
+        wanted = set(_names(object_ids, "get_objects"))
         return {n: CollisionObjectMsg(Header(frame_id=frame), n, matrix_to_pose(o.transform))
                 for n, o in self._world.objects.items() if not o.link and (not wanted or n in wanted)}
 
     def get_attached_objects(self, object_ids: Iterable[str] = ()) -> dict[str, AttachedCollisionObject]:
         """Return name -> AttachedCollisionObject (pose in its link's frame) of the objects asked (all for none)."""
-        wanted = set(object_ids)
+        wanted = set(_names(object_ids, "get_attached_objects"))
         return {n: AttachedCollisionObject(o.link, CollisionObjectMsg(Header(frame_id=o.link), n,
                                                                       matrix_to_pose(o.transform)), list(o.touch_links))
                 for n, o in self._world.objects.items() if o.link and (not wanted or n in wanted)}
@@ -152,20 +155,23 @@ class PlanningSceneInterface:
                 touch_links: Sequence[str] | None, where: str) -> None:
         """Attach a new object of `shape()` at `pose` to `link`, or (no pose) the scene object `name`."""
         if pose is None:
-            attach_existing(self._world, name, link, touch_links)
+            attach_existing(self._world, name, link, touch_links, where)
             return
         objects = self._world.objects
         placed = CollisionObject(_name(name, where), shape(), _placed(self._world, pose, where))
-        objects[name] = _on_link(self._world, placed, link, touch_links)
+        objects[name] = _on_link(self._world, placed, link, touch_links, where)
         self._world.change(objects=objects)
 
 
-def attach_existing(world: World, name: str, link: str, touch_links: Sequence[str] | None) -> None:
-    """Attach the scene object `name` to `link` where it is now; `touch_links` default to [link]; return None."""
+def attach_existing(world: World, name: str, link: str, touch_links: Sequence[str] | None, where: str) -> None:
+    """Attach the scene object `name` to `link` where it is now; `touch_links` default to [link]; return None.
+
+    `where` names the call in errors.
+    """
     objects = world.objects
     if name not in objects:
         raise UnknownName("object", name, "the planning scene", objects)
-    objects[name] = _on_link(world, _in_world(world, objects[name]), link, touch_links)
+    objects[name] = _on_link(world, _in_world(world, objects[name]), link, touch_links, where)
     world.change(objects=objects)
 
 
@@ -183,11 +189,15 @@ def detach(world: World, name: str, link: str | None = None) -> bool:
     return bool(chosen)
 
 
-def _on_link(world: World, placed: CollisionObject, link: str, touch_links: Sequence[str] | None) -> CollisionObject:
+def _on_link(
+    world: World, placed: CollisionObject, link: str, touch_links: Sequence[str] | None, where: str
+) -> CollisionObject:
     """Return a world object attached to `link`, kept where it is now."""
     robot = world.robot(None)
-    if link not in robot.link_names:
-        raise UnknownName("link", link, "the robot's links", robot.link_names)
+    if not isinstance(link, str) or link not in robot.link_names:
+        raise UnknownName("link", str(link), f"{where} (the robot's links)", robot.link_names)
+    if touch_links is not None and (isinstance(touch_links, str) or not hasattr(touch_links, "__iter__")):
+        raise UsageError(f"{where}: touch_links: expected a list of link names, got {touch_links!r}")
     touch = tuple(touch_links) if touch_links is not None else (link,)
     for other in touch:
         if other not in robot.link_names:
@@ -206,7 +216,7 @@ def _in_world(world: World, item: CollisionObject) -> CollisionObject:
 def _placed(world: World, pose: PoseStamped | Pose, where: str) -> NDArray[np.float64]:
     """Return `root_T_pose` of a PoseStamped (in its frame, the robot where it is now) or a Pose (planning frame)."""
     if isinstance(pose, PoseStamped):
-        frame = pose.header.frame_id.lstrip("/") or world.robot(None).root_link
+        frame = frame_name(pose.header.frame_id, f"{where}: header.frame_id") or world.robot(None).root_link
         return world.pose(frame) @ pose_to_matrix(pose.pose, f"{where}: pose")
     if isinstance(pose, Pose):
         return pose_to_matrix(pose, f"{where}: pose")
@@ -220,19 +230,30 @@ def _name(name: Any, where: str) -> str:
     return name
 
 
+def _names(object_ids: Any, where: str) -> list[str]:
+    """Return the object names of a list, else raise UsageError naming `where` (a string would be its letters)."""
+    if isinstance(object_ids, str) or not hasattr(object_ids, "__iter__"):
+        raise UsageError(f"{where}: expected a list of object names, got {reprlib.repr(object_ids)}")
+    return list(object_ids)
+
+
 def _lengths(values: Any, count: int, where: str) -> tuple[float, ...]:
     """Return `count` positive finite lengths [m], else raise UsageError naming `where`."""
     try:
         numbers = tuple(float(v) for v in values)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         numbers = ()
-    if len(numbers) != count or not all(0.0 < v < math.inf for v in numbers):
-        raise UsageError(f"{where}: expected {count} positive lengths in [m], got {values!r}")
+    # A scene file's sizes have the same bound: the collision library misses contacts with a box of 1e18 m.
+    if len(numbers) != count or not all(0.0 < v <= MAX_MAGNITUDE for v in numbers):
+        raise UsageError(f"{where}: expected {count} positive lengths in [m] up to {MAX_MAGNITUDE:,.0f}, "
+                         f"got {reprlib.repr(values)}")
     return numbers
 
 
 def _mesh(filename: str | Path, size: Sequence[float], where: str) -> Shape:
     """Return the mesh shape of a file (checked as a scene file's mesh is), scaled by `size`."""
     scale = _lengths(size, 3, f"{where}: size")
+    if not isinstance(filename, str | Path) or not str(filename):
+        raise UsageError(f"{where}: filename: expected a mesh file's path, got {filename!r}")
     path = mesh_file(Path(filename), f"{where}: filename")
     return Shape("mesh", (), str(path), (scale[0], scale[1], scale[2]))

@@ -17,6 +17,7 @@ import numpy as np
 from moveplan.core.errors import FrameNotFound, MoveplanError, UsageError
 from moveplan.core.types import Frame
 
+from ._targets import frame_name
 from ._world import current_world
 from .conversions import matrix_to_pose, matrix_to_transform, pose_to_matrix, transform_to_matrix
 from .msgs import Header, PoseStamped, TransformStamped
@@ -49,7 +50,9 @@ class Buffer:
         Raises:
             FrameNotFound: A frame neither the robot nor the scene has; the message lists the known ones.
         """
-        target_T_source = np.linalg.inv(self.world.pose(_bare(target_frame))) @ self.world.pose(_bare(source_frame))
+        target = frame_name(target_frame, "lookup_transform: target_frame")
+        source = frame_name(source_frame, "lookup_transform: source_frame")
+        target_T_source = np.linalg.inv(self.world.pose(target)) @ self.world.pose(source)
         return TransformStamped(Header(frame_id=target_frame), source_frame, matrix_to_transform(target_T_source))
 
     def can_transform(self, target_frame: str, source_frame: str, time: Any = None, timeout: Any = None) -> bool:
@@ -64,7 +67,8 @@ class Buffer:
         """Return a PoseStamped expressed in `target_frame` (tf2_geometry_msgs' do_transform_pose)."""
         if not isinstance(object_stamped, PoseStamped):
             raise UsageError(f"Buffer.transform: expected a PoseStamped, got {type(object_stamped).__name__}")
-        source = object_stamped.header.frame_id or self.world.robot(None).root_link
+        source = frame_name(object_stamped.header.frame_id, "Buffer.transform: header.frame_id") \
+            or self.world.robot(None).root_link
         target_T_source = transform_to_matrix(self.lookup_transform(target_frame, source).transform)
         pose = matrix_to_pose(target_T_source @ pose_to_matrix(object_stamped.pose, "Buffer.transform: pose"))
         return PoseStamped(Header(object_stamped.header.seq, object_stamped.header.stamp, target_frame), pose)
@@ -101,21 +105,20 @@ class StaticTransformBroadcaster:
             ConfigError: A frame named as a robot link, or frames that form a loop.
             FrameNotFound: A parent frame that does not exist.
         """
+        if not isinstance(transform, TransformStamped) and (isinstance(transform, str)
+                                                             or not hasattr(transform, "__iter__")):
+            raise UsageError(f"sendTransform: expected a TransformStamped or a list of them, got {transform!r}")
         transforms = [transform] if isinstance(transform, TransformStamped) else list(transform)
         frames = self._world.frames
         for item in transforms:
             if not isinstance(item, TransformStamped):
                 raise UsageError(f"sendTransform: expected TransformStamped messages, got {type(item).__name__}")
-            child = _bare(item.child_frame_id)
+            child = frame_name(item.child_frame_id, "sendTransform: child_frame_id")
             if not child:
                 raise UsageError("sendTransform: a transform needs a child_frame_id")
-            parent = _bare(item.header.frame_id) or self._world.robot(None).root_link
+            parent = frame_name(item.header.frame_id, f"sendTransform('{child}'): header.frame_id") \
+                or self._world.robot(None).root_link
             matrix = transform_to_matrix(item.transform, f"sendTransform('{child}'): transform")
             frames.pop(child, None)  # a frame sent again moves: it goes last, after any parent sent with it
             frames[child] = Frame(child, parent, matrix)
         self._world.change(frames=frames)
-
-
-def _bare(frame: str) -> str:
-    """Return a frame name without tf1's leading slash."""
-    return frame.lstrip("/")

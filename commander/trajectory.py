@@ -7,6 +7,7 @@ from its fields.
 
 from __future__ import annotations
 
+import reprlib
 from collections.abc import Sequence
 from typing import Any
 
@@ -85,15 +86,27 @@ def from_message(message: Any, joints: Sequence[str], where: str) -> StepResult:
     if not hasattr(source, "joint_names") or not hasattr(source, "points"):
         raise UsageError(f"{where}: expected a RobotTrajectory or a trajectory_msgs JointTrajectory, "
                          f"got {type(message).__name__}")
+    for key in ("joint_names", "points"):
+        value = getattr(source, key)
+        if isinstance(value, str) or not hasattr(value, "__iter__"):
+            raise UsageError(f"{where}: {key}: expected a list, got {reprlib.repr(value)}")
     names = [str(n) for n in source.joint_names]
     points = list(source.points)
+    for k, point in enumerate(points):
+        if not all(hasattr(point, key) for key in ("positions", "velocities", "accelerations")) \
+                or not hasattr(getattr(point, "time_from_start", None), "to_sec"):
+            raise UsageError(f"{where}: points[{k}]: expected a JointTrajectoryPoint with a Duration "
+                             f"time_from_start, got {reprlib.repr(point)}")
     if not points:
         raise UsageError(f"{where}: the trajectory has no points")
     unknown = [n for n in names if n not in joints]
     if unknown or len(set(names)) != len(names) or not names:
         raise UsageError(f"{where}: joint_names {names}: expected distinct joints of the group ({', '.join(joints)})")
     columns = [_field(points, key, len(names), where) for key in ("positions", "velocities", "accelerations")]
-    times = np.array([p.time_from_start.to_sec() for p in points], dtype=float)
+    try:
+        times = np.array([p.time_from_start.to_sec() for p in points], dtype=float)
+    except (TypeError, ValueError):
+        raise UsageError(f"{where}: points hold a time_from_start that is not a number of seconds") from None
     try:
         trajectory = JointTrajectory(tuple(names), times, *columns)
     except ValueError as exc:
@@ -107,7 +120,10 @@ def from_message(message: Any, joints: Sequence[str], where: str) -> StepResult:
 
 def _field(points: list[Any], key: str, width: int, where: str) -> NDArray[np.float64]:
     """Return one field of every point as an array (K, width); a field empty on every point is zeros."""
-    rows = [list(getattr(p, key)) for p in points]
+    try:
+        rows = [list(getattr(p, key)) for p in points]
+    except TypeError:
+        raise UsageError(f"{where}: points hold {key} that are not lists of numbers") from None
     if key != "positions" and not any(rows):
         return np.zeros((len(points), width))
     for k, row in enumerate(rows):

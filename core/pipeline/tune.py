@@ -8,7 +8,7 @@ plan through it under the same plant, as `execute --fake --plant pid --controlle
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, cast
@@ -57,6 +57,7 @@ class TuneRequest:
     recording: Path | None = None
     topic: str = "/joint_states"
     seed: int = 0
+    plot: Path | None = None
 
 
 @dataclass(frozen=True)
@@ -94,14 +95,16 @@ class TuneResult:
         return self.verification.ok and not self.ringing
 
 
-def tune(request: TuneRequest) -> TuneResult:
-    """Return the tuning of the plan's controller, its file written to `request.output`.
+def tune(request: TuneRequest, draw: Callable[[TuneResult, Path], None] | None = None) -> TuneResult:
+    """Return the tuning of the plan's controller, its file written to `request.output` (and drawn to `request.plot`).
 
-    The file is written whatever the verification finds (TuneResult.ok says).
+    The file is written whatever the verification finds (TuneResult.ok says). With
+    `request.plot`, `draw` (tune_plot.write_tuning_plot) writes the plot before the gains file
+    is renamed into place: if either fails, or a signal arrives, neither is left.
 
     Raises:
         InputError: The plan, the controllers file or the recording is unreadable or invalid,
-            or the controller does not command velocity or effort alone.
+            the controller does not command velocity or effort alone, or an output cannot be written.
         UsageError: An unknown joint in `joints`, a bad plant parameter, oscillations < 0.
     """
     if request.oscillations < 0:
@@ -126,11 +129,22 @@ def tune(request: TuneRequest) -> TuneResult:
     tuned = tuple(_tune_joint(controller, joint, interface, values, request) for joint in joints)
     gains = {t.setup.joint: {k: v for k, v in t.gains.as_dict().items() if k != "ff_velocity_scale"} for t in tuned}
     written = tuned_controllers_text(text, source, controller.name, gains)
-    with staged_file(request.output, written.encode("utf-8")) as staged:
-        verification = execute(ExecuteRequest(plan=request.plan, plant="pid", plant_params=params,
-                                              controllers=staged, seed=request.seed,
-                                              controllers_as_data=request.controllers is None))
-    return TuneResult(controller.name, source, request.output, interface, tuned, params, fit, verification)
+    drawn = False
+    try:
+        with staged_file(request.output, written.encode("utf-8")) as staged:
+            verification = execute(ExecuteRequest(plan=request.plan, plant="pid", plant_params=params,
+                                                  controllers=staged, seed=request.seed,
+                                                  controllers_as_data=request.controllers is None))
+            result = TuneResult(controller.name, source, request.output, interface, tuned, params, fit, verification)
+            if request.plot is not None:
+                assert draw is not None, "a plot asked for and nothing to draw it"
+                draw(result, request.plot)
+                drawn = True
+    except BaseException:
+        if drawn and request.plot is not None:
+            request.plot.unlink(missing_ok=True)
+        raise
+    return result
 
 
 def _controllers_text(request: TuneRequest, plan: recording.PlanFile, embedded: Path | None) -> tuple[str, str]:
