@@ -41,7 +41,7 @@ MOVE_S, PAUSE_S, DWELL_S = 4.0, 0.3, 1.7
 PERIOD_S = 2 * MOVE_S + PAUSE_S + DWELL_S
 DELAY_S, NOISE_RAD = 0.002, 1e-5
 FIRST_S = 1.0
-SCHEMA = Path(__file__).resolve().parents[1] / "core/bag/msgs/jazzy/sensor_msgs__msg__JointState.msg"
+SCHEMA = Path(__file__).resolve().parents[1] / "core/bag/cdr/msgs/jazzy/sensor_msgs__msg__JointState.msg"
 QOS = ("- history: 3\n  depth: 0\n  reliability: 1\n  durability: 2\n  deadline:\n    sec: 0\n"
        "    nsec: 0\n  lifespan:\n    sec: 0\n    nsec: 0\n  liveliness: 1\n"
        "  liveliness_lease_duration:\n    sec: 0\n    nsec: 0\n"

@@ -184,7 +184,7 @@ def check_outputs(outputs: Mapping[str, Path | None], inputs: Mapping[str, Path 
         UsageError: Naming the flag, the path and why.
 
     """
-    from moveplan.core.bag.bag_writer import output_problem
+    from moveplan.core.bag.container.writer import output_problem
 
     read = [(name, p) for name, given in inputs.items() if given is not None
             for p in ([given] if isinstance(given, Path) else given)]

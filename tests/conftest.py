@@ -100,7 +100,7 @@ def dense_peaks(trajectory: JointTrajectory, per_segment: int = 64) -> tuple[np.
     return np.abs(velocities).max(axis=0), np.abs(accelerations).max(axis=0)
 
 
-MSGS = ROOT / "core" / "bag" / "msgs" / "jazzy"
+MSGS = ROOT / "core" / "bag" / "cdr" / "msgs" / "jazzy"
 SCHEMAS = {
     "sensor_msgs/msg/JointState": (MSGS / "sensor_msgs__msg__JointState.msg").read_bytes(),
     "std_msgs/msg/String": (MSGS / "std_msgs__msg__String.msg").read_bytes(),

@@ -1,6 +1,6 @@
 """The reference CDR: mcap_ros2's schema-driven encoder, reached through its public Writer.
 
-moveplan's encoders (core/bag/generic_cdr.py and the `*_cdr` twins) are checked against
+moveplan's encoders (core/bag/cdr/generic.py and the `*_cdr` twins) are checked against
 it byte for byte. The messages go through an uncompressed in-memory MCAP file and are
 read back in the order they were written.
 """
@@ -19,7 +19,7 @@ from mcap_ros2.writer import Writer
 
 def schema(msgtype: str, distro: str) -> str:
     """The shipped ros2msg schema text of `msgtype` ("pkg/msg/Type") for `distro`."""
-    return files("moveplan.core.bag.msgs").joinpath(distro, msgtype.replace("/", "__") + ".msg").read_text()
+    return files("moveplan.core.bag.cdr.msgs").joinpath(distro, msgtype.replace("/", "__") + ".msg").read_text()
 
 
 def reference_cdr(msgtype: str, distro: str, messages: Iterable[Any], text: str | None = None) -> list[bytes]:

@@ -15,8 +15,8 @@ from mcap.reader import make_reader
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 
+from moveplan.core.bag.container.summary import summarize
 from moveplan.core.bag.jointstates import encode_joint_states, read_joint_states
-from moveplan.core.bag.summary import summarize
 from moveplan.core.errors import InputError
 
 RECORDINGS = SAMPLES / "recordings"

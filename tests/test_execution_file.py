@@ -18,13 +18,13 @@ from reference_cdr import reference_cdr
 from rosbags.highlevel import AnyReader
 from rosbags.interfaces import ConnectionExtRosbag2, QosDurability
 
-from moveplan.core.bag import messages as msgs
+from moveplan.core.bag.cdr import messages as msgs
+from moveplan.core.bag.cdr.bulk import controller_states_cdr
+from moveplan.core.bag.cdr.joint_state import encode_joint_states
+from moveplan.core.bag.container.summary import summarize
 from moveplan.core.bag.execution_file import EXECUTION_RESULT_TOPIC
-from moveplan.core.bag.jointstate_cdr import encode_joint_states
-from moveplan.core.bag.message_cdr import controller_states_cdr
 from moveplan.core.bag.plan_file import PlanFile, read_plan
 from moveplan.core.bag.plan_writer import write_plan
-from moveplan.core.bag.summary import summarize
 from moveplan.core.config.controllers import ControllerConfig, ExecutionConfig
 from moveplan.core.control.controller import ExecutionReport, simulate
 from moveplan.core.control.plants import FrozenPlant, MirrorPlant, make_plant
@@ -37,7 +37,7 @@ from moveplan.core.types import ControllerStates, JointTrajectory, Plan, PointSe
 
 DISTROS = sorted(
     entry.name
-    for entry in files("moveplan.core.bag.msgs").iterdir()
+    for entry in files("moveplan.core.bag.cdr.msgs").iterdir()
     if entry.is_dir() and entry.name.isalpha()
 )
 JOINTS = ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint")
@@ -156,7 +156,7 @@ def test_executed_file_has_the_topics_types_counts_and_schemas_of_its_distro(
 ) -> None:
     path = write(tmp_path, two_steps, distro)
     cycles = sum(len(s.report.times_s) for s in two_steps.steps)
-    shipped = files("moveplan.core.bag.msgs").joinpath(distro)
+    shipped = files("moveplan.core.bag.cdr.msgs").joinpath(distro)
     with AnyReader([path]) as reader:
         counts = {topic: info.msgcount for topic, info in reader.topics.items()}
         types = {c.topic: c.msgtype for c in reader.connections}

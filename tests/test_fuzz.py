@@ -1063,7 +1063,7 @@ def test_a_joint_state_logged_at_the_largest_mcap_time_is_judged_or_refused_in_o
     cli: Cli, files: Files, chunked: bool, flags: tuple[str, ...]
 ) -> None:
     # Found by the fuzzer: a log time of 2**64 - 1 (a u64 in MCAP) in a file read by the linear scan
-    # overflowed an int64 array in core/bag/topic_reader.py (an internal error).
+    # overflowed an int64 array in core/bag/container/topic_reader.py (an internal error).
     content = with_log_time(files.executed_content, "/joint_states", 12, (1 << 64) - 1)
     with scratch_folder() as scratch:
         recording = scratch / "recording.mcap"
@@ -1164,7 +1164,7 @@ def test_a_db3_recording_with_ids_that_are_no_integers_is_refused_in_one_line(
     cli: Cli, files: Files, damage: str
 ) -> None:
     # Found by the fuzzer: in tables declared without types (any value in any column), a topic id
-    # of NULL raised TypeError from int() in core/bag/db3.py (an internal error); text ids too.
+    # of NULL raised TypeError from int() in core/bag/container/db3.py (an internal error); text ids too.
     with scratch_folder() as scratch:
         recording = scratch / "run.db3"
         shutil.copy(files.db3, recording)
@@ -1213,7 +1213,7 @@ def test_a_chunk_too_short_for_its_header_is_damage_skipped_or_refused_in_one_li
     cli: Cli, files: Files, length: int, summary: bool, flags: tuple[str, ...]
 ) -> None:
     # Found by the fuzzer: a chunk record's length set below the 40 bytes of a chunk's header made
-    # core/bag/mcap_linear.py unpack past it (struct.error: an internal error of check-tolerances
+    # core/bag/container/mcap_linear.py unpack past it (struct.error: an internal error of check-tolerances
     # --skip-damaged in a file without a summary) and inspect refuse the file with struct's message.
     for source in (files.executed_bytes, files.plain_executed):
         chunk = next(record for record in mcap_records(source) if record.opcode == CHUNK)

@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 from reference_cdr import reference_cdr, schema
 
-from moveplan.core.bag.definitions import Field, parse_definitions
-from moveplan.core.bag.generic_cdr import encoder
+from moveplan.core.bag.cdr.definitions import Field, parse_definitions
+from moveplan.core.bag.cdr.generic import encoder
 
 SHIPPED = sorted(
     (distro.name, entry.name.removesuffix(".msg").replace("__", "/"))
-    for distro in files("moveplan.core.bag.msgs").iterdir()
+    for distro in files("moveplan.core.bag.cdr.msgs").iterdir()
     if distro.is_dir() and distro.name.isalpha()
     for entry in distro.iterdir()
     if entry.name.endswith(".msg")

@@ -22,7 +22,7 @@ import pytest
 from conftest import ROOT, SAMPLES, UR10E, Cli
 
 from moveplan.cli.errors import PIPE_CLOSED
-from moveplan.core.bag.bag_writer import atomic_file
+from moveplan.core.bag.container.writer import atomic_file
 from moveplan.core.collision import _cache
 from moveplan.core.errors import InputError, UsageError
 from moveplan.core.pipeline import benchmark as bench

@@ -21,7 +21,7 @@ from moveplan.core.bag.jointstates import (
 from moveplan.core.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[1]
-MSGS = ROOT / "core" / "bag" / "msgs" / "jazzy"
+MSGS = ROOT / "core" / "bag" / "cdr" / "msgs" / "jazzy"
 SCHEMAS = {
     JOINT_STATE_TYPE: (MSGS / "sensor_msgs__msg__JointState.msg").read_bytes(),
     "std_msgs/msg/String": (MSGS / "std_msgs__msg__String.msg").read_bytes(),

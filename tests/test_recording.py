@@ -16,11 +16,11 @@ from reference_cdr import generic, reference_cdr
 from rosbags.highlevel import AnyReader
 from rosbags.interfaces import ConnectionExtRosbag2, QosDurability
 
-from moveplan.core.bag import message_cdr
-from moveplan.core.bag import messages as msgs
+from moveplan.core.bag.cdr import bulk as message_cdr
+from moveplan.core.bag.cdr import messages as msgs
+from moveplan.core.bag.container.summary import summarize
 from moveplan.core.bag.plan_file import PlanFile, read_plan
 from moveplan.core.bag.plan_writer import write_plan
-from moveplan.core.bag.summary import summarize
 from moveplan.core.errors import InputError, UsageError
 from moveplan.core.types import (
     CollisionObject,
@@ -44,7 +44,7 @@ TYPES = {
 }
 DISTROS = sorted(
     entry.name
-    for entry in files("moveplan.core.bag.msgs").iterdir()
+    for entry in files("moveplan.core.bag.cdr.msgs").iterdir()
     if entry.is_dir() and entry.name.isalpha()
 )
 
@@ -236,7 +236,7 @@ def test_every_channel_is_cdr_with_the_shipped_schema_text_byte_for_byte(
 ) -> None:
     path = tmp_path / "plan.mcap"
     write_plan(path, plan, distro=distro)
-    shipped = files("moveplan.core.bag.msgs").joinpath(distro)
+    shipped = files("moveplan.core.bag.cdr.msgs").joinpath(distro)
     schemas = {}
     for opcode, fields in top_level_records(path):
         if opcode == 0x03:

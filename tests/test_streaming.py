@@ -19,10 +19,10 @@ import pytest
 from conftest import MSGS, ROOT, write_bag
 from mcap.writer import CompressionType, Writer
 
-from moveplan.core.bag.jointstate_cdr import JOINT_STATE_TYPE, encode_joint_states
+from moveplan.core.bag.cdr.joint_state import JOINT_STATE_TYPE, encode_joint_states
+from moveplan.core.bag.container.summary import summarize
 from moveplan.core.bag.jointstates import open_joint_states, read_joint_states
 from moveplan.core.bag.plan_file import PlanStepRecord
-from moveplan.core.bag.summary import summarize
 from moveplan.core.config.controllers import ControllerConfig, ExecutionConfig
 from moveplan.core.control import alignment, check_samples
 from moveplan.core.control.check_samples import Samples, source_of

@@ -1,13 +1,18 @@
 """ROS 2 bags: MCAP reading and writing, rosbag2 sqlite3 reading, CDR encoding, and the message layouts moveplan writes.
 
-Two layers, as the mcap Python package splits container and codec. The container:
-bag_writer (a bag written atomically), qos, mcap_scan and summary (reading with the mcap
-package), mcap_records, mcap_linear and topic_reader (one topic in bulk, without it),
-db3 (rosbag2's sqlite3 storage) and bag_files (which files a recording is). The codec, on
-top: cdr, definitions, generic_cdr, messages, message_cdr, jointstate_cdr. The files
-moveplan writes and reads are built from both: plan_file and plan_writer,
-execution_file, jointstates (with sample_store: decoded samples kept on disk, so that
-reading a recording takes the same memory for an hour as for a minute).
+Three floors, as the mcap Python packages split container and codec:
+- `container/`: bags as records and files, whatever the messages: a bag written atomically
+  (writer, qos), MCAP read with the mcap package (mcap_scan, summary) and without it
+  (mcap_records, mcap_linear, topic_reader: one topic in bulk), chunks checked
+  (chunk_codecs, mcap_verify), rosbag2's sqlite3 storage (db3), and which files a recording
+  is (files).
+- `cdr/`: messages as bytes: the CDR writer (primitives), the ros2msg definitions moveplan
+  ships (definitions, msgs/), the schema-driven encoder (generic), messages as dicts
+  (messages) and the hand-written twins of the big ones (bulk, joint_state).
+- here, on both: the files moveplan writes and reads: plan files (plan_file, plan_writer),
+  executed files (execution_file) and joint states from any recording (jointstates, with
+  _sample_store: decoded samples kept on disk, so that reading a recording takes the same
+  memory for an hour as for a minute).
 """
 
 from importlib import import_module
@@ -20,7 +25,7 @@ _HOME = {
     "JointStateStore": "jointstates", "open_joint_states": "jointstates", "read_joint_states": "jointstates",
     "PlanFile": "plan_file", "PlanStepRecord": "plan_file", "plan_urdf": "plan_file", "read_plan": "plan_file",
     "write_plan": "plan_writer",
-    "BagSummary": "summary", "TopicSummary": "summary", "summarize": "summary",
+    "BagSummary": "container.summary", "TopicSummary": "container.summary", "summarize": "container.summary",
 }
 
 __all__ = [

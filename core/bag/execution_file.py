@@ -20,12 +20,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..types import ControllerStates, TfSamples
-from . import messages as msgs
-from .bag_writer import BagStream, open_bag
-from .definitions import CONTROLLER_STATE, schema_text
-from .generic_cdr import encoder
-from .jointstate_cdr import JOINT_STATE_TYPE, encode_joint_states
-from .message_cdr import controller_states_cdr, tf_messages_cdr
+from .cdr import messages as msgs
+from .cdr.bulk import controller_states_cdr, tf_messages_cdr
+from .cdr.definitions import CONTROLLER_STATE, schema_text
+from .cdr.generic import encoder
+from .cdr.joint_state import JOINT_STATE_TYPE, encode_joint_states
+from .container.writer import BagStream, open_bag
 from .plan_file import ROBOT_DESCRIPTION, STRING
 
 __all__ = ["EXECUTION_RESULT_TOPIC", "ExecutedStep", "ExecutionWriter", "execution_writer", "write_execution"]

@@ -1,13 +1,13 @@
 """Joint states from any bag: sensor_msgs/msg/JointState messages as numpy columns.
 
-Fast enough for hour-long 1 kHz recordings: core.bag.topic_reader hands over a topic's
+Fast enough for hour-long 1 kHz recordings: core.bag.container.topic_reader hands over a topic's
 payloads chunk by chunk (MCAP) or batch by batch (rosbag2 sqlite3), and the rows whose
 bytes up to the position array equal a template row's (same frame_id, same names, same
 array sizes) are decoded together with numpy. Rows laid out differently get their own
 template, or are decoded one by one. Decoded rows go to temporary files batch by batch
-(core.bag.sample_store): `open_joint_states` hands back a store read by row ranges, whose
+(core.bag._sample_store): `open_joint_states` hands back a store read by row ranges, whose
 memory does not grow with the recording; `read_joint_states` loads it all.
-The CDR layout itself is core.bag.jointstate_cdr's, which also encodes payloads
+The CDR layout itself is core.bag.cdr.joint_state's, which also encodes payloads
 (`encode_joint_states`, re-exported here with JOINT_STATE_TYPE and JointStateSeries).
 """
 
@@ -24,16 +24,16 @@ from numpy.typing import NDArray
 
 from ..errors import CorruptData, InputError, known
 from ..types import JointStateSeries, TimeSource
-from .joint_state_checks import seconds_text
-from .jointstate_cdr import (
+from ._joint_state_checks import seconds_text
+from ._sample_store import JointStateStore, SampleSpool
+from .cdr.joint_state import (
     JOINT_STATE_TYPE,
     JointStateLayout,
     check_definition,
     encode_joint_states,
     parse_layout,
 )
-from .sample_store import JointStateStore, SampleSpool
-from .topic_reader import Channel, byte_rows, read_topic
+from .container.topic_reader import Channel, byte_rows, read_topic
 
 __all__ = [
     "JOINT_STATE_TYPE", "JointStateSeries", "JointStateStore", "encode_joint_states", "open_joint_states",

@@ -8,11 +8,11 @@ from pathlib import Path
 import numpy as np
 
 from ..types import Plan
-from . import messages as msgs
-from .bag_writer import write_bag
-from .definitions import schema_text
-from .generic_cdr import encoder
-from .message_cdr import display_trajectory_cdr, joint_trajectory_cdr, tf_messages_cdr
+from .cdr import messages as msgs
+from .cdr.bulk import display_trajectory_cdr, joint_trajectory_cdr, tf_messages_cdr
+from .cdr.definitions import schema_text
+from .cdr.generic import encoder
+from .container.writer import write_bag
 from .plan_file import PLAN_TOPICS, ROBOT_DESCRIPTION, TRAJECTORY
 
 __all__ = ["write_plan"]

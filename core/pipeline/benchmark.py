@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ..bag.bag_writer import atomic_file
+from ..bag.container.writer import atomic_file
 from ..errors import ConfigError, InputError, MoveplanError, NoPlan, UsageError
 from .request import RobotSource
 

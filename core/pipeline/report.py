@@ -14,7 +14,7 @@ from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
 from .. import bag as recording
-from ..bag import messages as msgs
+from ..bag.cdr import messages as msgs
 from ..bag.execution_file import ExecutedStep, ExecutionWriter, execution_writer
 from ..config.controllers import ControllerConfig
 from ..control.controller import ExecutionReport

@@ -16,7 +16,7 @@ from typing import Any, cast
 import numpy as np
 
 from .. import bag as recording
-from ..bag.bag_writer import staged_file
+from ..bag.container.writer import staged_file
 from ..config.controllers import ControllerConfig
 from ..config.controllers_write import tuned_controllers_text
 from ..config.fields import read_input_text

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bag.bag_writer import atomic_file
+from ..bag.container.writer import atomic_file
 from ..control.tuning import JointTuning
 from .tune import TuneResult
 

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import CorruptData, InputError
+from ...errors import CorruptData, InputError
 
 __all__ = [
     "Db3Batch", "Db3Info", "Db3Topic", "check_pages", "db3_info", "db3_messages", "open_db3", "topic_counts",

@@ -4,8 +4,8 @@ ROS 2 (rmw_fastrtps, rosbag2) serializes messages as plain CDR: a 4-byte encapsu
 header 00 01 00 00 (CDR, little endian), then the fields in definition order, each
 primitive aligned to its own size relative to the start of the payload after the header.
 Sequences and strings carry a uint32 length; strings are UTF-8 with a trailing NUL that
-the length counts. The schema-driven encoder (core.bag.generic_cdr) writes field by field;
-the hand-written twins (core.bag.message_cdr) pack float arrays in bulk from numpy, and
+the length counts. The schema-driven encoder (core.bag.cdr.generic) writes field by field;
+the hand-written twins (core.bag.cdr.bulk) pack float arrays in bulk from numpy, and
 `patched_copies` repeats a written template with new values, which is what makes them
 fast: a generic encoder spends a Python call per field.
 """

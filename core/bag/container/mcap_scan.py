@@ -23,8 +23,8 @@ from mcap.opcode import Opcode
 from mcap.records import Attachment, Channel, Header, McapRecord, Message, Metadata, Schema
 from mcap.stream_reader import MAGIC_SIZE, StreamReader
 
-from ..errors import InputError
-from .bag_files import check_regular
+from ...errors import InputError
+from .files import check_regular
 
 __all__ = ["DAMAGE", "ClampedReads", "Contents", "Kept", "open_mcap", "scan"]
 

@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..types import JointStateSeries, SkippedData, TimeSource
-from .joint_state_checks import REORDER_LIMIT_NS, OrderWatch, finite_error
+from ._joint_state_checks import REORDER_LIMIT_NS, OrderWatch, finite_error
 
 __all__ = ["JointStateStore", "SampleSpool"]
 

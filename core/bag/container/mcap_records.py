@@ -16,7 +16,7 @@ from typing import IO
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import CorruptData, InputError
+from ...errors import CorruptData, InputError
 from .chunk_codecs import MAX_CHUNK_ENV, Codecs, Damage, crc32
 
 __all__ = [

@@ -20,7 +20,7 @@ from typing import IO
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import CorruptData, InputError
+from ...errors import CorruptData, InputError
 from .chunk_codecs import DEFAULT_MAX_CHUNK_BYTES, MAX_CHUNK_ENV, Damage, Skips
 from .mcap_records import (
     ATTACHMENT,

@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..errors import CorruptData, InputError, UsageError
-from ..types import SkippedData
+from ...errors import CorruptData, InputError, UsageError
+from ...types import SkippedData
 
 try:  # zlib-ng's CRC-32 runs at ~15x zlib's: checking every chunk then costs the fast reader next to nothing
     from zlib_ng.zlib_ng import crc32

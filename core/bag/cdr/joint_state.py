@@ -17,8 +17,8 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from ..errors import InputError
-from .cdr import CdrWriter, patched_copies
+from ...errors import InputError
+from .primitives import CdrWriter, patched_copies
 
 __all__ = [
     "JOINT_STATE_TYPE",

@@ -1,8 +1,8 @@
 """ROS 2 messages as plain dicts, for the schema-driven CDR encoder, and their time stamps.
 
-Field names follow the .msg definitions in core/bag/msgs; a field left out is written with
-its default (zero, empty or the definition's constant) by the encoder (core.bag.generic_cdr).
-The big, numerous messages also have `*_cdr` twins in core.bag.message_cdr that write the
+Field names follow the .msg definitions in core/bag/cdr/msgs; a field left out is written with
+its default (zero, empty or the definition's constant) by the encoder (core.bag.cdr.generic).
+The big, numerous messages also have `*_cdr` twins in core.bag.cdr.bulk that write the
 same bytes directly.
 """
 
@@ -17,7 +17,7 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from ..types import CollisionObject, ControllerStates, JointTrajectory, PointSeries
+from ...types import CollisionObject, ControllerStates, JointTrajectory, PointSeries
 from .definitions import POINT_SOURCES, controller_state_fields
 
 __all__ = [

@@ -1,7 +1,7 @@
 """An MCAP file checked whole: every chunk's size and CRC, every attachment's CRC, the data and summary sections' CRCs.
 
 What `inspect` and the plan reader do before they trust a file (a topic read checks the
-chunks it reads as it goes, core.bag.topic_reader). Every chunk is decompressed, bounded by
+chunks it reads as it goes, core.bag.container.topic_reader). Every chunk is decompressed, bounded by
 the size it declares, into one buffer reused chunk after chunk; an attachment is read a
 block at a time. A CRC of 0 is one the writer did not compute: nothing to check.
 """
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO
 
-from ..errors import CorruptData, InputError
+from ...errors import CorruptData, InputError
 from .chunk_codecs import DATA_SECTION, Codecs, Damage, Skips, crc32
 from .mcap_linear import CUT, DataRecord, data_records
 from .mcap_records import (

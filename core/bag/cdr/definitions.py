@@ -1,7 +1,7 @@
-"""The ros2msg definitions moveplan ships (core/bag/msgs), per distro, and their fields parsed.
+"""The ros2msg definitions moveplan ships (core/bag/cdr/msgs), per distro, and their fields parsed.
 
 A schema text is a top-level .msg definition followed by every definition it depends on,
-each after a line of "=" and a "MSG: pkg/Type" line (core/bag/msgs/README.md).
+each after a line of "=" and a "MSG: pkg/Type" line (core/bag/cdr/msgs/README.md).
 `parse_definitions` reads it as rosidl's .msg parser does, into what an encoder needs:
 per message type its fields in order, each with its type, array kind and default.
 """
@@ -14,7 +14,7 @@ from functools import cache
 from importlib.resources import files
 from typing import Any
 
-from ..errors import UsageError, known
+from ...errors import UsageError, known
 
 __all__ = [
     "CONTROLLER_STATE",
@@ -82,9 +82,9 @@ class Field:
 def schema_text(msgtype: str, distro: str) -> bytes:
     """Return the shipped ros2msg definition of `msgtype` ("pkg/msg/Type") for `distro`.
 
-    The text is exactly what rosbag2 stores as an MCAP schema (see core/bag/msgs/README.md).
+    The text is exactly what rosbag2 stores as an MCAP schema (see core/bag/cdr/msgs/README.md).
     """
-    folder = files("moveplan.core.bag.msgs")
+    folder = files("moveplan.core.bag.cdr.msgs")
     distros = [entry.name for entry in folder.iterdir() if entry.is_dir() and entry.name.isalpha()]
     if distro not in distros:
         raise UsageError(f"unknown ROS distro '{distro}'; known: {known(distros)}")

@@ -1,7 +1,7 @@
 """CDR twins of the big, numerous messages: trajectories, /tf, controller states.
 
-Each `*_cdr` function writes exactly the bytes the schema-driven encoder (core.bag.generic_cdr)
-makes of its dict builder's message in core.bag.messages, but with bulk float packing and
+Each `*_cdr` function writes exactly the bytes the schema-driven encoder (core.bag.cdr.generic)
+makes of its dict builder's message in core.bag.cdr.messages, but with bulk float packing and
 templates patched per message: the generic encoder spends a Python call per float
 (tests/test_recording.py and tests/test_execution_file.py check every shipped distro). The
 field layout is the same in every distro except control_msgs/JointTrajectoryControllerState,
@@ -15,10 +15,10 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from ..types import ControllerStates, JointTrajectory, PointSeries
-from .cdr import CdrWriter, patched_copies, time_array
+from ...types import ControllerStates, JointTrajectory, PointSeries
 from .definitions import POINT_SOURCES, controller_state_fields
 from .messages import quaternions_xyzw, seconds_to_ns
+from .primitives import CdrWriter, patched_copies, time_array
 
 __all__ = ["controller_states_cdr", "display_trajectory_cdr", "joint_trajectory_cdr", "tf_messages_cdr"]
 
