@@ -159,7 +159,7 @@ def _write_db3(source: Path, folder: Path) -> None:
 def moveplan_check(path: Path) -> tuple[float, float, int]:
     """Return read and check wall times in [s] and the message count; prints the verdict."""
     from moveplan.core.bag import jointstates
-    from moveplan.core.control.checking import check_recording, uses_velocities
+    from moveplan.core.control.check.recording import check_recording, uses_velocities
 
     plan, controller = make_recording.cycle_plan(), make_recording.controller()
     began = time.perf_counter()

@@ -24,7 +24,7 @@ from moveplan.cli.tables import number as _number
 
 if TYPE_CHECKING:  # each command imports only the core modules it runs
     from moveplan.core.config.robot_config import RobotConfig
-    from moveplan.core.control.check_report import CheckReport
+    from moveplan.core.control.check.report import CheckReport
     from moveplan.core.errors import MoveplanError
     from moveplan.core.pipeline.benchmark import Run
     from moveplan.core.pipeline.execute import PlanExecution

@@ -17,8 +17,8 @@ from moveplan.core.bag.jointstates import (
 )
 from moveplan.core.bag.plan_file import PlanStepRecord
 from moveplan.core.config.controllers import ControllerConfig, ExecutionConfig
-from moveplan.core.control.check_report import CheckReport
-from moveplan.core.control.checking import check_recording, uses_velocities
+from moveplan.core.control.check.recording import check_recording, uses_velocities
+from moveplan.core.control.check.report import CheckReport
 from moveplan.core.control.controller import WAIT_LIMIT_S, Disturbance, simulate
 from moveplan.core.control.plants import MirrorPlant
 from moveplan.core.control.results import INCOMPLETE

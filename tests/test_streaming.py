@@ -24,9 +24,10 @@ from moveplan.core.bag.container.summary import summarize
 from moveplan.core.bag.jointstates import open_joint_states, read_joint_states
 from moveplan.core.bag.plan_file import PlanStepRecord
 from moveplan.core.config.controllers import ControllerConfig, ExecutionConfig
-from moveplan.core.control import alignment, check_samples
-from moveplan.core.control.check_samples import Samples, source_of
-from moveplan.core.control.checking import check_recording
+from moveplan.core.control.check import alignment
+from moveplan.core.control.check import samples as check_samples
+from moveplan.core.control.check.recording import check_recording
+from moveplan.core.control.check.samples import Samples, source_of
 from moveplan.core.pipeline.report import check_document
 from moveplan.core.trajectory import sample
 from moveplan.core.types import JointStateSeries, JointTrajectory

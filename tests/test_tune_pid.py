@@ -323,7 +323,7 @@ def test_a_file_without_the_controller_is_refused() -> None:
 
 
 def test_responses_of_a_ladder_are_simulated_in_one_pass_and_agree_with_one_by_one() -> None:
-    from moveplan.core.control.responses import measure, simulate_responses
+    from moveplan.core.control.plants.responses import measure, simulate_responses
 
     gains = {"p": np.array([20.0, 60.0]), "i": 0.0, "d": 0.0, "i_clamp": 0.0, "ff_velocity_scale": 1.0}
     both = simulate_responses("velocity", 0.002, gains, {**PLANT, "drive_tau": 0.02}, 1.0, bump=0.01)

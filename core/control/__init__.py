@@ -1,7 +1,7 @@
 """ros2_control as MoveIt drives it: the JointTrajectoryController, simulated hardware, and its tolerances."""
 
-from .check_report import CheckReport, CycleCheck, StepCheck
-from .checking import check_recording, uses_velocities
+from .check.recording import check_recording, uses_velocities
+from .check.report import CheckReport, CycleCheck, StepCheck
 from .controller import Disturbance, ExecutionReport, simulate
 from .goal_validation import validate_goal
 from .plants import PLANTS, make_plant

@@ -21,8 +21,8 @@ from numpy.typing import NDArray
 from ..config.controllers import ControllerConfig
 from ..trajectory import PointBefore, sample
 from ..types import JointTrajectory
-from .check_report import CheckReport, CycleCheck, StepCheck
-from .check_samples import SampleSource
+from .check.report import CheckReport, CycleCheck, StepCheck
+from .check.samples import SampleSource
 from .quality import JointTracking, tracking
 from .results import SUCCESSFUL
 from .tolerances import in_controller_order, position_error

@@ -27,8 +27,8 @@ from ..config.embed import check_carried
 from ..config.joint_units import check_joint_units
 from ..config.robot_config import RobotConfig, load_robot_config
 from ..config.sources import CONFIG_FILE
-from ..control.check_report import CheckReport
-from ..control.checking import SampleSource, check_recording, uses_velocities
+from ..control.check.recording import SampleSource, check_recording, uses_velocities
+from ..control.check.report import CheckReport
 from ..control.goal_validation import validate_goal
 from ..control.margins import merged_margins
 from ..control.quality import JointTracking, merged_tracking

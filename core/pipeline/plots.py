@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..bag import PlanFile
-from ..control.check_samples import SCAN_ROWS, SampleSource
+from ..control.check.samples import SCAN_ROWS, SampleSource
 from ..control.results import Violation
 from ..control.tolerances import in_controller_order, position_error
 from ..errors import InputError, UsageError
@@ -40,7 +40,7 @@ from .tracking_figure import TrackedStep, Tracking, ViolationMark, tracking_figu
 if TYPE_CHECKING:
     from ..config.controllers import ControllerConfig
     from ..config.robot_config import RobotConfig
-    from ..control.check_report import CheckReport, StepCheck
+    from ..control.check.report import CheckReport, StepCheck
     from ..control.controller import ExecutionReport
     from ..types import JointTrajectory, TfSamples
 

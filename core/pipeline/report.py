@@ -27,7 +27,7 @@ from ..types import TfSamples
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from ..control.check_report import CheckReport
+    from ..control.check.report import CheckReport
     from ..control.results import ExecutionResult, Violation
     from .execute import ExecuteRequest, PlanExecution
 

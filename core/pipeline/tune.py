@@ -20,8 +20,8 @@ from ..bag.container.writer import staged_file
 from ..config.controllers import ControllerConfig
 from ..config.controllers_write import tuned_controllers_text
 from ..config.fields import read_input_text
-from ..control.plant_fit import PlantFit, RecordedStep, fit_plant
 from ..control.plants import pid_gains, pid_interface, pid_parameters
+from ..control.plants.fit import PlantFit, RecordedStep, fit_plant
 from ..control.step_tracking import sample_index
 from ..control.tolerances import in_controller_order
 from ..control.tuning import Gains, JointSetup, JointTuning, tune_joint

@@ -19,9 +19,9 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from ..errors import InputError, known
-from ..trajectory import shortest_angular_distance
-from ..types import JointStateSeries
+from ...errors import InputError, known
+from ...trajectory import shortest_angular_distance
+from ...types import JointStateSeries
 
 __all__ = ["SCAN_ROWS", "SampleSource", "Samples", "source_of"]
 

@@ -1,173 +1,20 @@
-"""Simulated hardware behind a JointTrajectoryController: what happens to the commands it writes.
-
-A plant receives, once per control cycle, the command the controller samples
-and returns the state the controller will read on the next cycle. `mirror`
-copies commands to states like ros2_control's mock_components/GenericSystem,
-`lag` follows them with a first-order delay, `pid` is a double integrator per
-joint driven through the velocity or effort interface by JTC's PID adapter.
-"""
+"""The pid plant: a double integrator per joint, driven through velocity or effort by JTC's PID adapter."""
 
 from __future__ import annotations
 
 import math
-from abc import ABC, abstractmethod
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from ..config.controllers import ControllerConfig
-from ..errors import UsageError, known
-from .tolerances import position_error
+from ...config.controllers import ControllerConfig
+from ...errors import UsageError, known
+from ..tolerances import position_error
+from .base import Plant, State
 
-__all__ = ["PLANTS", "FrozenPlant", "LagPlant", "MirrorPlant", "PidPlant", "Plant", "make_plant", "pid_gains",
-           "pid_interface", "pid_parameters"]
-
-State = tuple[NDArray[np.float64], NDArray[np.float64]]
-Run = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
-
-PLANTS = ("mirror", "lag", "pid")
-"""Plant names `make_plant` knows, the default first."""
-
-
-class Plant(ABC):
-    """Simulated hardware for n joints; positions in [rad] or [m], velocities in [rad]/[s].
-
-    Attributes:
-        interface: The command interface the plant is driven through.
-        last_output: The value written to that interface by the last `step`, shape (n,).
-    """
-
-    interface = "position"
-
-    def __init__(self, joint_count: int) -> None:
-        self._q = np.zeros(joint_count)
-        self._qd = np.zeros(joint_count)
-        self.last_output = np.zeros(joint_count)
-
-    def reset(self, positions: npt.ArrayLike, seed: int = 0) -> State:
-        """Return the measured state after placing the joints at rest at `positions`."""
-        self._q = np.array(positions, dtype=np.float64)
-        self._qd = np.zeros_like(self._q)
-        self.last_output = self._q.copy()
-        return self._measure()
-
-    @abstractmethod
-    def step(
-        self,
-        command_positions: NDArray[np.float64],
-        command_velocities: NDArray[np.float64],
-        command_accelerations: NDArray[np.float64],
-        dt: float,
-    ) -> State:
-        """Return the measured positions and velocities after applying one command for `dt` [s]."""
-
-    def displace(self, delta: NDArray[np.float64]) -> State:
-        """Return the measured state after a bump moved the joints by `delta`."""
-        self._q = self._q + delta
-        return self._measure()
-
-    def run(
-        self,
-        command_positions: NDArray[np.float64],
-        command_velocities: NDArray[np.float64],
-        command_accelerations: NDArray[np.float64],
-        dt: float,
-        bumps: NDArray[np.float64],
-    ) -> Run:
-        """Return measured positions, velocities and outputs, (K, n) each, after each of K commands.
-
-        Row k is the state after command k and then bump k (a displacement, usually zero).
-        """
-        count, n = command_positions.shape
-        positions, velocities, outputs = (np.empty((count, n)) for _ in range(3))
-        bumped = np.any(bumps != 0.0, axis=1)
-        for k in range(count):
-            p, v = self.step(
-                command_positions[k], command_velocities[k], command_accelerations[k], dt
-            )
-            outputs[k] = self.last_output
-            if bumped[k]:
-                p, v = self.displace(bumps[k])
-            positions[k], velocities[k] = p, v
-        return positions, velocities, outputs
-
-    def _measure(self) -> State:
-        # Plants rebind their state arrays and never modify them in place, so no copies.
-        return self._q, self._qd
-
-
-class MirrorPlant(Plant):
-    """State = command, like mock_components/GenericSystem: joints are where they were told to be.
-
-    GenericSystem reports velocity 0 unless velocity is commanded; this reports the commanded
-    velocity, which JTC only compares when it commands velocity or effort.
-    """
-
-    def step(
-        self,
-        command_positions: NDArray[np.float64],
-        command_velocities: NDArray[np.float64],
-        command_accelerations: NDArray[np.float64],
-        dt: float,
-    ) -> State:
-        """Return the command as the new state."""
-        self._q, self._qd = command_positions, command_velocities
-        self.last_output = command_positions
-        return self._measure()
-
-    def run(
-        self,
-        command_positions: NDArray[np.float64],
-        command_velocities: NDArray[np.float64],
-        command_accelerations: NDArray[np.float64],
-        dt: float,
-        bumps: NDArray[np.float64],
-    ) -> Run:
-        """Return the commands as states, plus the bumps: no loop, the state is the command."""
-        self._q, self._qd = command_positions[-1] + bumps[-1], command_velocities[-1].copy()
-        self.last_output = command_positions[-1].copy()
-        return command_positions + bumps, command_velocities.copy(), command_positions.copy()
-
-
-class FrozenPlant(Plant):
-    """Hardware that ignores commands (the upstream tests' separate command and state values)."""
-
-    def step(
-        self,
-        command_positions: NDArray[np.float64],
-        command_velocities: NDArray[np.float64],
-        command_accelerations: NDArray[np.float64],
-        dt: float,
-    ) -> State:
-        """Return the unchanged state."""
-        self.last_output = command_positions
-        return self._measure()
-
-
-class LagPlant(Plant):
-    """First-order response to the position command with time constant `tau_s` per joint [s]."""
-
-    def __init__(self, tau_s: npt.ArrayLike) -> None:
-        self._tau = np.array(tau_s, dtype=np.float64)
-        self._dt, self._decay = math.nan, np.ones_like(self._tau)
-        super().__init__(len(self._tau))
-
-    def step(
-        self,
-        command_positions: NDArray[np.float64],
-        command_velocities: NDArray[np.float64],
-        command_accelerations: NDArray[np.float64],
-        dt: float,
-    ) -> State:
-        """Return the state after moving exponentially towards the command for `dt`."""
-        if dt != self._dt:
-            self._dt, self._decay = dt, np.exp(-dt / self._tau)
-        self._q = command_positions + (self._q - command_positions) * self._decay
-        self._qd = (command_positions - self._q) / self._tau
-        self.last_output = command_positions
-        return self._measure()
+__all__ = ["PidPlant", "pid_gains", "pid_interface", "pid_parameters"]
 
 
 class PidPlant(Plant):
@@ -306,38 +153,6 @@ _PID_PARAMS = {"inertia": 1.0, "max_effort": math.inf, "max_velocity": math.inf,
 _GAINS = ("p", "i", "d", "i_clamp", "ff_velocity_scale")
 
 
-def make_plant(
-    name: str,
-    params: Mapping[str, float],
-    controller: ControllerConfig,
-    continuous_joints: Iterable[str] = (),
-) -> Plant:
-    """Return the plant `name` for the controller's joints, tuned by `params`.
-
-    mirror takes no parameters; lag takes `tau` [s] for all joints and `tau.<joint>` for one
-    (default 0.05 s); both follow the sampled position command whatever the controller's
-    command interfaces. pid takes max_velocity [rad]/[s], max_effort [N m], inertia
-    [kg m^2], noise (standard deviation of measured positions [rad]), drive_tau (the drive's
-    lag [s]) and load (added to the PID output: [N m] through effort, [rad]/[s] through
-    velocity), each for all joints or as `name.<joint>` for one, and the gains of
-    `controller`, which must command velocity or effort alone. Raises UsageError for an
-    unknown plant or parameter, naming the valid ones.
-    """
-    joints = controller.joints
-    if name == "mirror":
-        _check_params(name, params, ())
-        return MirrorPlant(len(joints))
-    if name == "lag":
-        _check_params(name, params, ("tau", *(f"tau.{j}" for j in joints)))
-        default = _positive(params, "tau", 0.05)
-        return LagPlant([_positive(params, f"tau.{j}", default) for j in joints])
-    if name == "pid":
-        values = pid_parameters(params, joints)
-        return PidPlant(pid_gains(controller), pid_interface(controller),
-                        continuous=[j in set(continuous_joints) for j in joints], **values)
-    raise UsageError(f"unknown plant '{name}'; known: {known(PLANTS)}")
-
-
 def pid_parameters(params: Mapping[str, float], joints: Sequence[str]) -> dict[str, NDArray[np.float64]]:
     """Return pid's parameters per joint (arrays in the order of `joints`), defaults filled in.
 
@@ -364,20 +179,6 @@ def pid_parameters(params: Mapping[str, float], joints: Sequence[str]) -> dict[s
 _RANGES = {key: (">= 0", lambda v: v >= 0.0) for key in ("noise", "drive_tau")} | {
     key: ("positive", lambda v: v > 0.0) for key in ("inertia", "max_effort", "max_velocity")} | {
     "load": ("a finite number", math.isfinite)}
-
-
-def _check_params(name: str, params: Mapping[str, float], valid: Iterable[str]) -> None:
-    allowed = set(valid)
-    for key in params:
-        if key not in allowed:
-            raise UsageError(f"plant '{name}' has no parameter '{key}'; known: {known(allowed)}")
-
-
-def _positive(params: Mapping[str, float], key: str, default: float) -> float:
-    value = float(params.get(key, default))
-    if not value > 0.0:
-        raise UsageError(f"plant parameter '{key}' must be positive, got {value}")
-    return value
 
 
 def pid_interface(controller: ControllerConfig) -> str:

@@ -16,8 +16,8 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from .plants import PidPlant
-from .quality import BAND_FLOOR, NOISE_BANDS, crossings, noise_level
+from ..quality import BAND_FLOOR, NOISE_BANDS, crossings, noise_level
+from .pid import PidPlant
 
 __all__ = ["DIVERGED", "SETTLE_FRACTION", "Response", "measure", "simulate_responses"]
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..types import SkippedData
-from .margins import merged_margins
-from .results import INCOMPLETE, SUCCESSFUL, ExecutionResult, ToleranceReport, Violation
+from ...types import SkippedData
+from ..margins import merged_margins
+from ..results import INCOMPLETE, SUCCESSFUL, ExecutionResult, ToleranceReport, Violation
 
 __all__ = ["CheckReport", "CycleCheck", "StepCheck"]
 

@@ -18,10 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..trajectory import PointBefore, sample
-from ..types import JointTrajectory
-from .plants import PidPlant
-from .quality import noise_level
+from ...trajectory import PointBefore, sample
+from ...types import JointTrajectory
+from ..quality import noise_level
+from .pid import PidPlant
 
 __all__ = ["FITTED", "JointFit", "PlantFit", "RecordedStep", "fit_plant"]
 

@@ -13,13 +13,13 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from ..trajectory import PointBefore, sample
+from ...trajectory import PointBefore, sample
+from ..controller import WAIT_LIMIT_S
+from ..judging import judge_spans
+from ..moveit_checks import Timeout, check_start_state, expected_duration_s
+from ..results import INCOMPLETE, TIMED_OUT, ExecutionResult, ToleranceReport
 from .alignment import StepProfile
-from .check_context import CheckContext
-from .controller import WAIT_LIMIT_S
-from .judging import judge_spans
-from .moveit_checks import Timeout, check_start_state, expected_duration_s
-from .results import INCOMPLETE, TIMED_OUT, ExecutionResult, ToleranceReport
+from .context import CheckContext
 
 __all__ = ["judge_steps"]
 

@@ -20,10 +20,10 @@ state is not recorded, so MoveIt's start check is skipped), and, with `start="al
 already running when the recording began. A violation seen before the cut is still that
 failure.
 
-This module is the entry point; the parts are check_samples (the recording, read a block
-at a time from memory or from a store on disk), check_context (what the checks share),
-check_windows (one step judged over windows of samples), check_cycles (executions step by
-step, and every cycle), check_verdicts (results and reports) and check_report (the values).
+This module is the entry point; the parts are samples (the recording, read a block at a
+time from memory or from a store on disk), context (what the checks share), windows (one
+step judged over windows of samples), cycles (executions step by step, and every cycle),
+verdicts (results and reports) and report (the values).
 """
 
 from __future__ import annotations
@@ -32,16 +32,16 @@ import math
 from collections.abc import Iterable, Sequence
 from typing import Literal
 
-from ..config.controllers import ControllerConfig, ExecutionConfig
-from ..errors import InputError, UsageError
-from ..types import JointStateSeries
+from ...config.controllers import ControllerConfig, ExecutionConfig
+from ...errors import InputError, UsageError
+from ...types import JointStateSeries
+from ..tolerances import velocity_error_computable
 from .alignment import find_gaps, first_start
-from .check_context import CheckContext, CheckedPlan
-from .check_cycles import all_cycles, already_running, executions
-from .check_report import CheckReport, StepCheck
-from .check_samples import SampleSource, source_of
-from .check_verdicts import cycles_report, execution_report
-from .tolerances import velocity_error_computable
+from .context import CheckContext, CheckedPlan
+from .cycles import all_cycles, already_running, executions
+from .report import CheckReport, StepCheck
+from .samples import SampleSource, source_of
+from .verdicts import cycles_report, execution_report
 
 __all__ = ["SampleSource", "Start", "check_recording", "uses_velocities"]
 

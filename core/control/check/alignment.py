@@ -21,7 +21,7 @@ largest joint distance, shortest angle for continuous joints, in [rad]:
   goal started as long before that as the plan takes to leave it.
 
 Scans over the whole recording (departures, gaps) read it block by block through
-core.control.check_samples, carrying the zone state from block to block: the result is
+core.control.check.samples, carrying the zone state from block to block: the result is
 the same for any cut into blocks, and a recording of a shift is never held whole.
 """
 
@@ -34,11 +34,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError
-from ..trajectory import sample
-from ..types import JointTrajectory
-from .check_samples import SCAN_ROWS, Samples
-from .tolerances import position_error
+from ...errors import InputError
+from ...trajectory import sample
+from ...types import JointTrajectory
+from ..tolerances import position_error
+from .samples import SCAN_ROWS, Samples
 
 __all__ = [
     "DEPARTURE_THRESHOLD_RAD",

@@ -6,14 +6,14 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..trajectory import sample
+from ...trajectory import sample
+from ..results import INCOMPLETE, ExecutionResult
+from ..tolerances import position_error
 from .alignment import ZONE_RAD, cycle_starts, next_start
-from .check_context import CheckContext
-from .check_report import CycleCheck, StepCheck
-from .check_verdicts import execution_verdict
-from .check_windows import judge_steps
-from .results import INCOMPLETE, ExecutionResult
-from .tolerances import position_error
+from .context import CheckContext
+from .report import CycleCheck, StepCheck
+from .verdicts import execution_verdict
+from .windows import judge_steps
 
 __all__ = ["all_cycles", "already_running", "executions"]
 

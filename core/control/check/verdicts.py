@@ -5,10 +5,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import replace
 
-from .check_context import CheckContext
-from .check_report import CheckReport, CycleCheck, StepCheck
-from .margins import merged_margins
-from .results import INCOMPLETE, SUCCESSFUL, ExecutionResult, Violation
+from ..margins import merged_margins
+from ..results import INCOMPLETE, SUCCESSFUL, ExecutionResult, Violation
+from .context import CheckContext
+from .report import CheckReport, CycleCheck, StepCheck
 
 __all__ = ["cycles_report", "execution_report", "execution_verdict"]
 

@@ -6,11 +6,11 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
-from ..config.controllers import ControllerConfig, ExecutionConfig
-from ..types import JointTrajectory
+from ...config.controllers import ControllerConfig, ExecutionConfig
+from ...types import JointTrajectory
+from ..tolerances import SegmentTolerances, in_controller_order, segment_tolerances, velocity_error_computable
 from .alignment import ZONE_RAD, StepProfile
-from .check_samples import Samples, SampleSource
-from .tolerances import SegmentTolerances, in_controller_order, segment_tolerances, velocity_error_computable
+from .samples import Samples, SampleSource
 
 __all__ = ["PLAN_PROFILE_SAMPLES", "CheckContext", "CheckedPlan", "CheckedStep"]
 
