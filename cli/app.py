@@ -343,7 +343,7 @@ def benchmark(
         check_outputs({"--csv": csv, "--plot": plot},
                       {"PROBLEMS": problems, "--robot": robot, **description_inputs(urdf, srdf)})
         if plot is not None:
-            from moveplan.core.pipeline.plots import check_plot_path
+            from moveplan.core.pipeline.plots.commands import check_plot_path
 
             check_plot_path(plot)
         seed_list = parse_seeds(seeds)

@@ -40,11 +40,11 @@ def tune_pid(
         check_outputs({"-o": output, "--plot": plot},
                       {"PLAN": plan_file, "--controllers": controllers, "--recording": recording})
         from moveplan.cli.render_tuning import tuning_summary
+        from moveplan.core.pipeline.plots.tuning import write_tuning_plot
         from moveplan.core.pipeline.tune import TuneRequest, tune
-        from moveplan.core.pipeline.tune_plot import write_tuning_plot
 
         if plot is not None:
-            from moveplan.core.pipeline.plots import check_plot_path
+            from moveplan.core.pipeline.plots.commands import check_plot_path
 
             check_plot_path(plot)
         names = tuple(j.strip() for j in (joints or "").split(",") if j.strip())

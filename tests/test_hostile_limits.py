@@ -325,7 +325,7 @@ def test_a_signal_while_the_plot_is_drawn_leaves_no_output_and_exits_128_plus_si
     out = tmp_path / "out"
     out.mkdir()
     if command == "tune-pid":
-        hook = ["moveplan.core.pipeline.tune_plot", "write_tuning_plot"]
+        hook = ["moveplan.core.pipeline.plots.tuning", "write_tuning_plot"]
         args: list[object] = ["tune-pid", SHIPPED_PLAN, "--controllers", SAMPLES / "ur10e_velocity_controllers.yaml",
                               "-o", out / "tuned.yaml", "--plot", out / "tuned.png"]
     else:

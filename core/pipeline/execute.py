@@ -8,8 +8,6 @@ wherever the simulated robot then is.
 
 from __future__ import annotations
 
-import logging
-import tempfile
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import AbstractContextManager, ExitStack
 from dataclasses import dataclass, replace
@@ -22,20 +20,17 @@ from numpy.typing import NDArray
 from .. import bag as recording
 from ..bag.jointstates import open_joint_states
 from ..config import JointGoal
-from ..config.controllers import ControllerConfig, ExecutionConfig, default_controller, parse_controllers
-from ..config.embed import check_carried
+from ..config.controllers import ControllerConfig, ExecutionConfig
 from ..config.joint_units import check_joint_units
-from ..config.robot_config import RobotConfig, load_robot_config
-from ..config.sources import CONFIG_FILE
 from ..control.check.recording import SampleSource, check_recording, uses_velocities
 from ..control.check.report import CheckReport
-from ..control.goal_validation import validate_goal
 from ..control.margins import merged_margins
 from ..control.quality import JointTracking, merged_tracking
 from ..control.results import ExecutionResult, ExecutionSummary, Violation
 from ..control.step_tracking import recorded_tracking, simulated_tracking
-from ..errors import ConfigError, InputError, UnknownName
+from ..errors import InputError, UnknownName
 from ..types import TfSamples
+from .plan_files import plan_config, plan_controller, read_valid_plan
 
 if TYPE_CHECKING:
     from ..control.controller import Disturbance, ExecutionReport
@@ -44,16 +39,11 @@ if TYPE_CHECKING:
 
 _TF_RATE_HZ = 30.0
 
-MAX_PLAN_S = 86_400.0
-"""The longest plan read, in [s] from its first step's start to its last step's end: a day."""
-
 __all__ = [
-    "MAX_PLAN_S", "CheckRequest", "CheckedRecording", "ExecuteRequest", "OpenRecorder", "PlanExecution",
-    "StepExecution", "StepRecorder", "check", "execute", "pick_controller", "plan_config", "plan_controller",
-    "read_valid_plan",
+    "CheckRequest", "CheckedRecording", "ExecuteRequest", "OpenRecorder", "PlanExecution", "StepExecution",
+    "StepRecorder", "check", "execute",
 ]
 
-_LOG = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -165,89 +155,6 @@ OpenRecorder = Callable[[ControllerConfig, recording.PlanFile, bool], AbstractCo
 """Opens a StepRecorder for the controller and plan; the flag says whether link poses will come."""
 
 
-def plan_config(plan: recording.PlanFile, source: Path) -> RobotConfig:
-    """Return the robot config embedded in a plan file, read as data: no xacro, no substitution, no host file.
-
-    Raises:
-        InputError: The plan carries no config, carries xacro (written by an earlier moveplan:
-            planned again, it carries the expanded files), or a config that names a file it
-            does not carry or does not load; names the plan file.
-    """
-    if CONFIG_FILE not in plan.attachments:
-        raise InputError(f"{source}: the plan carries no robot config ({CONFIG_FILE} attachment missing)")
-    check_carried(plan.attachments, str(source))
-    with tempfile.TemporaryDirectory(prefix="moveplan-") as folder:
-        for name, data in plan.attachments.items():
-            path = Path(folder) / name
-            if not path.resolve().is_relative_to(Path(folder).resolve()):
-                raise InputError(f"{source}: attachment name '{name}' points outside the config")
-            try:
-                path.parent.mkdir(parents=True, exist_ok=True)
-                path.write_bytes(data)
-            except OSError as exc:  # names such as "." or both "a" and "a/b"
-                raise InputError(f"{source}: attachment name '{name}' is not a file name: {exc.strerror}") from None
-        # Its warnings were given when the plan was made, and would name a temporary folder here.
-        config_log = logging.getLogger("moveplan.core.config")
-        level = config_log.level
-        config_log.setLevel(logging.ERROR)
-        try:
-            return load_robot_config(folder, embedded=True)
-        except ConfigError as exc:
-            # The files are the plan's: named as it carries them, not by the temporary folder.
-            message = str(exc).replace(f"{Path(folder).resolve()}/", "").replace(f"{folder}/", "")
-            raise InputError(f"{source}: embedded config: {message}") from None
-        finally:
-            config_log.setLevel(level)
-
-
-def read_valid_plan(path: Path) -> recording.PlanFile:
-    """Return the plan file at `path`, each step checked as JTC validates a goal, the whole no longer than MAX_PLAN_S.
-
-    Raises:
-        InputError: The file is unreadable, or a step holds a NaN or infinite value or
-            times that are not strictly increasing (the message names step, point and joint),
-            or ends more than MAX_PLAN_S after the plan's start.
-
-    """
-    plan = recording.read_plan(path)
-    for step in plan.steps:
-        validate_goal(step.trajectory, f"{path}: step '{step.name}' on /planned_trajectory")
-    origin = min((step.start_s for step in plan.steps), default=0.0)
-    for step in plan.steps:
-        end_s = step.start_s - origin + step.trajectory.duration_s
-        if end_s > MAX_PLAN_S:
-            raise InputError(
-                f"{path}: step '{step.name}' ends {end_s:.6g} s after the plan's start, past the limit of "
-                f"{MAX_PLAN_S:.0f} s (a day) on a plan's length (a time_from_start or log time written wrong?)")
-    return plan
-
-
-def pick_controller(
-    controllers: Mapping[str, ControllerConfig], joints: Sequence[str], source: str, preferred: Sequence[str] = ()
-) -> ControllerConfig:
-    """Return the JointTrajectoryController that drives all of `joints`, chosen as MoveIt chooses.
-
-    MoveIt's TrajectoryExecutionManager ranks the controllers that fit by whether moveit_controllers.yaml
-    marks them `default: true` (`preferred`), then by fewest joints. Several left that differ
-    (tolerances, gains, interfaces, rate) are an error: ros2_control activates only one of them,
-    and which one the launch file spawns active is not in the files.
-    """
-    fitting = [c for c in controllers.values() if set(joints) <= set(c.joints)]
-    if not fitting:
-        raise ConfigError(f"{source}: no JointTrajectoryController drives all of {', '.join(joints)}; "
-                          f"controllers: {', '.join(controllers) or '(none)'}")
-    best = min((c.name not in preferred, len(c.joints)) for c in fitting)
-    candidates = [c for c in fitting if (c.name not in preferred, len(c.joints)) == best]
-    # The same joints listed in another order drive the robot the same way.
-    settings = [replace(c, name="", joints=tuple(sorted(c.joints))) for c in candidates]
-    if any(other != settings[0] for other in settings[1:]):
-        names = ", ".join(f"'{c.name}'" for c in candidates)
-        raise ConfigError(f"{source}: controllers {names} all drive {', '.join(joints)} with different settings; "
-                          "keep one, mark one `default: true` in moveit_controllers.yaml, or pass "
-                          "--controllers FILE holding one")
-    return candidates[0]
-
-
 def execute(
     request: ExecuteRequest, record: OpenRecorder | None = None, *, link_poses: bool = True
 ) -> PlanExecution:
@@ -270,7 +177,7 @@ def execute(
     config = plan_config(plan, request.plan)
     if request.start_joints is not None:
         check_joint_units(request.start_joints, config, ())
-    controller = _controller(config, plan, request.plan, request.controllers, not request.controllers_as_data)
+    controller = plan_controller(config, plan, request.plan, request.controllers, not request.controllers_as_data)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
     plant = make_plant(request.plant, dict(request.plant_params or {}), controller, continuous)
     reports = _simulated_steps(request, plan, controller, config.execution, plant, continuous)
@@ -379,7 +286,7 @@ def check(request: CheckRequest, then: Callable[[CheckedRecording], None] | None
     """
     plan = read_valid_plan(request.plan)
     config = plan_config(plan, request.plan)
-    controller = _controller(config, plan, request.plan, request.controllers)
+    controller = plan_controller(config, plan, request.plan, request.controllers)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
     # The samples wait on disk and are read back a window at a time: memory does not grow with the recording.
     with open_joint_states(request.recording, request.topic, joints=controller.joints,
@@ -392,28 +299,3 @@ def check(request: CheckRequest, then: Callable[[CheckedRecording], None] | None
         if then is not None:
             then(CheckedRecording(report, plan, controller, tuple(continuous), recorded))
         return report
-
-
-def plan_controller(
-    config: RobotConfig, plan: recording.PlanFile, path: Path, override: Path | None
-) -> ControllerConfig:
-    """Return the controller that executes the plan at `path`: from `override` (--controllers), else its own config."""
-    return _controller(config, plan, path, override)
-
-
-def _controller(
-    config: RobotConfig, plan: recording.PlanFile, path: Path, override: Path | None, substitute: bool = True
-) -> ControllerConfig:
-    """Return the controller driving the plan's joints, from `override` (substituted or not) or the plan's config."""
-    joints = plan.steps[0].trajectory.joint_names
-    if override is not None:
-        return pick_controller(parse_controllers(override, substitute=substitute), joints, str(override))
-    if "controllers" not in config.sources:
-        # A config without ros2_controllers.yaml (ABB's, most Setup Assistant packages before Humble): the
-        # controller ros2_control would load with no parameters file, as users get from mock hardware.
-        _LOG.warning("%s: the robot config has no ros2_controllers.yaml; executing with a "
-                     "JointTrajectoryController at ros2_controllers' defaults (100 Hz, position interface, "
-                     "no path or goal tolerances); --controllers FILE gives yours", path)
-        return default_controller(joints)
-    return pick_controller(config.controllers, joints, f"{path}: embedded {config.sources['controllers'].name}",
-                           config.execution.default_controllers)

@@ -17,7 +17,7 @@ from ..bag.plan_file import END_STATES_KEY
 from ..errors import InputError
 from ..trajectory import peak_rates
 from ..types import RobotState
-from .execute import plan_config, read_valid_plan
+from .plan_files import plan_config, read_valid_plan
 
 __all__ = ["Inspection", "StepPeaks", "end_states", "inspect_file", "step_peaks"]
 

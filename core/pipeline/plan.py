@@ -237,7 +237,7 @@ def _start_from(path: Path, robot: Robot) -> JointGoal:
 
     """
     # Imported here: execution's district (the controller simulation) is no part of planning.
-    from .execute import read_valid_plan
+    from .plan_files import read_valid_plan
 
     plan = read_valid_plan(path)
     name = robot.config.name

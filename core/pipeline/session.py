@@ -32,8 +32,8 @@ from ..planning.goals import check_limits
 from ..planning.search import seed_planner
 from ..types import CollisionObject, Frame, JointTrajectory, Plan, StepResult
 from .checks import filter_threshold, problem_checks
-from .execute import pick_controller
 from .plan import assemble
+from .plan_files import pick_controller
 from .request import PlanRequest
 from .step import plan_step
 

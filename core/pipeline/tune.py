@@ -33,10 +33,8 @@ from .execute import (
     PlanExecution,
     check,
     execute,
-    plan_config,
-    plan_controller,
-    read_valid_plan,
 )
+from .plan_files import plan_config, plan_controller, read_valid_plan
 from .report import execution_document, finite_numbers
 
 __all__ = ["TuneRequest", "TuneResult", "tune", "tuning_document"]

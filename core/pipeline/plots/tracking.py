@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..types import frozen_array
-from .plot_figures import blended, corner_note, finite_or_nan, grid, legend_line, step_lines
+from ...types import frozen_array
+from .figures import blended, corner_note, finite_or_nan, grid, legend_line, step_lines
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

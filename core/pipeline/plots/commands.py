@@ -18,13 +18,13 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from ..bag import PlanFile
-from ..control.check.samples import SCAN_ROWS, SampleSource
-from ..control.results import Violation
-from ..control.tolerances import in_controller_order, position_error
-from ..errors import InputError, UsageError
-from ..trajectory import PointBefore, peak_rates, sample
-from .execute import (
+from ...bag import PlanFile
+from ...control.check.samples import SCAN_ROWS, SampleSource
+from ...control.results import Violation
+from ...control.tolerances import in_controller_order, position_error
+from ...errors import InputError, UsageError
+from ...trajectory import PointBefore, peak_rates, sample
+from ..execute import (
     CheckedRecording,
     CheckRequest,
     ExecuteRequest,
@@ -32,17 +32,17 @@ from .execute import (
     StepRecorder,
     check,
     execute,
-    plan_config,
 )
-from .plot_figures import PlanCurves, plan_figure, write_png
-from .tracking_figure import TrackedStep, Tracking, ViolationMark, tracking_figure
+from ..plan_files import plan_config
+from .figures import PlanCurves, plan_figure, write_png
+from .tracking import TrackedStep, Tracking, ViolationMark, tracking_figure
 
 if TYPE_CHECKING:
-    from ..config.controllers import ControllerConfig
-    from ..config.robot_config import RobotConfig
-    from ..control.check.report import CheckReport, StepCheck
-    from ..control.controller import ExecutionReport
-    from ..types import JointTrajectory, TfSamples
+    from ...config.controllers import ControllerConfig
+    from ...config.robot_config import RobotConfig
+    from ...control.check.report import CheckReport, StepCheck
+    from ...control.controller import ExecutionReport
+    from ...types import JointTrajectory, TfSamples
 
 __all__ = [
     "POINTS_PER_SERIES", "check_plot_path", "check_plotted", "execute_plotted", "thinned", "write_plan_plot",
@@ -139,7 +139,7 @@ def execute_plotted(
         UsageError: `distro` has no shipped message definitions, or an output path is refused.
 
     """
-    from .report import execution_recorder
+    from ..report import execution_recorder
 
     @contextmanager
     def record(controller: ControllerConfig, plan: PlanFile, poses: bool) -> Iterator[StepRecorder]:

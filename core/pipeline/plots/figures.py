@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..bag.container.writer import atomic_file
-from ..types import frozen_array
+from ...bag.container.writer import atomic_file
+from ...types import frozen_array
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
