@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from moveplan.cli import state_command, tune_command
-from moveplan.cli.errors import (
+from . import state_command, tune_command
+from .errors import (
     GuardedGroup,
     all_or_none,
     check_outputs,
@@ -20,7 +20,7 @@ from moveplan.cli.errors import (
     exit_codes,
     handle_signals,
 )
-from moveplan.cli.options import (
+from .options import (
     ROBOT_HELP,
     JsonOpt,
     PackagePathOpt,
@@ -34,7 +34,7 @@ from moveplan.cli.options import (
     robot_source,
     setup_logging,
 )
-from moveplan.cli.parsing import (
+from .parsing import (
     MAX_SEED,
     parse_disturbance,
     parse_joint_values,
@@ -49,7 +49,7 @@ from moveplan.cli.parsing import (
 )
 
 if TYPE_CHECKING:  # each command imports the core it runs, so that `moveplan --help` stays fast
-    from moveplan.core.pipeline.request import PlanFlags
+    from ..core.pipeline import PlanFlags
 
 __all__ = ["app", "main"]
 
@@ -69,7 +69,7 @@ app = typer.Typer(
 
 def _print_version(value: bool) -> None:
     if value:
-        from moveplan.core.version import moveplan_version
+        from ..core.version import moveplan_version
 
         typer.echo(f"moveplan {moveplan_version()}")
         raise typer.Exit()
@@ -125,13 +125,13 @@ def plan(
 ) -> None:
     """Plan collision-free, time-parameterised motions and write them to MCAP."""
     setup_logging(verbose, quiet)
-    from moveplan.cli import render
+    from . import render
 
     with exit_codes(as_json, render.plan_failure):
         check_outputs({"-o": output}, {"TASK": task, "--robot": robot, "--scene": scene, "--request": motion_request,
                                        "--start-from": start_from, **description_inputs(urdf, srdf)})
         flags = _plan_flags(locals())
-        from moveplan.core.pipeline.plan import plan_to_file
+        from ..core.pipeline import plan_to_file
 
         result = plan_to_file(task, flags, output, ros_distro)
     render.plan_summary(result, output, as_json, quiet)
@@ -139,8 +139,8 @@ def plan(
 
 def _plan_flags(args: dict[str, Any]) -> PlanFlags:
     """Return the plan command's flags as core's typed values; core checks the rules between them."""
-    from moveplan.core.config.xacro import parse_xacro_args
-    from moveplan.core.pipeline.request import PlanFlags
+    from ..core.config import parse_xacro_args
+    from ..core.pipeline import PlanFlags
 
     def number(key: str) -> float | None:
         return parse_optional(parse_number, args[key], "--" + key.replace("_", "-"))
@@ -182,19 +182,19 @@ def execute(
     """Replay a plan through a simulated JointTrajectoryController and report every tolerance violation."""
     setup_logging(verbose, quiet)
     with exit_codes(as_json):
-        from moveplan.core.errors import UsageError
+        from ..core.errors import UsageError
 
         if not fake:
             raise UsageError("only fake execution exists yet: add --fake to replay through a simulated controller")
         check_outputs({"-o": output, "--plot": plot}, {"PLAN": plan_file, "--controllers": controllers})
-        from moveplan.cli import render
-        from moveplan.core.pipeline.execute import ExecuteRequest
-        from moveplan.core.pipeline.execute import execute as run
+        from ..core.pipeline import ExecuteRequest
+        from ..core.pipeline import execute as run
+        from . import render
 
         if plot is not None:
-            from moveplan.core.pipeline import plots
+            from ..core.pipeline import check_plot_path, execute_plotted
 
-            plots.check_plot_path(plot)
+            check_plot_path(plot)
 
         request = ExecuteRequest(
             plan=plan_file, plant=plant, plant_params=parse_params(plant_param or [], "--plant-param"),
@@ -203,11 +203,11 @@ def execute(
             controllers=controllers, seed=seed,
         )
         if plot is not None:
-            outcome = plots.execute_plotted(request, plot, output, ros_distro)
+            outcome = execute_plotted(request, plot, output, ros_distro)
         elif output is None:
             outcome = run(request)
         else:
-            from moveplan.core.pipeline.report import execute_to_file
+            from ..core.pipeline import execute_to_file
 
             outcome = execute_to_file(request, output, ros_distro)
     render.execution_summary(outcome, output, as_json, quiet)
@@ -239,9 +239,9 @@ def check_tolerances(
     """
     setup_logging(verbose, quiet)
     with exit_codes(as_json):
-        from moveplan.cli import render
-        from moveplan.core.errors import UsageError
-        from moveplan.core.pipeline.execute import CheckRequest, check
+        from ..core.errors import UsageError
+        from ..core.pipeline import CheckRequest, check
+        from . import render
 
         if time_source not in ("header", "log"):
             raise UsageError(f"--time-source: expected header or log, got '{time_source}'")
@@ -250,12 +250,12 @@ def check_tolerances(
         if plot is None:
             report = check(request)
         else:
-            from moveplan.core.pipeline import plots
+            from ..core.pipeline import check_plot_path, check_plotted
 
             check_outputs({"--plot": plot}, {"PLAN": plan_file, "RECORDING": recording_file,
                                              "--controllers": controllers})
-            plots.check_plot_path(plot)
-            report = plots.check_plotted(request, plot)
+            check_plot_path(plot)
+            report = check_plotted(request, plot)
     render.check_summary(report, recording_file, as_json, quiet)
     # Cut off before any verdict: the check could not be done on this recording (bad input).
     raise typer.Exit(0 if report.ok else 5 if report.complete else 3)
@@ -275,7 +275,7 @@ def robot_info(
     """Show a robot config: groups, joints and limits with their sources, frames, named states, controllers."""
     setup_logging(False, quiet)
     with exit_codes(as_json):
-        from moveplan.cli import render
+        from . import render
 
         loaded = robot_source(config, package_path, xacro_arg, urdf, srdf, strict_limits).load()
         loaded.collision_meshes()  # a missing mesh is reported here too, not only when planning
@@ -296,17 +296,17 @@ def inspect(
     """Summarise a ROS 2 bag (MCAP, .db3 or a bag folder): topics, counts; a plan's step durations and peak rates."""
     setup_logging(False, quiet)
     with exit_codes(as_json):
-        from moveplan.cli import render
-        from moveplan.core.pipeline.inspection import inspect_file
+        from ..core.pipeline import inspect_file
+        from . import render
 
         if plot is not None:
-            from moveplan.core.pipeline import plots
+            from ..core.pipeline import check_plot_path, write_plan_plot
 
             check_outputs({"--plot": plot}, {"FILE": file})
-            plots.check_plot_path(plot)
+            check_plot_path(plot)
         inspection = inspect_file(file, skip_damaged)
         if plot is not None:
-            plots.write_plan_plot(inspection.plan, file, plot)
+            write_plan_plot(inspection.plan, file, plot)
     render.inspect_summary(inspection, as_json, quiet)
 
 
@@ -336,14 +336,20 @@ def benchmark(
     """Plan many problems with several planners and seeds; report success, times, path quality, exact validity."""
     setup_logging(False, quiet)
     with exit_codes(as_json):
-        from moveplan.cli import render
-        from moveplan.core.pipeline import benchmark as bench
-        from moveplan.core.pipeline.request import check_planning_time
+        from ..core.pipeline import (
+            check_planning_time,
+            find_problems,
+            plot_benchmark,
+            run_benchmark,
+            summarize,
+            write_csv,
+        )
+        from . import render
 
         check_outputs({"--csv": csv, "--plot": plot},
                       {"PROBLEMS": problems, "--robot": robot, **description_inputs(urdf, srdf)})
         if plot is not None:
-            from moveplan.core.pipeline.plots.commands import check_plot_path
+            from ..core.pipeline import check_plot_path
 
             check_plot_path(plot)
         seed_list = parse_seeds(seeds)
@@ -351,20 +357,20 @@ def benchmark(
         timeout_s = parse_optional(parse_number, timeout, "--timeout")
         if timeout_s is not None:
             check_planning_time(timeout_s, "--timeout")
-        found = bench.find_problems(problems, count)
+        found = find_problems(problems, count)
         source = robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits)
         config = source.load()
         planners = [p.strip() for text in planner or [config.planning["planner"]] for p in text.split(",")]
         with render.benchmark_progress(len(found) * len(planners) * len(seed_list), quiet) as advance:
-            runs = bench.run_benchmark(source, found, planners, seed_list, time_s, jobs, advance, timeout_s)
+            runs = run_benchmark(source, found, planners, seed_list, time_s, jobs, advance, timeout_s)
         with all_or_none() as written:
             if csv is not None:
-                bench.write_csv(runs, csv)
+                write_csv(runs, csv)
                 written.append(csv)
             if plot is not None:
-                bench.plot(runs, plot)
+                plot_benchmark(runs, plot)
                 written.append(plot)
-    render.benchmark_summary(runs, bench.summarize(runs), as_json, quiet)
+    render.benchmark_summary(runs, summarize(runs), as_json, quiet)
 
 
 app.command("state")(state_command.state)

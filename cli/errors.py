@@ -27,8 +27,8 @@ try:  # typer 0.28 parses with its own copy of click
 except ImportError:
     from click import UsageError as ClickUsageError
 
-from moveplan.cli.tables import escape_controls
-from moveplan.core.errors import MoveplanError, UsageError
+from ..core.errors import MoveplanError, UsageError
+from .tables import escape_controls
 
 __all__ = [
     "PIPE_CLOSED", "GuardedGroup", "Interrupted", "all_or_none", "check_outputs", "description_inputs", "exit_codes",
@@ -184,7 +184,7 @@ def check_outputs(outputs: Mapping[str, Path | None], inputs: Mapping[str, Path 
         UsageError: Naming the flag, the path and why.
 
     """
-    from moveplan.core.bag.container.writer import output_problem
+    from ..core.bag import output_problem
 
     read = [(name, p) for name, given in inputs.items() if given is not None
             for p in ([given] if isinstance(given, Path) else given)]

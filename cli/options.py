@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 if TYPE_CHECKING:  # imported by the command that loads a robot: `moveplan --help` loads no config code
-    from moveplan.core.pipeline.request import RobotSource
+    from ..core.pipeline import RobotSource
 
 __all__ = [
     "ROBOT_HELP", "JsonOpt", "PackagePathOpt", "QuietOpt", "SrdfOpt", "StrictLimitsOpt", "TimeoutOpt", "UrdfOpt",
@@ -60,7 +60,7 @@ def robot_source(
     strict_limits: bool,
 ) -> RobotSource:
     """Return what loads the robot config: --robot and the flags that complete it, as core's typed value."""
-    from moveplan.core.config.xacro import parse_xacro_args
-    from moveplan.core.pipeline.request import RobotSource
+    from ..core.config import parse_xacro_args
+    from ..core.pipeline import RobotSource
 
     return RobotSource(robot, tuple(package_path or ()), parse_xacro_args(xacro_arg or ()), urdf, srdf, strict_limits)

@@ -11,10 +11,10 @@ import math
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from moveplan.core.errors import UsageError
+from ..core.errors import UsageError
 
 if TYPE_CHECKING:  # imported where used: `moveplan --help` loads no config code
-    from moveplan.core.config.goals import JointGoal, PoseGoal, ShiftGoal
+    from ..core.config import JointGoal, PoseGoal, ShiftGoal
 
 __all__ = [
     "MAX_SEED", "MAX_SEEDS", "parse_angle", "parse_disturbance", "parse_joint_values",
@@ -39,28 +39,28 @@ def parse_number(text: str, what: str) -> float:
             million radians, metres or seconds, and beyond it a typo must not reach the planner.
             A `deg` suffix, which only angles take (parse_angle).
     """
-    from moveplan.core.config.fields import expression
+    from ..core.config import expression
 
     return expression(text, what, UsageError)
 
 
 def parse_angle(text: str, what: str) -> tuple[float, bool]:
     """Return an angle in [rad] from radians, a pi expression or degrees (`90deg`), and whether it was in degrees."""
-    from moveplan.core.config.fields import angle
+    from ..core.config import angle
 
     return angle(text, what, UsageError)
 
 
 def parse_pose_angle(text: str, what: str) -> float:
     """Return a pose's roll, pitch or yaw in [rad] (as parse_angle reads it); a unitless one beyond 2*pi is refused."""
-    from moveplan.core.config.fields import pose_angle
+    from ..core.config import pose_angle
 
     return pose_angle(text, what, UsageError)
 
 
 def parse_time(text: str, what: str) -> float:
     """Return a time in [s] from `text` (a number or expression), checked to lie in [0, MAX_MAGNITUDE]."""
-    from moveplan.core.config.fields import MAX_MAGNITUDE
+    from ..core.config import MAX_MAGNITUDE
 
     time_s = parse_number(text, what)
     if time_s < 0:
@@ -75,7 +75,7 @@ def parse_optional(parse: Callable[[str, str], _T], text: str | None, what: str)
 
 def parse_joints(text: str, what: str) -> JointGoal:
     """Return a joints goal from "q1,...,qn" (all joints) or "name=value,..." (some joints), in [rad], [m] or `deg`."""
-    from moveplan.core.config.goals import JointGoal
+    from ..core.config import JointGoal
 
     items = [item.strip() for item in text.split(",")]
     if not text.strip() or any(not item for item in items):
@@ -108,7 +108,7 @@ def parse_pose(text: str, what: str) -> PoseGoal:
 
     Positions in [m]; roll, pitch and yaw in [rad] or `deg`, a unitless one beyond 2*pi refused.
     """
-    from moveplan.core.config.goals import PoseGoal
+    from ..core.config import PoseGoal
 
     items = text.split(",") if text.strip() else []
     if len(items) not in (3, 6, 7):
@@ -129,7 +129,7 @@ def parse_pose(text: str, what: str) -> PoseGoal:
 
 def parse_shift(text: str, what: str) -> ShiftGoal:
     """Return a shift of the tip from "z=0.1" or "x=0.05,yaw=30deg" ([m]; [rad] or `deg`), along the tool's axes."""
-    from moveplan.core.config.goals import SHIFT_AXES, ShiftGoal
+    from ..core.config import SHIFT_AXES, ShiftGoal
 
     offsets: dict[str, float] = {}
     for item in text.split(","):
@@ -160,7 +160,7 @@ def parse_params(items: list[str], what: str) -> dict[str, float]:
 
 def parse_disturbance(text: str) -> Any:
     """Return a Disturbance from "t=1.2,joint=elbow_joint,delta=0.05"."""
-    from moveplan.core.control.controller import Disturbance
+    from ..core.control import Disturbance
 
     pairs = [item.partition("=")[::2] for item in text.split(",")]
     fields = {k.strip(): v.strip() for k, v in pairs}

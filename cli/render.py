@@ -17,20 +17,17 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from moveplan.cli.tables import console as _console
-from moveplan.cli.tables import emit as _emit
-from moveplan.cli.tables import escape_controls, is_terminal, show, table
-from moveplan.cli.tables import number as _number
+from .tables import console as _console
+from .tables import emit as _emit
+from .tables import escape_controls, is_terminal, show, table
+from .tables import number as _number
 
 if TYPE_CHECKING:  # each command imports only the core modules it runs
-    from moveplan.core.config.robot_config import RobotConfig
-    from moveplan.core.control.check.report import CheckReport
-    from moveplan.core.errors import MoveplanError
-    from moveplan.core.pipeline.benchmark import Run
-    from moveplan.core.pipeline.execute import PlanExecution
-    from moveplan.core.pipeline.inspection import Inspection
-    from moveplan.core.pipeline.plan import PlanResult
-    from moveplan.core.pipeline.state import RobotState, StateResult
+    from ..core.config import RobotConfig
+    from ..core.control import CheckReport
+    from ..core.errors import MoveplanError
+    from ..core.pipeline import Inspection, PlanExecution, PlanResult, Run, StateResult
+    from ..core.types import RobotState
 
 __all__ = [
     "PROGRESS_EVERY_S", "benchmark_progress", "benchmark_summary", "check_summary", "execution_summary",
@@ -164,7 +161,7 @@ def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
     for setting, source in document["sources"].items():
         _console.print(f"{setting} from {source}")
     if document["missing_acceleration"]:
-        from moveplan.core.config.limits import DEFAULT_ACCELERATION
+        from ..core.config import DEFAULT_ACCELERATION
 
         _console.print(f"[yellow]no acceleration limit in the config[/yellow] for "
                        f"{', '.join(document['missing_acceleration'])}: plans use the default "
@@ -232,7 +229,7 @@ def inspect_summary(inspection: Inspection, as_json: bool, quiet: bool) -> None:
 
 def execution_summary(outcome: PlanExecution, output: Path | None, as_json: bool, quiet: bool) -> None:
     """Print the result, every violation and the per-joint margins, or the JSON document."""
-    from moveplan.core.pipeline.report import execution_document
+    from ..core.pipeline import execution_document
 
     document = execution_document(outcome)
     if output is not None:
@@ -254,7 +251,7 @@ def check_summary(report: CheckReport, recording: Path, as_json: bool, quiet: bo
 
     A check with no complete execution is bad input (exit 3): the document says so under "error".
     """
-    from moveplan.core.pipeline.report import check_document
+    from ..core.pipeline import check_document
 
     document = check_document(report, recording)
     for warning in document["warnings"]:

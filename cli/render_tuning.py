@@ -7,20 +7,20 @@ from typing import TYPE_CHECKING, Any
 
 from rich.markup import escape
 
-from moveplan.cli.tables import console as _console
-from moveplan.cli.tables import emit as _emit
-from moveplan.cli.tables import number as _number
-from moveplan.cli.tables import show, table
+from .tables import console as _console
+from .tables import emit as _emit
+from .tables import number as _number
+from .tables import show, table
 
 if TYPE_CHECKING:
-    from moveplan.core.pipeline.tune import TuneResult
+    from ..core.pipeline import TuneResult
 
 __all__ = ["tuning_summary"]
 
 
 def tuning_summary(result: TuneResult, plot: Path | None, as_json: bool, quiet: bool) -> None:
     """Print per joint the stages of the tuning, the fitted plant, the verification; or the tune-pid JSON document."""
-    from moveplan.core.pipeline.tune import tuning_document
+    from ..core.pipeline import tuning_document
 
     document = tuning_document(result)
     if plot is not None:

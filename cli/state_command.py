@@ -7,8 +7,8 @@ from typing import Annotated
 
 import typer
 
-from moveplan.cli.errors import exit_codes
-from moveplan.cli.options import (
+from .errors import exit_codes
+from .options import (
     ROBOT_HELP,
     JsonOpt,
     PackagePathOpt,
@@ -20,7 +20,7 @@ from moveplan.cli.options import (
     robot_source,
     setup_logging,
 )
-from moveplan.cli.parsing import parse_joints, parse_optional, parse_time
+from .parsing import parse_joints, parse_optional, parse_time
 
 __all__ = ["state"]
 
@@ -48,14 +48,14 @@ def state(
     """Show a robot state: the group's joint values and a link's pose in a frame (lookup_transform)."""
     setup_logging(False, quiet)
     with exit_codes(as_json):
-        from moveplan.cli import render
-        from moveplan.core.pipeline.state import StateRequest
-        from moveplan.core.pipeline.state import state as robot_state
+        from ..core.pipeline import StateRequest
+        from ..core.pipeline import state as robot_state
+        from . import render
 
         given = {"--package-path": package_path, "--xacro-arg": xacro_arg, "--urdf": urdf, "--srdf": srdf,
                  "--strict-limits": strict_limits}
         if robot is None and (flags := [name for name, value in given.items() if value]):
-            from moveplan.core.errors import UsageError
+            from ..core.errors import UsageError
 
             raise UsageError(f"{flags[0]} completes --robot: give --robot too (with --from alone, the plan's "
                              "embedded config is used as it is)")

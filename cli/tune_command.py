@@ -7,9 +7,9 @@ from typing import Annotated
 
 import typer
 
-from moveplan.cli.errors import check_outputs, exit_codes
-from moveplan.cli.options import JsonOpt, QuietOpt, VerboseOpt, setup_logging
-from moveplan.cli.parsing import MAX_SEED, parse_params
+from .errors import check_outputs, exit_codes
+from .options import JsonOpt, QuietOpt, VerboseOpt, setup_logging
+from .parsing import MAX_SEED, parse_params
 
 __all__ = ["tune_pid"]
 
@@ -39,12 +39,11 @@ def tune_pid(
     with exit_codes(as_json):
         check_outputs({"-o": output, "--plot": plot},
                       {"PLAN": plan_file, "--controllers": controllers, "--recording": recording})
-        from moveplan.cli.render_tuning import tuning_summary
-        from moveplan.core.pipeline.plots.tuning import write_tuning_plot
-        from moveplan.core.pipeline.tune import TuneRequest, tune
+        from ..core.pipeline import TuneRequest, tune, write_tuning_plot
+        from .render_tuning import tuning_summary
 
         if plot is not None:
-            from moveplan.core.pipeline.plots.commands import check_plot_path
+            from ..core.pipeline import check_plot_path
 
             check_plot_path(plot)
         names = tuple(j.strip() for j in (joints or "").split(",") if j.strip())

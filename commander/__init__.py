@@ -16,8 +16,7 @@ messages go to the logging module. docs/python.md has the whole API.
 
 import logging
 
-from moveplan.core.errors import MoveplanError
-
+from ..core.errors import MoveplanError
 from . import conversions, msgs, tf, transformations
 from .move_group import MoveGroupCommander
 from .robot import RobotCommander

@@ -11,12 +11,9 @@ import numbers
 import reprlib
 from typing import Any
 
-from moveplan.core.config.planners import PLANNERS
-from moveplan.core.config.tasks import MIN_SCALING
-from moveplan.core.errors import UsageError, known
-from moveplan.core.pipeline.request import check_planning_time
-from moveplan.core.pipeline.session import MotionSettings
-
+from ..core.config import MIN_SCALING, PLANNERS
+from ..core.errors import UsageError, known
+from ..core.pipeline import MotionSettings, check_planning_time
 from ._world import World
 
 __all__ = ["PLANNING_TIME_S", "PlanningSettings", "real_number"]

@@ -8,9 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from moveplan.core.config import JointGoal, PoseGoal
-from moveplan.core.errors import UsageError
-
+from ..core.config import JointGoal, PoseGoal
+from ..core.errors import UsageError
 from .conversions import list_to_pose, pose_to_list
 from .msgs import JointState, Pose, PoseStamped
 

@@ -16,15 +16,13 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from moveplan.core.collision import MotionChecker
-from moveplan.core.control.results import ExecutionSummary
-from moveplan.core.errors import UsageError
-from moveplan.core.model.robot import Robot
-from moveplan.core.model.scene import Scene, empty_scene
-from moveplan.core.model.scene_file import load_scene
-from moveplan.core.pipeline.request import RobotSource
-from moveplan.core.pipeline.session import (
+from ..core.collision import MotionChecker
+from ..core.control import ExecutionSummary
+from ..core.errors import UsageError
+from ..core.model import Robot, Scene, empty_scene, load_scene
+from ..core.pipeline import (
     ExecutionSettings,
+    RobotSource,
     compose_scene,
     frame_in_root,
     motion_checks,
@@ -32,7 +30,7 @@ from moveplan.core.pipeline.session import (
     start_configuration,
     write_session,
 )
-from moveplan.core.types import CollisionObject, Frame, StepResult
+from ..core.types import CollisionObject, Frame, StepResult
 
 __all__ = ["Executed", "World", "current_world", "make_current"]
 

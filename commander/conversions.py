@@ -14,9 +14,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from moveplan.core.config.fields import MAX_MAGNITUDE
-from moveplan.core.errors import UsageError
-
+from ..core.config import MAX_MAGNITUDE
+from ..core.errors import UsageError
 from .msgs import Point, Pose, PoseStamped, Quaternion, Transform, Vector3
 from .transformations import quaternion_from_euler, quaternion_from_matrix, quaternion_matrix
 

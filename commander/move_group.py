@@ -16,16 +16,13 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
-from moveplan.core.config import Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, StepSpec
-from moveplan.core.config.goals import SHIFT_AXES
-from moveplan.core.control.results import ExecutionSummary
-from moveplan.core.errors import NoPlan, UnknownName, UsageError
-from moveplan.core.model.moveit_request import PositionGoal
-from moveplan.core.model.poses import pose_matrix
-from moveplan.core.pipeline.session import cartesian_motion, execute_motion, plan_motion
-from moveplan.core.planning.goals import joint_target
-from moveplan.core.types import StepResult
-
+from ..core.config import SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, StepSpec
+from ..core.control import ExecutionSummary
+from ..core.errors import NoPlan, UnknownName, UsageError
+from ..core.model import PositionGoal, pose_matrix
+from ..core.pipeline import cartesian_motion, execute_motion, plan_motion
+from ..core.planning import joint_target
+from ..core.types import StepResult
 from ._settings import PlanningSettings, real_number
 from ._targets import finite_number, joint_goal, pose_goal
 from ._world import current_world

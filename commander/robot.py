@@ -14,11 +14,9 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from moveplan.core.config.tasks import MAX_SEED
-from moveplan.core.errors import UsageError
-from moveplan.core.pipeline.request import RobotSource
-from moveplan.core.pipeline.session import ExecutionSettings, check_execution
-
+from ..core.config import MAX_SEED
+from ..core.errors import UsageError
+from ..core.pipeline import ExecutionSettings, RobotSource, check_execution
 from ._targets import finite_number
 from ._world import World, make_current
 from .msgs import JointState, RobotState

@@ -17,11 +17,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from moveplan.core.config.fields import MAX_MAGNITUDE
-from moveplan.core.errors import UnknownName, UsageError
-from moveplan.core.model.scene import mesh_file
-from moveplan.core.types import CollisionObject, Shape
-
+from ..core.config import MAX_MAGNITUDE
+from ..core.errors import UnknownName, UsageError
+from ..core.model import mesh_file
+from ..core.types import CollisionObject, Shape
 from ._targets import frame_name
 from ._world import World, current_world
 from .conversions import matrix_to_pose, pose_to_matrix

@@ -14,9 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from moveplan.core.errors import FrameNotFound, MoveplanError, UsageError
-from moveplan.core.types import Frame
-
+from ..core.errors import FrameNotFound, MoveplanError, UsageError
+from ..core.types import Frame
 from ._targets import frame_name
 from ._world import current_world
 from .conversions import matrix_to_pose, matrix_to_transform, pose_to_matrix, transform_to_matrix

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from moveplan.core.errors import (
+from ..core.errors import (
     GoalInCollision,
     GoalOutsideLimits,
     GoalUnreachable,
@@ -25,8 +25,7 @@ from moveplan.core.errors import (
     StartOutsideLimits,
     UsageError,
 )
-from moveplan.core.types import JointTrajectory, StepResult
-
+from ..core.types import JointTrajectory, StepResult
 from .msgs import Duration, Header, JointTrajectoryPoint, MoveItErrorCodes, RobotTrajectory
 from .msgs import JointTrajectory as JointTrajectoryMsg
 

@@ -14,7 +14,7 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from moveplan.core.errors import UsageError
+from ..core.errors import UsageError
 
 __all__ = [
     "euler_from_quaternion", "euler_matrix", "quaternion_from_euler", "quaternion_from_matrix", "quaternion_matrix",

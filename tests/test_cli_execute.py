@@ -11,8 +11,8 @@ import pytest
 from conftest import SAMPLES, UR10E, Cli
 
 from moveplan.core.control.results import Violation
-from moveplan.core.pipeline import execute as pipeline
-from moveplan.core.pipeline.execute import ExecuteRequest, PlanExecution
+from moveplan.core.pipeline import execution as pipeline
+from moveplan.core.pipeline.execution import ExecuteRequest, PlanExecution
 
 SHIPPED_PLAN = SAMPLES / "recordings" / "tool_up_plan.mcap"  # shipped: these tests need no planner
 

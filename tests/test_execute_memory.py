@@ -14,7 +14,7 @@ from moveplan.core.bag.execution_file import EXECUTION_RESULT_TOPIC
 from moveplan.core.control.controller import Disturbance
 from moveplan.core.control.results import ExecutionSummary
 from moveplan.core.errors import UsageError
-from moveplan.core.pipeline.execute import ExecuteRequest, execute
+from moveplan.core.pipeline.execution import ExecuteRequest, execute
 from moveplan.core.pipeline.report import execute_to_file, write_execution
 
 STEPS = 120

@@ -31,7 +31,7 @@ from moveplan.core.control.plants import FrozenPlant, MirrorPlant, make_plant
 from moveplan.core.control.published import controller_states
 from moveplan.core.control.results import Violation
 from moveplan.core.errors import InputError, UsageError
-from moveplan.core.pipeline.execute import PlanExecution, StepExecution
+from moveplan.core.pipeline.execution import PlanExecution, StepExecution
 from moveplan.core.pipeline.report import execution_document, write_execution
 from moveplan.core.types import ControllerStates, JointTrajectory, Plan, PointSeries, StepResult, TfSamples
 

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import ast
+import importlib
 import tomllib
 from pathlib import Path
 
 import grimp
+import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -25,3 +28,30 @@ def test_every_package_folder_is_shipped_by_pyproject() -> None:
     folders = {"moveplan." + ".".join(init.parent.relative_to(ROOT).parts)
                for top in ("core", "cli", "commander", "configs") for init in (ROOT / top).rglob("__init__.py")}
     assert folders - listed == set()
+
+
+def _scope(module: str) -> str:
+    """Return the package whose insides may import `module` directly (moveplan.core's districts are moveplan's)."""
+    parent = module.rsplit(".", 1)[0]
+    return "moveplan" if parent == "moveplan.core" else parent
+
+
+def _faces() -> list[str]:
+    return sorted("moveplan." + ".".join(init.parent.relative_to(ROOT).parts)
+                  for init in (ROOT / "core").rglob("__init__.py") if "msgs" not in init.parts)
+
+
+@pytest.mark.parametrize("face", _faces())
+def test_a_face_exports_what_it_lists_and_loads_it_on_first_use(face: str) -> None:
+    """`from moveplan.core.X import name` gives the name, typed for mypy, and no name hides a submodule."""
+    package = importlib.import_module(face)
+    tree = ast.parse(Path(package.__file__).read_text())
+    typed = {alias.asname or alias.name for node in ast.walk(tree) if isinstance(node, ast.If)
+             for inner in node.body if isinstance(inner, ast.ImportFrom) for alias in inner.names}
+    exported = set(getattr(package, "__all__", ()))
+    assert typed == exported
+    children = {child.stem for child in Path(package.__file__).parent.iterdir()
+                if child.suffix == ".py" or (child / "__init__.py").exists()}
+    assert exported & children == set()
+    for name in exported:
+        assert getattr(package, name) is not None

@@ -674,7 +674,7 @@ def test_every_written_message_is_what_the_generic_encoder_writes(
     frame, trajectories = plan.planning_frame, [step.trajectory for step in plan.steps]
     statics = plan.static_frames
     expected = {
-        "/robot_description": [msgs.string(plan.urdf)],
+        "/robot_description": [msgs.string_message(plan.urdf)],
         "/tf_static": [
             msgs.tf_message(
                 [f.parent for f in statics],

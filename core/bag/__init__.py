@@ -15,40 +15,65 @@ Three floors, as the mcap Python packages split container and codec:
   memory for an hour as for a minute).
 """
 
-from importlib import import_module
-from typing import Any
+from typing import TYPE_CHECKING
 
-# Loaded on first use (PEP 562): writing a plan needs none of the readers (sqlite3, the linear
-# MCAP scan, the sample store), and every command pays for what its imports load.
-_HOME = {
-    "EXECUTION_RESULT_TOPIC": "execution_file", "ExecutedStep": "execution_file", "write_execution": "execution_file",
-    "JointStateStore": "jointstates", "open_joint_states": "jointstates", "read_joint_states": "jointstates",
-    "PlanFile": "plan_file", "PlanStepRecord": "plan_file", "plan_urdf": "plan_file", "read_plan": "plan_file",
-    "write_plan": "plan_writer",
-    "BagSummary": "container.summary", "TopicSummary": "container.summary", "summarize": "container.summary",
-}
+from .._faces import lazy_exports
+
+if TYPE_CHECKING:
+    from ._sample_store import JointStateStore
+    from .cdr import seconds_to_ns, stamps_ns
+    from .container import BagSummary, TopicSummary, atomic_file, output_problem, staged_file, summarize
+    from .execution_file import EXECUTION_RESULT_TOPIC, ExecutedStep, ExecutionWriter, execution_writer, write_execution
+    from .jointstates import open_joint_states, read_joint_states
+    from .plan_file import END_STATES_KEY, PlanFile, PlanStepRecord, plan_urdf, read_plan
+    from .plan_writer import write_plan
 
 __all__ = [
-    "EXECUTION_RESULT_TOPIC",
     "BagSummary",
+    "END_STATES_KEY",
+    "EXECUTION_RESULT_TOPIC",
     "ExecutedStep",
+    "ExecutionWriter",
     "JointStateStore",
     "PlanFile",
     "PlanStepRecord",
     "TopicSummary",
+    "atomic_file",
+    "execution_writer",
     "open_joint_states",
+    "output_problem",
     "plan_urdf",
     "read_joint_states",
     "read_plan",
+    "seconds_to_ns",
+    "staged_file",
+    "stamps_ns",
     "summarize",
     "write_execution",
     "write_plan",
 ]
 
-
-def __getattr__(name: str) -> Any:
-    """Return the exported name `name`, importing the module that defines it."""
-    if name not in _HOME:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(import_module(f".{_HOME[name]}", __name__), name)
-
+__getattr__ = lazy_exports(__name__, {
+    "BagSummary": "container",
+    "END_STATES_KEY": "plan_file",
+    "EXECUTION_RESULT_TOPIC": "execution_file",
+    "ExecutedStep": "execution_file",
+    "ExecutionWriter": "execution_file",
+    "JointStateStore": "_sample_store",
+    "PlanFile": "plan_file",
+    "PlanStepRecord": "plan_file",
+    "TopicSummary": "container",
+    "atomic_file": "container",
+    "execution_writer": "execution_file",
+    "open_joint_states": "jointstates",
+    "output_problem": "container",
+    "plan_urdf": "plan_file",
+    "read_joint_states": "jointstates",
+    "read_plan": "plan_file",
+    "seconds_to_ns": "cdr",
+    "staged_file": "container",
+    "stamps_ns": "cdr",
+    "summarize": "container",
+    "write_execution": "execution_file",
+    "write_plan": "plan_writer",
+})

@@ -20,12 +20,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..types import ControllerStates, TfSamples
-from .cdr import messages as msgs
-from .cdr.bulk import controller_states_cdr, tf_messages_cdr
-from .cdr.definitions import CONTROLLER_STATE, schema_text
-from .cdr.generic import encoder
-from .cdr.joint_state import JOINT_STATE_TYPE, encode_joint_states
-from .container.writer import BagStream, open_bag
+from .cdr import (
+    CONTROLLER_STATE,
+    JOINT_STATE_TYPE,
+    controller_states_cdr,
+    encode_joint_states,
+    encoder,
+    schema_text,
+    stamps_ns,
+    string_message,
+    tf_messages_cdr,
+)
+from .container import BagStream, open_bag
 from .plan_file import ROBOT_DESCRIPTION, STRING
 
 __all__ = ["EXECUTION_RESULT_TOPIC", "ExecutedStep", "ExecutionWriter", "execution_writer", "write_execution"]
@@ -84,7 +90,7 @@ class ExecutionWriter:
 
     def add_description(self, urdf: str) -> None:
         """Add /robot_description at log time 0; return None."""
-        self._pending.append((0, _DESCRIPTION, ROBOT_DESCRIPTION, self._string(msgs.string(urdf))))
+        self._pending.append((0, _DESCRIPTION, ROBOT_DESCRIPTION, self._string(string_message(urdf))))
 
     def add_cycles(self, cycles: ExecutedStep) -> None:
         """Add cycles: per cycle its /joint_states, then its controller state; return None.
@@ -116,11 +122,11 @@ class ExecutionWriter:
         """
         if self._next[_TF_SAMPLES] is None:
             raise ValueError("this executed file was opened without /tf")
-        stamps_ns = msgs.stamps_ns(tf.times_s)
-        if not len(stamps_ns):
+        times_ns = stamps_ns(tf.times_s)
+        if not len(times_ns):
             return
-        self._advance(_TF_SAMPLES, stamps_ns)
-        stamps = stamps_ns.tolist()
+        self._advance(_TF_SAMPLES, times_ns)
+        stamps = times_ns.tolist()
         encoded = tf_messages_cdr(tf.parents, tf.children, tf.transforms, stamps)
         self._pending += [(stamp, _TF_SAMPLES, "/tf", data) for stamp, data in zip(stamps, encoded, strict=True)]
         self._flush()
@@ -134,7 +140,7 @@ class ExecutionWriter:
         """
         if end_ns < self._written_until:
             raise ValueError(f"the result at {end_ns} ns would precede messages written up to {self._written_until} ns")
-        result = self._string(msgs.string(json.dumps(document)))
+        result = self._string(string_message(json.dumps(document)))
         self._pending.append((end_ns, _RESULT, EXECUTION_RESULT_TOPIC, result))
         self._flush(final=True)
         self._bag.add_metadata("rosbag2", {"ROS_DISTRO": self._distro})

@@ -26,14 +26,14 @@ from ..errors import CorruptData, InputError, known
 from ..types import JointStateSeries, TimeSource
 from ._joint_state_checks import seconds_text
 from ._sample_store import JointStateStore, SampleSpool
-from .cdr.joint_state import (
+from .cdr import (
     JOINT_STATE_TYPE,
     JointStateLayout,
     check_definition,
     encode_joint_states,
     parse_layout,
 )
-from .container.topic_reader import Channel, byte_rows, read_topic
+from .container import Channel, byte_rows, read_topic
 
 __all__ = [
     "JOINT_STATE_TYPE", "JointStateSeries", "JointStateStore", "encode_joint_states", "open_joint_states",

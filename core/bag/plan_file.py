@@ -23,10 +23,8 @@ from mcap_ros2.decoder import DecoderFactory
 
 from ..errors import InputError
 from ..types import JointTrajectory
-from .cdr.messages import trajectory_from_message
-from .container.chunk_codecs import Skips
-from .container.mcap_scan import DAMAGE, Contents, Kept, open_mcap, scan
-from .container.mcap_verify import verify_mcap
+from .cdr import trajectory_from_message
+from .container import DAMAGE, Contents, Kept, Skips, open_mcap, scan, verify_mcap
 
 __all__ = [
     "END_STATES_KEY",

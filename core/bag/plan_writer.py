@@ -8,11 +8,18 @@ from pathlib import Path
 import numpy as np
 
 from ..types import Plan
-from .cdr import messages as msgs
-from .cdr.bulk import display_trajectory_cdr, joint_trajectory_cdr, tf_messages_cdr
-from .cdr.definitions import schema_text
-from .cdr.generic import encoder
-from .container.writer import write_bag
+from .cdr import (
+    Message,
+    display_trajectory_cdr,
+    encoder,
+    joint_trajectory_cdr,
+    marker_array,
+    schema_text,
+    seconds_to_ns,
+    string_message,
+    tf_messages_cdr,
+)
+from .container import write_bag
 from .plan_file import PLAN_TOPICS, ROBOT_DESCRIPTION, TRAJECTORY
 
 __all__ = ["write_plan"]
@@ -58,7 +65,7 @@ def _plan_messages(plan: Plan, schemas: dict[str, bytes]) -> list[tuple[str, int
     if not plan.steps:
         raise ValueError("a plan needs at least one step")
 
-    def generic(topic: str, message: msgs.Message) -> bytes:
+    def generic(topic: str, message: Message) -> bytes:
         msgtype = PLAN_TOPICS[topic][0]
         return encoder(msgtype, schemas[msgtype])(message)
 
@@ -69,9 +76,9 @@ def _plan_messages(plan: Plan, schemas: dict[str, bytes]) -> list[tuple[str, int
     static_transforms = np.reshape([f.transform for f in statics], (1, len(statics), 4, 4))
     [tf_static] = tf_messages_cdr([f.parent for f in statics], [f.name for f in statics], static_transforms, [0])
     messages = [
-        (ROBOT_DESCRIPTION, 0, generic(ROBOT_DESCRIPTION, msgs.string(plan.urdf))),
+        (ROBOT_DESCRIPTION, 0, generic(ROBOT_DESCRIPTION, string_message(plan.urdf))),
         ("/tf_static", 0, tf_static),
-        ("/planning_scene_markers", 0, generic("/planning_scene_markers", msgs.marker_array(plan.objects, frame))),
+        ("/planning_scene_markers", 0, generic("/planning_scene_markers", marker_array(plan.objects, frame))),
         ("/display_planned_path", 0, display_trajectory_cdr(plan.robot_name, trajectories, frame)),
     ]
     # Starts add up integer durations, so a step starts exactly where the previous one's
@@ -79,10 +86,10 @@ def _plan_messages(plan: Plan, schemas: dict[str, bytes]) -> list[tuple[str, int
     start_ns = 0
     for trajectory in trajectories:
         messages.append((TRAJECTORY, start_ns, joint_trajectory_cdr(trajectory, frame)))
-        start_ns += msgs.seconds_to_ns(trajectory.duration_s)
+        start_ns += seconds_to_ns(trajectory.duration_s)
     if plan.tf is not None:
         tf = plan.tf
-        stamps_ns = [msgs.seconds_to_ns(float(time_s)) for time_s in tf.times_s]
+        stamps_ns = [seconds_to_ns(float(time_s)) for time_s in tf.times_s]
         encoded = tf_messages_cdr(tf.parents, tf.children, tf.transforms, stamps_ns)
         messages += [("/tf", stamp, data) for stamp, data in zip(stamps_ns, encoded, strict=True)]
     # A stable sort: messages logged at the same time keep the order above.

@@ -15,7 +15,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ..errors import ConfigError, InputError
-from ..model.robot import Robot
+from ..model import Robot
 from ..trajectory import peak_rates, sample, sampler, straight_states
 from ..types import JointTrajectory
 

@@ -23,9 +23,9 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
-from ..config.robot_config import RobotConfig
+from ..config import RobotConfig
 from ..errors import ConfigError, StartInCollision, UnknownName
-from ..model.robot import Robot
+from ..model import Robot
 from ..types import CollisionObject, Shape
 
 __all__ = ["CollisionChecker", "GeometryMode", "coal_geometry", "convex_hull"]

@@ -24,15 +24,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import ConfigError
-from ..model.robot import Robot
-from ..model.scene import Scene
+from ..model import Robot, Scene
 from ..trajectory import interpolate
 from ..types import JointTrajectory
 from . import certify
 from .checker import CollisionChecker, GeometryMode
 from .sphere_filter import CLEAR, COLLIDES, MAYBE, SphereFilter, UnsupportedJoint
 
-__all__ = ["CERTIFY_STEP_M", "MotionChecker", "exact_checks", "hull_checker", "scene_checks", "sphere_filter"]
+__all__ = ["CERTIFY_STEP_M", "MotionChecker", "build_sphere_filter", "exact_checks", "hull_checker", "scene_checks"]
 
 logger = logging.getLogger(__name__)
 
@@ -186,7 +185,7 @@ def scene_checks(robot: Robot, scene: Scene, geometry: GeometryMode, base: NDArr
     """
     checker = CollisionChecker(robot, scene.objects, scene.source, geometry=geometry, allowed=scene.allowed)
     hulls = hull_checker(robot, checker, scene)
-    return MotionChecker(robot, checker, base, sphere_filter(robot, checker, hulls, scene, base), hulls)
+    return MotionChecker(robot, checker, base, build_sphere_filter(robot, checker, hulls, scene, base), hulls)
 
 
 def exact_checks(checks: MotionChecker, scene: Scene) -> MotionChecker:
@@ -197,7 +196,7 @@ def exact_checks(checks: MotionChecker, scene: Scene) -> MotionChecker:
     return MotionChecker(checks.robot, checker, checks.base)
 
 
-def sphere_filter(
+def build_sphere_filter(
     robot: Robot, checker: CollisionChecker, hulls: CollisionChecker | None, scene: Scene, base: NDArray[np.float64]
 ) -> SphereFilter | None:
     """Return the fast conservative pre-check for `robot` (other joints at `base`) in `scene`, or None."""

@@ -21,7 +21,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ..errors import UnsupportedJoint
-from ..model.robot import Robot
+from ..model import Robot
 from ..types import CollisionObject, JointTrajectory
 from . import certify
 from ._cache import announce_compilation

@@ -4,16 +4,125 @@ Everything read from a file is checked here, with the file and key in every erro
 districts above never read a configuration file themselves.
 """
 
-from .controllers import ControllerConfig, ExecutionConfig
-from .goals import Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
-from .limits import JointLimit
-from .planners import PLANNERS
-from .robot_config import RobotConfig, load_robot_config
-from .srdf import Group
-from .tasks import StepSpec, TaskFile, load_task
+from typing import TYPE_CHECKING
+
+from .._faces import lazy_exports
+
+if TYPE_CHECKING:
+    from .controllers import ControllerConfig, ExecutionConfig, default_controller, parse_controllers
+    from .controllers_write import tuned_controllers_text
+    from .embed import check_carried
+    from .fields import (
+        MAX_MAGNITUDE,
+        angle,
+        check_keys,
+        coordinate,
+        expression,
+        load_yaml,
+        mapping,
+        number,
+        parse_yaml,
+        pose_angle,
+        pose_angles,
+        read_input,
+        read_input_text,
+    )
+    from .goals import SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
+    from .joint_units import check_joint_units
+    from .limits import DEFAULT_ACCELERATION, JointLimit
+    from .planners import PLANNERS
+    from .robot_config import RobotConfig, load_robot_config
+    from .sources import CONFIG_FILE
+    from .srdf import Group
+    from .tasks import MAX_SEED, MIN_SCALING, StepSpec, TaskFile, load_task
+    from .xacro import PackagePath, parse_xacro_args
 
 __all__ = [
-    "Goal", "JointGoal", "NamedGoal", "PoseGoal", "ShiftGoal", "Start", "StartFrom",
-    "PLANNERS", "ControllerConfig", "ExecutionConfig", "Group", "JointLimit", "RobotConfig", "StepSpec", "TaskFile",
-    "load_robot_config", "load_task",
+    "CONFIG_FILE",
+    "ControllerConfig",
+    "DEFAULT_ACCELERATION",
+    "ExecutionConfig",
+    "Goal",
+    "Group",
+    "JointGoal",
+    "JointLimit",
+    "MAX_MAGNITUDE",
+    "MAX_SEED",
+    "MIN_SCALING",
+    "NamedGoal",
+    "PLANNERS",
+    "PackagePath",
+    "PoseGoal",
+    "RobotConfig",
+    "SHIFT_AXES",
+    "ShiftGoal",
+    "Start",
+    "StartFrom",
+    "StepSpec",
+    "TaskFile",
+    "angle",
+    "check_carried",
+    "check_joint_units",
+    "check_keys",
+    "coordinate",
+    "default_controller",
+    "expression",
+    "load_robot_config",
+    "load_task",
+    "load_yaml",
+    "mapping",
+    "number",
+    "parse_controllers",
+    "parse_xacro_args",
+    "parse_yaml",
+    "pose_angle",
+    "pose_angles",
+    "read_input",
+    "read_input_text",
+    "tuned_controllers_text",
 ]
+
+__getattr__ = lazy_exports(__name__, {
+    "CONFIG_FILE": "sources",
+    "ControllerConfig": "controllers",
+    "DEFAULT_ACCELERATION": "limits",
+    "ExecutionConfig": "controllers",
+    "Goal": "goals",
+    "Group": "srdf",
+    "JointGoal": "goals",
+    "JointLimit": "limits",
+    "MAX_MAGNITUDE": "fields",
+    "MAX_SEED": "tasks",
+    "MIN_SCALING": "tasks",
+    "NamedGoal": "goals",
+    "PLANNERS": "planners",
+    "PackagePath": "xacro",
+    "PoseGoal": "goals",
+    "RobotConfig": "robot_config",
+    "SHIFT_AXES": "goals",
+    "ShiftGoal": "goals",
+    "Start": "goals",
+    "StartFrom": "goals",
+    "StepSpec": "tasks",
+    "TaskFile": "tasks",
+    "angle": "fields",
+    "check_carried": "embed",
+    "check_joint_units": "joint_units",
+    "check_keys": "fields",
+    "coordinate": "fields",
+    "default_controller": "controllers",
+    "expression": "fields",
+    "load_robot_config": "robot_config",
+    "load_task": "tasks",
+    "load_yaml": "fields",
+    "mapping": "fields",
+    "number": "fields",
+    "parse_controllers": "controllers",
+    "parse_xacro_args": "xacro",
+    "parse_yaml": "fields",
+    "pose_angle": "fields",
+    "pose_angles": "fields",
+    "read_input": "fields",
+    "read_input_text": "fields",
+    "tuned_controllers_text": "controllers_write",
+})

@@ -1,13 +1,106 @@
 """ros2_control as MoveIt drives it: the JointTrajectoryController, simulated hardware, and its tolerances."""
 
-from .check.recording import check_recording, uses_velocities
-from .check.report import CheckReport, CycleCheck, StepCheck
-from .controller import Disturbance, ExecutionReport, simulate
-from .goal_validation import validate_goal
-from .plants import PLANTS, make_plant
-from .results import ExecutionResult, Violation
+from typing import TYPE_CHECKING
+
+from .._faces import lazy_exports
+
+if TYPE_CHECKING:
+    from .check import SCAN_ROWS, CheckReport, CycleCheck, SampleSource, StepCheck, check_recording, uses_velocities
+    from .controller import Disturbance, ExecutionReport, simulate
+    from .goal_validation import validate_goal
+    from .margins import merged_margins
+    from .plants import (
+        PLANTS,
+        Plant,
+        PlantFit,
+        RecordedStep,
+        fit_plant,
+        make_plant,
+        pid_gains,
+        pid_interface,
+        pid_parameters,
+    )
+    from .published import controller_states
+    from .quality import JointTracking, merged_tracking
+    from .results import ExecutionResult, ExecutionSummary, Violation
+    from .step_tracking import recorded_tracking, sample_index, simulated_tracking
+    from .tolerances import in_controller_order, position_error
+    from .tuning import Gains, JointSetup, JointTuning, tune_joint
 
 __all__ = [
-    "PLANTS", "CheckReport", "CycleCheck", "Disturbance", "ExecutionReport", "ExecutionResult", "StepCheck",
-    "Violation", "check_recording", "make_plant", "simulate", "uses_velocities", "validate_goal",
+    "CheckReport",
+    "CycleCheck",
+    "Disturbance",
+    "ExecutionReport",
+    "ExecutionResult",
+    "ExecutionSummary",
+    "Gains",
+    "JointSetup",
+    "JointTracking",
+    "JointTuning",
+    "PLANTS",
+    "Plant",
+    "PlantFit",
+    "RecordedStep",
+    "SCAN_ROWS",
+    "SampleSource",
+    "StepCheck",
+    "Violation",
+    "check_recording",
+    "controller_states",
+    "fit_plant",
+    "in_controller_order",
+    "make_plant",
+    "merged_margins",
+    "merged_tracking",
+    "pid_gains",
+    "pid_interface",
+    "pid_parameters",
+    "position_error",
+    "recorded_tracking",
+    "sample_index",
+    "simulate",
+    "simulated_tracking",
+    "tune_joint",
+    "uses_velocities",
+    "validate_goal",
 ]
+
+__getattr__ = lazy_exports(__name__, {
+    "CheckReport": "check",
+    "CycleCheck": "check",
+    "Disturbance": "controller",
+    "ExecutionReport": "controller",
+    "ExecutionResult": "results",
+    "ExecutionSummary": "results",
+    "Gains": "tuning",
+    "JointSetup": "tuning",
+    "JointTracking": "quality",
+    "JointTuning": "tuning",
+    "PLANTS": "plants",
+    "Plant": "plants",
+    "PlantFit": "plants",
+    "RecordedStep": "plants",
+    "SCAN_ROWS": "check",
+    "SampleSource": "check",
+    "StepCheck": "check",
+    "Violation": "results",
+    "check_recording": "check",
+    "controller_states": "published",
+    "fit_plant": "plants",
+    "in_controller_order": "tolerances",
+    "make_plant": "plants",
+    "merged_margins": "margins",
+    "merged_tracking": "quality",
+    "pid_gains": "plants",
+    "pid_interface": "plants",
+    "pid_parameters": "plants",
+    "position_error": "tolerances",
+    "recorded_tracking": "step_tracking",
+    "sample_index": "step_tracking",
+    "simulate": "controller",
+    "simulated_tracking": "step_tracking",
+    "tune_joint": "tuning",
+    "uses_velocities": "check",
+    "validate_goal": "goal_validation",
+})

@@ -21,7 +21,7 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from ..config.controllers import ControllerConfig, ExecutionConfig
+from ..config import ControllerConfig, ExecutionConfig
 from ..errors import InputError, UsageError, known
 from ..trajectory import PointBefore, sample
 from ..types import JointTrajectory, frozen_array

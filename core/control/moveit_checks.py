@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from ..config.controllers import ExecutionConfig
+from ..config import ExecutionConfig
 from .results import START_STATE_INVALID, ToleranceReport, Violation, result_of
 from .tolerances import position_error
 

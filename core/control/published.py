@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config.controllers import ControllerConfig
+from ..config import ControllerConfig
 from ..types import ControllerStates, PointSeries
 from .controller import ExecutionReport
 from .tolerances import velocity_error_computable

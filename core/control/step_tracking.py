@@ -18,11 +18,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config.controllers import ControllerConfig
+from ..config import ControllerConfig
 from ..trajectory import PointBefore, sample
 from ..types import JointTrajectory
-from .check.report import CheckReport, CycleCheck, StepCheck
-from .check.samples import SampleSource
+from .check import CheckReport, CycleCheck, SampleSource, StepCheck
 from .quality import JointTracking, tracking
 from .results import SUCCESSFUL
 from .tolerances import in_controller_order, position_error

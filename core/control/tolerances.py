@@ -14,7 +14,7 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from ..config.controllers import ControllerConfig
+from ..config import ControllerConfig
 from ..errors import InputError, UnknownName
 from ..trajectory import shortest_angular_distance
 from ..types import JointTrajectory

@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from .plants.responses import Response, measure, simulate_responses
+from .plants import Response, measure, simulate_responses
 
 __all__ = ["BANDWIDTH_PER_RATE", "Gains", "JointSetup", "JointTuning", "Stage", "tune_joint"]
 

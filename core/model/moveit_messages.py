@@ -16,8 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config.fields import MAX_MAGNITUDE, check_keys, coordinate, mapping, number
-from ..config.xacro import PackagePath
+from ..config import MAX_MAGNITUDE, PackagePath, check_keys, coordinate, mapping, number
 from ..errors import ConfigError, UnknownName
 from ..types import Shape
 from .poses import pose_matrix

@@ -37,10 +37,20 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config.fields import MAX_MAGNITUDE, check_keys, coordinate, load_yaml, mapping, number, read_input
-from ..config.goals import JointGoal, PoseGoal
-from ..config.planners import PLANNERS
-from ..config.tasks import MIN_SCALING, StepSpec
+from ..config import (
+    MAX_MAGNITUDE,
+    MIN_SCALING,
+    PLANNERS,
+    JointGoal,
+    PoseGoal,
+    StepSpec,
+    check_keys,
+    coordinate,
+    load_yaml,
+    mapping,
+    number,
+    read_input,
+)
 from ..errors import ConfigError, known
 from .moveit_messages import attached_object, header_frame, point, pose, quaternion, robot_state, yaml_list
 from .poses import pose_matrix

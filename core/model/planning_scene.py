@@ -46,8 +46,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config.fields import check_keys, mapping, number
-from ..config.xacro import PackagePath
+from ..config import PackagePath, check_keys, mapping, number
 from ..errors import ConfigError, UnknownName
 from ..types import CollisionObject, Frame
 from .moveit_messages import (
@@ -73,7 +72,7 @@ from .scene import (
     resolve_frames,
 )
 
-__all__ = ["attach_request_objects", "planning_scene"]
+__all__ = ["attach_request_objects", "read_planning_scene"]
 
 logger = logging.getLogger(__name__)
 
@@ -104,7 +103,7 @@ class _Objects:
                        subframes={i: tuple(f.name for f in subs) for i, (_, subs) in groups})
 
 
-def planning_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
+def read_planning_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
     """Return the scene a PlanningScene message (already parsed from YAML at `path`) describes."""
     source = str(path)
     check_keys(top, PLANNING_SCENE_KEYS, source)

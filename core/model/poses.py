@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
-from ..config.fields import MAX_MAGNITUDE, number
+from ..config import MAX_MAGNITUDE, number
 from ..errors import ConfigError
 
 __all__ = ["pose_matrix", "vector"]

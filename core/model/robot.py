@@ -18,8 +18,7 @@ import numpy.typing as npt
 import pinocchio as pin
 from numpy.typing import NDArray
 
-from ..config.robot_config import RobotConfig
-from ..config.srdf import Group
+from ..config import Group, RobotConfig
 from ..errors import ConfigError, UnknownName
 from ..types import Frame, TfSamples
 

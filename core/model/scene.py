@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config.fields import MAX_MAGNITUDE, check_keys, mapping, number, pose_angles
+from ..config import MAX_MAGNITUDE, check_keys, mapping, number, pose_angles
 from ..errors import ConfigError, FrameNotFound
 from ..types import CollisionObject, Frame, Shape
 from .poses import pose_matrix, vector

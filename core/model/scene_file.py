@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..config.fields import load_yaml, mapping
-from .planning_scene import planning_scene
+from ..config import load_yaml, mapping
+from .planning_scene import read_planning_scene
 from .robot import Robot
 from .scene import PLANNING_SCENE_KEYS, Scene, moveplan_scene
 
@@ -16,5 +16,5 @@ def load_scene(path: Path, robot: Robot) -> Scene:
     """Return the scene in a moveplan scene file or a PlanningScene YAML, resolved against `robot`'s links."""
     top = mapping(load_yaml(path), str(path))
     if PLANNING_SCENE_KEYS & set(top):
-        return planning_scene(top, path, robot)
+        return read_planning_scene(top, path, robot)
     return moveplan_scene(top, path, robot)

@@ -7,3 +7,128 @@ executed file), `inspection` (inspect_file), `benchmark` (run_benchmark, summari
 (the --plot files). Nothing is imported
 here, so that a command loads only what it runs (execute never loads OMPL).
 """
+
+from typing import TYPE_CHECKING
+
+from .._faces import lazy_exports
+
+if TYPE_CHECKING:
+    from .benchmark import Run, find_problems, plot_benchmark, run_benchmark, summarize, write_csv
+    from .execution import CheckRequest, ExecuteRequest, PlanExecution, check, execute
+    from .inspection import Inspection, inspect_file
+    from .plan import PlanResult, plan_to_file
+    from .plots import check_plot_path, check_plotted, execute_plotted, write_plan_plot, write_tuning_plot
+    from .report import check_document, execute_to_file, execution_document
+    from .request import PlanFlags, RobotSource, check_planning_time
+    from .robot_state import StateRequest, StateResult, state
+    from .session import (
+        ExecutionSettings,
+        MotionSettings,
+        cartesian_motion,
+        check_execution,
+        compose_scene,
+        execute_motion,
+        frame_in_root,
+        motion_checks,
+        plan_motion,
+        session_plan,
+        start_configuration,
+        write_session,
+    )
+    from .tuning import TuneRequest, TuneResult, tune, tuning_document
+
+__all__ = [
+    "CheckRequest",
+    "ExecuteRequest",
+    "ExecutionSettings",
+    "Inspection",
+    "MotionSettings",
+    "PlanExecution",
+    "PlanFlags",
+    "PlanResult",
+    "RobotSource",
+    "Run",
+    "StateRequest",
+    "StateResult",
+    "TuneRequest",
+    "TuneResult",
+    "cartesian_motion",
+    "check",
+    "check_document",
+    "check_execution",
+    "check_planning_time",
+    "check_plot_path",
+    "check_plotted",
+    "compose_scene",
+    "execute",
+    "execute_motion",
+    "execute_plotted",
+    "execute_to_file",
+    "execution_document",
+    "find_problems",
+    "frame_in_root",
+    "inspect_file",
+    "motion_checks",
+    "plan_motion",
+    "plan_to_file",
+    "plot_benchmark",
+    "run_benchmark",
+    "session_plan",
+    "start_configuration",
+    "state",
+    "summarize",
+    "tune",
+    "tuning_document",
+    "write_csv",
+    "write_plan_plot",
+    "write_session",
+    "write_tuning_plot",
+]
+
+__getattr__ = lazy_exports(__name__, {
+    "CheckRequest": "execution",
+    "ExecuteRequest": "execution",
+    "ExecutionSettings": "session",
+    "Inspection": "inspection",
+    "MotionSettings": "session",
+    "PlanExecution": "execution",
+    "PlanFlags": "request",
+    "PlanResult": "plan",
+    "RobotSource": "request",
+    "Run": "benchmark",
+    "StateRequest": "robot_state",
+    "StateResult": "robot_state",
+    "TuneRequest": "tuning",
+    "TuneResult": "tuning",
+    "cartesian_motion": "session",
+    "check": "execution",
+    "check_document": "report",
+    "check_execution": "session",
+    "check_planning_time": "request",
+    "check_plot_path": "plots",
+    "check_plotted": "plots",
+    "compose_scene": "session",
+    "execute": "execution",
+    "execute_motion": "session",
+    "execute_plotted": "plots",
+    "execute_to_file": "report",
+    "execution_document": "report",
+    "find_problems": "benchmark",
+    "frame_in_root": "session",
+    "inspect_file": "inspection",
+    "motion_checks": "session",
+    "plan_motion": "session",
+    "plan_to_file": "plan",
+    "plot_benchmark": "benchmark",
+    "run_benchmark": "benchmark",
+    "session_plan": "session",
+    "start_configuration": "session",
+    "state": "robot_state",
+    "summarize": "benchmark",
+    "tune": "tuning",
+    "tuning_document": "tuning",
+    "write_csv": "benchmark",
+    "write_plan_plot": "plots",
+    "write_session": "session",
+    "write_tuning_plot": "plots",
+})

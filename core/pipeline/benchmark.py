@@ -24,11 +24,11 @@ from typing import Any
 
 import numpy as np
 
-from ..bag.container.writer import atomic_file
+from ..bag import atomic_file
 from ..errors import ConfigError, InputError, MoveplanError, NoPlan, UsageError
 from .request import RobotSource
 
-__all__ = ["STAGES", "Problem", "Run", "find_problems", "plot", "run_benchmark", "summarize", "write_csv"]
+__all__ = ["STAGES", "Problem", "Run", "find_problems", "plot_benchmark", "run_benchmark", "summarize", "write_csv"]
 
 logger = logging.getLogger(__name__)
 
@@ -185,7 +185,7 @@ def _worker(robot: Path | RobotSource, problems: tuple[Problem, ...], planner: s
     """Run every problem with one planner and seed, and put each run on `results`."""
     key = (planner, seed)
     try:
-        from ..config.robot_config import load_robot_config
+        from ..config import load_robot_config
 
         config = robot.load() if isinstance(robot, RobotSource) else load_robot_config(robot)
         with tempfile.TemporaryDirectory(prefix="moveplan-benchmark-") as folder:
@@ -208,8 +208,8 @@ def _solve(problem: Problem, config: Any, planner: str, seed: int, budget: tuple
 
     `budget` is the search's planning time and wall-clock timeout.
     """
-    from ..bag.plan_writer import write_plan
-    from ..config.tasks import load_task
+    from ..bag import write_plan
+    from ..config import load_task
     from . import plan as pipeline
 
     began = time.perf_counter()
@@ -286,7 +286,7 @@ def write_csv(runs: Iterable[Run], path: Path) -> None:
         text.detach()  # the stream is atomic_file's to close
 
 
-def plot(runs: Iterable[Run], path: Path) -> None:
+def plot_benchmark(runs: Iterable[Run], path: Path) -> None:
     """Write a PNG of the distributions of search and total times, one panel per scenario (as `write_csv`)."""
     import matplotlib
 

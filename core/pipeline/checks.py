@@ -26,13 +26,19 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from ..collision import CollisionChecker, MotionChecker, SphereFilter, setup_clock
-from ..collision.checker import GeometryMode
-from ..collision.kernel_cache import kernels_cached
-from ..collision.motion import hull_checker, sphere_filter
-from ..collision.sphere_filter import MAYBE, kernels_loaded
-from ..model.robot import Robot
-from ..model.scene import Scene
+from ..collision import (
+    MAYBE,
+    CollisionChecker,
+    GeometryMode,
+    MotionChecker,
+    SphereFilter,
+    build_sphere_filter,
+    hull_checker,
+    kernels_cached,
+    kernels_loaded,
+    setup_clock,
+)
+from ..model import Robot, Scene
 from ..trajectory import interpolate
 
 __all__ = ["FILTER_AFTER_STATES", "FILTER_AFTER_STATES_UNCOMPILED", "filter_threshold", "problem_checks"]
@@ -61,7 +67,7 @@ def problem_checks(
     hulls = hull_checker(robot, checker, scene)
 
     def build() -> SphereFilter | None:
-        return sphere_filter(robot, checker, hulls, scene, base)
+        return build_sphere_filter(robot, checker, hulls, scene, base)
 
     if after <= 0 or kernels_loaded():
         return MotionChecker(robot, checker, base, build(), hulls)

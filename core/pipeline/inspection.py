@@ -12,8 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bag import BagSummary, PlanFile, summarize
-from ..bag.plan_file import END_STATES_KEY
+from ..bag import END_STATES_KEY, BagSummary, PlanFile, summarize
 from ..errors import InputError
 from ..trajectory import peak_rates
 from ..types import RobotState
@@ -93,9 +92,8 @@ def end_states(plan: PlanFile, path: Path) -> tuple[RobotState, ...]:
             pass
         logger.warning("%s: its recorded end states are unreadable; computing them from its robot config", path)
     # Imported here: reading the recorded states needs no kinematics (pinocchio).
-    from ..model.robot import Robot
-    from ..model.scene import empty_scene
-    from .state import robot_state
+    from ..model import Robot, empty_scene
+    from .robot_state import robot_state
 
     try:
         robot = Robot(plan_config(plan, path), plan.group)

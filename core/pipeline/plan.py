@@ -19,27 +19,28 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ..bag import write_plan
-from ..bag.plan_file import END_STATES_KEY
-from ..collision.motion import MotionChecker, exact_checks
-from ..config import JointGoal, NamedGoal, RobotConfig, StartFrom, load_robot_config, load_task
-from ..config.fields import read_input
-from ..config.joint_units import check_joint_units
-from ..config.limits import DEFAULT_ACCELERATION
+from ..bag import END_STATES_KEY, write_plan
+from ..collision import MotionChecker, exact_checks
+from ..config import (
+    DEFAULT_ACCELERATION,
+    JointGoal,
+    NamedGoal,
+    RobotConfig,
+    StartFrom,
+    check_joint_units,
+    load_robot_config,
+    load_task,
+    read_input,
+)
 from ..errors import InputError, MoveplanError, StartInCollision, StartOutsideLimits, UnknownName, UsageError
-from ..model.moveit_messages import known_joints
-from ..model.planning_scene import attach_request_objects
-from ..model.robot import Robot
-from ..model.scene import Scene, empty_scene
-from ..model.scene_file import load_scene
-from ..planning.goals import check_limits, joint_target
-from ..planning.search import seed_planner
+from ..model import Robot, Scene, attach_request_objects, empty_scene, known_joints, load_scene
+from ..planning import check_limits, joint_target, seed_planner
 from ..trajectory import sample
 from ..types import Plan, StepResult, TfSamples
 from ..version import moveplan_version
 from .checks import filter_threshold, problem_checks
 from .request import PlanFlags, PlanRequest, resolve_request
-from .state import RobotState, robot_state
+from .robot_state import RobotState, robot_state
 from .step import plan_step
 
 __all__ = ["PlanFlags", "PlanRequest", "PlanResult", "assemble", "plan", "plan_to_file", "resolve_request"]

@@ -13,11 +13,16 @@ from dataclasses import replace
 from pathlib import Path
 
 from .. import bag as recording
-from ..config.controllers import ControllerConfig, default_controller, parse_controllers
-from ..config.embed import check_carried
-from ..config.robot_config import RobotConfig, load_robot_config
-from ..config.sources import CONFIG_FILE
-from ..control.goal_validation import validate_goal
+from ..config import (
+    CONFIG_FILE,
+    ControllerConfig,
+    RobotConfig,
+    check_carried,
+    default_controller,
+    load_robot_config,
+    parse_controllers,
+)
+from ..control import validate_goal
 from ..errors import ConfigError, InputError
 
 __all__ = ["MAX_PLAN_S", "pick_controller", "plan_config", "plan_controller", "read_valid_plan"]

@@ -14,22 +14,17 @@ from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
 from .. import bag as recording
-from ..bag.cdr import messages as msgs
-from ..bag.execution_file import ExecutedStep, ExecutionWriter, execution_writer
-from ..config.controllers import ControllerConfig
-from ..control.controller import ExecutionReport
-from ..control.published import controller_states
-from ..control.quality import JointTracking, merged_tracking
-from ..control.results import ExecutionSummary
+from ..bag import ExecutedStep, ExecutionWriter, execution_writer, seconds_to_ns, stamps_ns
+from ..config import ControllerConfig
+from ..control import ExecutionReport, ExecutionSummary, JointTracking, controller_states, merged_tracking
 from ..errors import InputError
 from ..types import TfSamples
 
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from ..control.check.report import CheckReport
-    from ..control.results import ExecutionResult, Violation
-    from .execute import ExecuteRequest, PlanExecution
+    from ..control import CheckReport, ExecutionResult, Violation
+    from .execution import ExecuteRequest, PlanExecution
 
 __all__ = [
     "ExecutionRecorder", "check_document", "execute_to_file", "execution_document", "execution_recorder", "finite",
@@ -64,14 +59,14 @@ class ExecutionRecorder:
             ValueError: The report's output interface is not a JTC command interface.
 
         """
-        times_ns = msgs.stamps_ns(report.times_s)
+        times_ns = stamps_ns(report.times_s)
         for first in range(0, len(times_ns), _BLOCK_CYCLES):
             stop = first + _BLOCK_CYCLES
             block, block_ns = report.cycles(first, stop), times_ns[first:stop]
             states = controller_states(block, self._controller, self._start_ns + block_ns, block_ns)
             self._writer.add_cycles(ExecutedStep(block.joint_names, block.actual_positions, block.actual_velocities,
                                                  states))
-        self._start_ns += msgs.seconds_to_ns(report.duration_s)
+        self._start_ns += seconds_to_ns(report.duration_s)
 
     def finish(self, execution: PlanExecution) -> None:
         """Write the result document when the last step ended: that is when it was known; return None."""
@@ -108,7 +103,7 @@ def execute_to_file(request: ExecuteRequest, path: Path, distro: str = "jazzy") 
         InputError: The plan is unreadable or invalid, or `path` cannot be written.
 
     """
-    from .execute import execute
+    from .execution import execute
 
     return execute(request, lambda controller, plan, tf: execution_recorder(path, controller, plan, distro, tf))
 
@@ -117,7 +112,7 @@ def write_execution(path: Path, execution: PlanExecution, distro: str = "jazzy",
     """Write what `execution` did to `path` as a ROS 2 bag for `distro`, atomically; return None.
 
     Steps that carry their samples (reports built by hand) are written with `tf`, if given.
-    An execution from `pipeline.execute.execute` keeps only per-step summaries: it is run
+    An execution from `pipeline.execution.execute` keeps only per-step summaries: it is run
     again from its request straight into the file (the simulation is deterministic, so the
     file holds what it did); `execute_to_file` writes it in the one run.
 
@@ -164,7 +159,7 @@ def execution_document(execution: PlanExecution) -> dict[str, Any]:
                 "tracking": tracking_document(getattr(report, "tracking", {})),
             }
         )
-        start_ns += msgs.seconds_to_ns(report.duration_s)
+        start_ns += seconds_to_ns(report.duration_s)
     return _finite_numbers({
         **_verdict(execution.ok, execution.result, execution.violations, execution.margins),
         "controller": execution.controller.name,

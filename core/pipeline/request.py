@@ -13,6 +13,8 @@ from pathlib import Path
 from typing import TypeVar
 
 from ..config import (
+    MAX_MAGNITUDE,
+    MIN_SCALING,
     JointGoal,
     NamedGoal,
     PoseGoal,
@@ -24,10 +26,8 @@ from ..config import (
     TaskFile,
     load_robot_config,
 )
-from ..config.fields import MAX_MAGNITUDE
-from ..config.tasks import MIN_SCALING
 from ..errors import UsageError
-from ..model.moveit_request import MotionPlanRequest, load_motion_plan_request
+from ..model import MotionPlanRequest, load_motion_plan_request
 
 __all__ = ["PlanFlags", "PlanRequest", "RobotSource", "check_planning_time", "resolve_request"]
 

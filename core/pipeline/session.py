@@ -19,17 +19,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..bag import write_plan
-from ..collision.motion import MotionChecker
-from ..config import PoseGoal, RobotConfig, StepSpec
-from ..config.controllers import ControllerConfig, default_controller, parse_controllers
-from ..control.controller import ExecutionReport, simulate
-from ..control.goal_validation import validate_goal
-from ..control.plants import make_plant
+from ..collision import MotionChecker
+from ..config import ControllerConfig, PoseGoal, RobotConfig, StepSpec, default_controller, parse_controllers
+from ..control import ExecutionReport, make_plant, simulate, validate_goal
 from ..errors import ConfigError, NoPlan, StartInCollision, StartOutsideLimits
-from ..model.robot import Robot
-from ..model.scene import Scene, check_shape_count, first_repeated, resolve_frames
-from ..planning.goals import check_limits
-from ..planning.search import seed_planner
+from ..model import Robot, Scene, check_shape_count, first_repeated, resolve_frames
+from ..planning import check_limits, seed_planner
 from ..types import CollisionObject, Frame, JointTrajectory, Plan, StepResult
 from .checks import filter_threshold, problem_checks
 from .plan import assemble

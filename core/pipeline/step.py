@@ -16,16 +16,22 @@ from functools import partial
 import numpy as np
 from numpy.typing import NDArray
 
-from ..collision.motion import MotionChecker
-from ..collision.sphere_filter import SphereFilter
+from ..collision import MotionChecker, SphereFilter
 from ..config import JointGoal, NamedGoal, StepSpec
 from ..errors import GoalInCollision, PlanningFailed, PlanningTimeExceeded
-from ..model.kinematics import solve_ik
-from ..model.robot import Robot
-from ..model.scene import Scene
-from ..planning.cartesian import straight_line
-from ..planning.goals import check_limits, joint_target, orientation_tolerance, pose_error, tip_target
-from ..planning.search import PathResult, Validity, plan_path, repair_path
+from ..model import Robot, Scene, solve_ik
+from ..planning import (
+    PathResult,
+    Validity,
+    check_limits,
+    joint_target,
+    orientation_tolerance,
+    plan_path,
+    pose_error,
+    repair_path,
+    straight_line,
+    tip_target,
+)
 from ..timing import rest_to_rest, time_parameterize
 from ..types import JointTrajectory, StepResult
 from .request import PlanRequest

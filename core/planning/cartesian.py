@@ -18,8 +18,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ..errors import GoalUnreachable
-from ..model.kinematics import solve_ik
-from ..model.robot import Robot
+from ..model import Robot, solve_ik
 from ..trajectory import interpolate
 from ..types import frozen_array
 from .goals import pose_error

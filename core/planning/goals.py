@@ -18,13 +18,9 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
-from ..config.goals import JointGoal, NamedGoal, PoseGoal, ShiftGoal
+from ..config import JointGoal, NamedGoal, PoseGoal, ShiftGoal
 from ..errors import ConfigError, GoalOutsideLimits, OutsideLimits, UnknownName, UsageError
-from ..model.kinematics import solve_ik
-from ..model.moveit_request import PositionGoal
-from ..model.poses import pose_matrix
-from ..model.robot import Robot
-from ..model.scene import Scene
+from ..model import PositionGoal, Robot, Scene, pose_matrix, solve_ik
 
 __all__ = [
     "check_limits", "joint_target", "named_state", "orientation_tolerance", "pose_error", "tip_target",

@@ -30,7 +30,7 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from ..collision import setup_clock
-from ..config.planners import PLANNERS
+from ..config import PLANNERS
 from ..errors import PlanningFailed, PlanningTimeExceeded, UsageError, known
 from ..types import frozen_array
 

@@ -1,5 +1,18 @@
 """Time parameterisation: a joint-space path timed within the velocity and acceleration limits."""
 
-from .parameterize import rest_to_rest, time_parameterize
+from typing import TYPE_CHECKING
 
-__all__ = ["rest_to_rest", "time_parameterize"]
+from .._faces import lazy_exports
+
+if TYPE_CHECKING:
+    from .parameterize import rest_to_rest, time_parameterize
+
+__all__ = [
+    "rest_to_rest",
+    "time_parameterize",
+]
+
+__getattr__ = lazy_exports(__name__, {
+    "rest_to_rest": "parameterize",
+    "time_parameterize": "parameterize",
+})

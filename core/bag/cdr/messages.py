@@ -30,7 +30,7 @@ __all__ = [
     "quaternions_xyzw",
     "seconds_to_ns",
     "stamps_ns",
-    "string",
+    "string_message",
     "tf_message",
     "time_msg",
     "trajectory_from_message",
@@ -62,7 +62,7 @@ def time_msg(stamp_ns: int) -> Message:
     return {"sec": sec, "nanosec": nanosec}
 
 
-def string(text: str) -> Message:
+def string_message(text: str) -> Message:
     """Return a std_msgs/String holding `text`."""
     return {"data": text}
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-from ...config.fields import load_yaml
+from ...config import load_yaml
 from ...errors import InputError
 
 __all__ = ["MCAP_MAGIC", "SQLITE_HEADER", "BagFile", "Storage", "bag_files", "check_regular", "split_order"]

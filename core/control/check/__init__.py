@@ -6,7 +6,31 @@ judged window by window with the controller's own rules (cycles, windows), and t
 gathered (verdicts) into the report (report).
 """
 
-from .recording import check_recording, uses_velocities
-from .report import CheckReport, CycleCheck, StepCheck
+from typing import TYPE_CHECKING
 
-__all__ = ["CheckReport", "CycleCheck", "StepCheck", "check_recording", "uses_velocities"]
+from ..._faces import lazy_exports
+
+if TYPE_CHECKING:
+    from .recording import check_recording, uses_velocities
+    from .report import CheckReport, CycleCheck, StepCheck
+    from .samples import SCAN_ROWS, SampleSource
+
+__all__ = [
+    "CheckReport",
+    "CycleCheck",
+    "SCAN_ROWS",
+    "SampleSource",
+    "StepCheck",
+    "check_recording",
+    "uses_velocities",
+]
+
+__getattr__ = lazy_exports(__name__, {
+    "CheckReport": "report",
+    "CycleCheck": "report",
+    "SCAN_ROWS": "samples",
+    "SampleSource": "samples",
+    "StepCheck": "report",
+    "check_recording": "recording",
+    "uses_velocities": "recording",
+})

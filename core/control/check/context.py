@@ -6,7 +6,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
-from ...config.controllers import ControllerConfig, ExecutionConfig
+from ...config import ControllerConfig, ExecutionConfig
 from ...types import JointTrajectory
 from ..tolerances import SegmentTolerances, in_controller_order, segment_tolerances, velocity_error_computable
 from .alignment import ZONE_RAD, StepProfile

@@ -32,7 +32,7 @@ import math
 from collections.abc import Iterable, Sequence
 from typing import Literal
 
-from ...config.controllers import ControllerConfig, ExecutionConfig
+from ...config import ControllerConfig, ExecutionConfig
 from ...errors import InputError, UsageError
 from ...types import JointStateSeries
 from ..tolerances import velocity_error_computable

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 
-from ...config.controllers import ControllerConfig
+from ...config import ControllerConfig
 from ...errors import UsageError, known
 from .base import Plant
 from .lag import LagPlant

@@ -9,7 +9,7 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
-from ...config.controllers import ControllerConfig
+from ...config import ControllerConfig
 from ...errors import UsageError, known
 from ..tolerances import position_error
 from .base import Plant, State

@@ -6,7 +6,26 @@ sized per joint, step lines, notes, PNG files). matplotlib is imported inside th
 that draw, so importing these modules loads none of it.
 """
 
-from .commands import check_plot_path, check_plotted, execute_plotted, write_plan_plot
-from .tuning import write_tuning_plot
+from typing import TYPE_CHECKING
 
-__all__ = ["check_plot_path", "check_plotted", "execute_plotted", "write_plan_plot", "write_tuning_plot"]
+from ..._faces import lazy_exports
+
+if TYPE_CHECKING:
+    from .commands import check_plot_path, check_plotted, execute_plotted, write_plan_plot
+    from .tuning import write_tuning_plot
+
+__all__ = [
+    "check_plot_path",
+    "check_plotted",
+    "execute_plotted",
+    "write_plan_plot",
+    "write_tuning_plot",
+]
+
+__getattr__ = lazy_exports(__name__, {
+    "check_plot_path": "commands",
+    "check_plotted": "commands",
+    "execute_plotted": "commands",
+    "write_plan_plot": "commands",
+    "write_tuning_plot": "tuning",
+})

@@ -19,12 +19,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...bag import PlanFile
-from ...control.check.samples import SCAN_ROWS, SampleSource
-from ...control.results import Violation
-from ...control.tolerances import in_controller_order, position_error
+from ...control import SCAN_ROWS, SampleSource, Violation, in_controller_order, position_error
 from ...errors import InputError, UsageError
 from ...trajectory import PointBefore, peak_rates, sample
-from ..execute import (
+from ..execution import (
     CheckedRecording,
     CheckRequest,
     ExecuteRequest,
@@ -38,10 +36,8 @@ from .figures import PlanCurves, plan_figure, write_png
 from .tracking import TrackedStep, Tracking, ViolationMark, tracking_figure
 
 if TYPE_CHECKING:
-    from ...config.controllers import ControllerConfig
-    from ...config.robot_config import RobotConfig
-    from ...control.check.report import CheckReport, StepCheck
-    from ...control.controller import ExecutionReport
+    from ...config import ControllerConfig, RobotConfig
+    from ...control import CheckReport, ExecutionReport, StepCheck
     from ...types import JointTrajectory, TfSamples
 
 __all__ = [

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ...bag.container.writer import atomic_file
+from ...bag import atomic_file
 from ...types import frozen_array
 
 if TYPE_CHECKING:

@@ -6,9 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ...bag.container.writer import atomic_file
-from ...control.tuning import JointTuning
-from ..tune import TuneResult
+from ...bag import atomic_file
+from ...control import JointTuning
+from ..tuning import TuneResult
 
 __all__ = ["write_tuning_plot"]
 

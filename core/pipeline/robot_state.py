@@ -14,15 +14,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config import JointGoal, NamedGoal, RobotConfig
-from ..config.fields import mapping, parse_yaml
-from ..config.joint_units import check_joint_units
+from ..config import JointGoal, NamedGoal, RobotConfig, check_joint_units, mapping, parse_yaml
 from ..errors import FrameNotFound, InputError, OutsideLimits, UnknownName, UsageError
-from ..model.planning_scene import planning_scene
-from ..model.robot import Robot
-from ..model.scene import PLANNING_SCENE_KEYS, Scene, empty_scene, moveplan_scene
-from ..model.scene_file import load_scene
-from ..planning.goals import joint_target
+from ..model import PLANNING_SCENE_KEYS, Robot, Scene, empty_scene, load_scene, moveplan_scene, read_planning_scene
+from ..planning import joint_target
 from ..trajectory import sample
 from ..types import LinkPose, RobotState
 from .request import RobotSource
@@ -202,7 +197,7 @@ def _plan_scene(scene: Path | None, attachments: dict[str, bytes], path: Path, r
     except UnicodeDecodeError:
         raise InputError(f"{shown}: not UTF-8 text") from None
     if PLANNING_SCENE_KEYS & set(top):
-        return planning_scene(_without_mesh_files(top), shown, robot)
+        return read_planning_scene(_without_mesh_files(top), shown, robot)
     return moveplan_scene({"frames": top.get("frames")}, shown, robot)
 
 

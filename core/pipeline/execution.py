@@ -18,24 +18,29 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import bag as recording
-from ..bag.jointstates import open_joint_states
-from ..config import JointGoal
-from ..config.controllers import ControllerConfig, ExecutionConfig
-from ..config.joint_units import check_joint_units
-from ..control.check.recording import SampleSource, check_recording, uses_velocities
-from ..control.check.report import CheckReport
-from ..control.margins import merged_margins
-from ..control.quality import JointTracking, merged_tracking
-from ..control.results import ExecutionResult, ExecutionSummary, Violation
-from ..control.step_tracking import recorded_tracking, simulated_tracking
+from ..bag import open_joint_states
+from ..config import ControllerConfig, ExecutionConfig, JointGoal, check_joint_units
+from ..control import (
+    CheckReport,
+    ExecutionResult,
+    ExecutionSummary,
+    JointTracking,
+    SampleSource,
+    Violation,
+    check_recording,
+    merged_margins,
+    merged_tracking,
+    recorded_tracking,
+    simulated_tracking,
+    uses_velocities,
+)
 from ..errors import InputError, UnknownName
 from ..types import TfSamples
 from .plan_files import plan_config, plan_controller, read_valid_plan
 
 if TYPE_CHECKING:
-    from ..control.controller import Disturbance, ExecutionReport
-    from ..control.plants import Plant
-    from ..model.robot import Robot
+    from ..control import Disturbance, ExecutionReport, Plant
+    from ..model import Robot
 
 _TF_RATE_HZ = 30.0
 
@@ -171,7 +176,7 @@ def execute(
 
     """
     # Imported here: check-tolerances shares this module and simulates nothing.
-    from ..control.plants import make_plant
+    from ..control import make_plant
 
     plan = read_valid_plan(request.plan)
     config = plan_config(plan, request.plan)
@@ -184,7 +189,7 @@ def execute(
     robot = None
     if record is not None and link_poses:
         # pinocchio is imported here, not at the top: check-tolerances shares this module and needs no kinematics.
-        from ..model.robot import Robot
+        from ..model import Robot
 
         robot = Robot(config, plan.group)
     steps: list[StepExecution] = []
@@ -223,7 +228,7 @@ def _simulated_steps(
 
     Each step is one goal, sent from where the simulated robot ended the one before.
     """
-    from ..control.controller import Disturbance, simulate
+    from ..control import Disturbance, simulate
 
     start = _start_positions(request, plan, controller)
     goal = np.array([controller.goal_tolerance[j] for j in controller.joints])

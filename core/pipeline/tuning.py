@@ -16,17 +16,24 @@ from typing import Any, cast
 import numpy as np
 
 from .. import bag as recording
-from ..bag.container.writer import staged_file
-from ..config.controllers import ControllerConfig
-from ..config.controllers_write import tuned_controllers_text
-from ..config.fields import read_input_text
-from ..control.plants import pid_gains, pid_interface, pid_parameters
-from ..control.plants.fit import PlantFit, RecordedStep, fit_plant
-from ..control.step_tracking import sample_index
-from ..control.tolerances import in_controller_order
-from ..control.tuning import Gains, JointSetup, JointTuning, tune_joint
+from ..bag import staged_file
+from ..config import ControllerConfig, read_input_text, tuned_controllers_text
+from ..control import (
+    Gains,
+    JointSetup,
+    JointTuning,
+    PlantFit,
+    RecordedStep,
+    fit_plant,
+    in_controller_order,
+    pid_gains,
+    pid_interface,
+    pid_parameters,
+    sample_index,
+    tune_joint,
+)
 from ..errors import ConfigError, InputError, UsageError, known
-from .execute import (
+from .execution import (
     CheckedRecording,
     CheckRequest,
     ExecuteRequest,
