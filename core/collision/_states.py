@@ -4,7 +4,7 @@ The same computation as core/collision/certify.py `trajectory_states`, with the 
 core/trajectory.py `sample`; the peak rates come from timing's compiled twin, the numbers numpy's
 gives. numpy's version costs a tenth of a median MotionBenchMaker plan step in array calls on a
 few thousand numbers, this one a hundredth. The numbers agree to rounding
-(tests/test_certify_soundness.py); numpy's version is the reference, and the one used before the
+(tests/collision/test_certify_soundness.py); numpy's version is the reference, and the one used before the
 sphere filter (and numba) is loaded.
 """
 

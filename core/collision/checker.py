@@ -40,7 +40,7 @@ _HULLS: dict[tuple[str, tuple[float, ...]], coal.ConvexBase] = {}
 # The robot's own geometry by (URDF, config folder, package path, mode): reading its meshes costs
 # ~80 ms, and a benchmark builds a checker per problem for one robot.
 # Shapes closer than this count as touching. With no margin, coal's test as pinocchio asks it
-# called the Panda hand's convex hull free while it sank 62 um into a box (tests/test_collision.py);
+# called the Panda hand's convex hull free while it sank 62 um into a box (tests/collision/test_collision.py);
 # with a positive margin it finds that contact, and is no slower.
 _MARGIN_M = 1e-6
 _ROBOT_GEOMETRY: dict[tuple[str, str, tuple[Path, ...], str], pin.GeometryModel] = {}

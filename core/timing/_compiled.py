@@ -3,7 +3,7 @@
 numpy's versions spend a sixth of a median MotionBenchMaker plan step in array calls on a few
 hundred numbers and in plain Python loops. These repeat each of their floating-point operations
 in the same order (numba, like numpy, contracts nothing into fused multiply-adds), so a plan is
-byte for byte the same whichever runs; tests/test_timing_properties.py holds them together.
+byte for byte the same whichever runs; tests/timing/test_timing_properties.py holds them together.
 Imported only once the sphere filter has loaded numba (core/pipeline/step.py).
 """
 

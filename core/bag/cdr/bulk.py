@@ -3,7 +3,7 @@
 Each `*_cdr` function writes exactly the bytes the schema-driven encoder (core.bag.cdr.generic)
 makes of its dict builder's message in core.bag.cdr.messages, but with bulk float packing and
 templates patched per message: the generic encoder spends a Python call per float
-(tests/test_recording.py and tests/test_execution_file.py check every shipped distro). The
+(tests/bag/test_recording.py and tests/bag/test_execution_file.py check every shipped distro). The
 field layout is the same in every distro except control_msgs/JointTrajectoryControllerState,
 whose encoder reads it from the distro's schema.
 """

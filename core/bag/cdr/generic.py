@@ -2,7 +2,7 @@
 
 The encoder the `*_cdr` twins are measured against, and the one the few small messages
 (std_msgs/String, the scene's MarkerArray) take. It writes what mcap_ros2's encoder writes
-(tests/test_generic_cdr.py compares the two on every shipped type): a field left out takes
+(tests/bag/test_generic_cdr.py compares the two on every shipped type): a field left out takes
 its definition's default, else zero, "" or False; a missing nested message is written with
 its defaults; values are coerced with float(), int(), bool() and str(); a fixed-size array
 is padded with defaults or cut to its size, a bounded one cut to its bound; and

@@ -12,7 +12,7 @@ from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.config.substitutions import substitute
 from moveplan.core.errors import ConfigError
 
-PREFIXED_ARM = Path(__file__).parent / "data" / "controller_substitutions" / "prefixed_arm"
+PREFIXED_ARM = Path(__file__).parents[1] / "data" / "controller_substitutions" / "prefixed_arm"
 UR_JOINTS = ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
              "wrist_3_joint")
 PLAN = ROOT / "samples" / "recordings" / "tool_up_plan.mcap"  # a UR10e plan

@@ -20,7 +20,7 @@ from moveplan.core.bag.jointstates import (
 )
 from moveplan.core.errors import InputError
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 MSGS = ROOT / "core" / "bag" / "cdr" / "msgs" / "jazzy"
 SCHEMAS = {
     JOINT_STATE_TYPE: (MSGS / "sensor_msgs__msg__JointState.msg").read_bytes(),

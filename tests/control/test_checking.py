@@ -32,7 +32,7 @@ HOME = np.array([0.0, -np.pi / 2, -np.pi / 2, 0.0, 0.0, 0.0])
 PICK = HOME + np.array([1.0, 0.5, -0.8, 1.2, -1.0, 1.5])
 RATE = 250.0
 EXECUTION = ExecutionConfig()
-SCHEMA = (Path(__file__).resolve().parents[1] / "core/bag/cdr/msgs/jazzy/sensor_msgs__msg__JointState.msg")
+SCHEMA = (Path(__file__).resolve().parents[2] / "core/bag/cdr/msgs/jazzy/sensor_msgs__msg__JointState.msg")
 
 
 @dataclass(frozen=True)

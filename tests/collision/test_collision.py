@@ -62,7 +62,7 @@ def test_a_hull_sinking_a_fraction_of_a_millimetre_into_a_box_collides_as_its_me
 
 def test_a_robot_without_collision_geometry_plans(cli: Cli, tmp_path: Path) -> None:
     """A bare kinematic model (no <collision> anywhere) has nothing to collide: MoveIt plans it."""
-    source = Path(__file__).parent / "data" / "controller_substitutions" / "prefixed_arm"
+    source = Path(__file__).parents[1] / "data" / "controller_substitutions" / "prefixed_arm"
     shutil.copytree(source, tmp_path / "arm")
     urdf = tmp_path / "arm" / "arm.urdf.xacro"
     urdf.write_text(re.sub(r"<collision>.*?</collision>", "", urdf.read_text(), flags=re.S))

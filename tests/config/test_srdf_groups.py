@@ -15,7 +15,7 @@ from moveplan.core.config.urdf import parse_urdf
 from moveplan.core.errors import ConfigError, UnknownName
 
 # A PR2-like mobile manipulator: planar virtual joint named in groups, <link> groups, subgroups.
-PR2_LIKE = Path(__file__).parent / "data" / "srdf_groups" / "pr2_like"
+PR2_LIKE = Path(__file__).parents[1] / "data" / "srdf_groups" / "pr2_like"
 SRDF = (PR2_LIKE / "pr2_like.srdf").read_text()
 URDF_JOINTS = parse_urdf((PR2_LIKE / "pr2_like.urdf").read_text(), PR2_LIKE / "pr2_like.urdf")
 LEFT_ARM = ("l_shoulder_pan_joint", "l_shoulder_lift_joint", "l_wrist_roll_joint")

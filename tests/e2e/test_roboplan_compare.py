@@ -13,8 +13,8 @@ import numpy as np
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.model.robot import Robot
 
-BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
-MBM = Path(__file__).resolve().parent / "data" / "mbm"
+BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
+MBM = Path(__file__).resolve().parents[1] / "data" / "mbm"
 
 
 def _module(name: str):

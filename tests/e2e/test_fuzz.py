@@ -35,7 +35,7 @@ run by hand, MOVEPLAN_FUZZ_EXAMPLES=N runs N examples per test with random seeds
 (`--hypothesis-seed` replays one; a failure prints its @reproduce_failure blob), and
 MOVEPLAN_FUZZ_KEEP=DIR keeps the files of each test's last failing example in DIR/<test name>:
 
-    MOVEPLAN_FUZZ_EXAMPLES=500 MOVEPLAN_FUZZ_KEEP=/tmp/fuzz .venv/bin/python -m pytest tests/test_fuzz.py
+    MOVEPLAN_FUZZ_EXAMPLES=500 MOVEPLAN_FUZZ_KEEP=/tmp/fuzz .venv/bin/python -m pytest tests/e2e/test_fuzz.py
 """
 
 from __future__ import annotations
@@ -885,7 +885,7 @@ def test_a_damaged_db3_recording_or_bag_folder_is_judged_or_refused_in_one_line(
         elif level == "bytes":
             recording.write_bytes(data.draw(damaged_bytes(recording.read_bytes())).data)
         else:
-            metadata = yaml.safe_load((Path(__file__).parent / "data" / "db3" / "metadata.yaml").read_text())
+            metadata = yaml.safe_load((Path(__file__).parents[1] / "data" / "db3" / "metadata.yaml").read_text())
             information = metadata["rosbag2_bagfile_information"]
             information["relative_file_paths"] = ["run_0.db3"]
             information["files"] = information["files"][:1]

@@ -271,7 +271,7 @@ def test_a_benchmark_plot_that_fails_takes_its_csv_with_it(
     def full_disk(runs: object, path: Path) -> None:
         raise InputError(f"{path}: cannot write: No space left on device")
 
-    monkeypatch.setattr(bench, "plot", full_disk)
+    monkeypatch.setattr(bench, "plot_benchmark", full_disk)
     out = tmp_path / "out"
     out.mkdir()
     result = cli("benchmark", problems, "--robot", "panda", "--planner", "RRTConnect", "--csv", out / "runs.csv",
@@ -329,7 +329,7 @@ def test_a_signal_while_the_plot_is_drawn_leaves_no_output_and_exits_128_plus_si
         args: list[object] = ["tune-pid", SHIPPED_PLAN, "--controllers", SAMPLES / "ur10e_velocity_controllers.yaml",
                               "-o", out / "tuned.yaml", "--plot", out / "tuned.png"]
     else:
-        hook = ["moveplan.core.pipeline.benchmark", "plot"]
+        hook = ["moveplan.core.pipeline.benchmark", "plot_benchmark"]
         args = ["benchmark", problems, "--robot", "panda", "--planner", "RRTConnect", "--csv", out / "runs.csv",
                 "--plot", out / "times.png"]
     started = tmp_path / "started"

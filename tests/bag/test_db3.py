@@ -21,7 +21,7 @@ from moveplan.core.errors import InputError
 
 RECORDINGS = SAMPLES / "recordings"
 PLAN = RECORDINGS / "tool_up_plan.mcap"
-DATA = Path(__file__).resolve().parent / "data" / "db3"
+DATA = Path(__file__).resolve().parents[1] / "data" / "db3"
 JOINT_STATE = "sensor_msgs/msg/JointState"
 # Humble's rosbag2_storage_sqlite3 (schema version 3): SqliteStorage::initialize.
 HUMBLE_SCHEMA = """

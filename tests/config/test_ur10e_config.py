@@ -8,7 +8,7 @@ import pinocchio as pin
 import pytest
 import yaml
 
-CONFIG = Path(__file__).parents[1] / "configs/ur10e"
+CONFIG = Path(__file__).parents[2] / "configs/ur10e"
 URDF = CONFIG / "ur10e.urdf"
 SRDF = CONFIG / "ur10e.srdf"
 JOINTS = [

@@ -14,7 +14,7 @@ from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import ConfigError
 
 # Controller files of real MoveIt config packages, unchanged (sources in the folder's README).
-REALWORLD = Path(__file__).parent / "data" / "realworld_controllers"
+REALWORLD = Path(__file__).parents[1] / "data" / "realworld_controllers"
 
 URDF = """<?xml version="1.0"?>
 <robot name="arm">
