@@ -43,7 +43,7 @@ import pinocchio as pin
 import yaml
 from numpy.typing import NDArray
 
-from moveplan.core.collision.certify import reach, segment_states
+from moveplan.core.collision._certify import reach, segment_states
 from moveplan.core.collision.checker import CollisionChecker, coal_geometry
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.model.robot import Robot

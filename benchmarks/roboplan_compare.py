@@ -236,7 +236,7 @@ def _check_python(python: Path | None) -> None:
 
 def _checker(shared: Any, robot: Any, problem: Any, run: dict[str, Any]) -> tuple[Any, Any]:
     """Return moveplan's exact checker of the problem and its reach; warn if roboplan's scene disagrees on it."""
-    from moveplan.core.collision.certify import reach
+    from moveplan.core.collision._certify import reach
     from moveplan.core.collision.checker import CollisionChecker
 
     checker = CollisionChecker(robot, tuple(o for _, o in problem.objects), str(problem.scene), "exact")

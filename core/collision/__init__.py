@@ -5,6 +5,7 @@ from typing import TYPE_CHECKING
 from .._faces import lazy_exports
 
 if TYPE_CHECKING:
+    from ._setup_clock import add_setup_time, setup_time_spent
     from ._verdicts import MAYBE
     from .checker import CollisionChecker, GeometryMode
     from .kernel_cache import kernels_cached
@@ -17,11 +18,13 @@ __all__ = [
     "MAYBE",
     "MotionChecker",
     "SphereFilter",
+    "add_setup_time",
     "build_sphere_filter",
     "exact_checks",
     "hull_checker",
     "kernels_cached",
     "kernels_loaded",
+    "setup_time_spent",
 ]
 
 __getattr__ = lazy_exports(__name__, {
@@ -30,9 +33,11 @@ __getattr__ = lazy_exports(__name__, {
     "MAYBE": "_verdicts",
     "MotionChecker": "motion",
     "SphereFilter": "sphere_filter",
+    "add_setup_time": "_setup_clock",
     "build_sphere_filter": "motion",
     "exact_checks": "motion",
     "hull_checker": "motion",
     "kernels_cached": "kernel_cache",
     "kernels_loaded": "sphere_filter",
+    "setup_time_spent": "_setup_clock",
 })

@@ -25,7 +25,7 @@ __all__ = ["decode", "encode"]
 
 # The dataclasses an entry may hold: name -> (module under core/collision/, class). Fixed here, never
 # taken from a file: a name the table lacks is refused.
-_DATACLASSES = {"SphereSet": ("sphere_fit", "SphereSet"), "PairTable": ("pair_tables", "PairTable")}
+_DATACLASSES = {"SphereSet": ("_sphere_fit", "SphereSet"), "PairTable": ("_pair_tables", "PairTable")}
 _DTYPES = frozenset(np.dtype(t).str for t in ("<f8", "<f4", "<i8", "<i4", "<u8", "<u4", "|u1", "|i1", "|b1"))
 
 

@@ -32,7 +32,7 @@ def clearance(q: Any, model: Any, cap: float, scratch: Any) -> tuple[int, float]
     that, no point of the geometry the spheres enclose reaches an obstacle or another owner's
     geometry. Two owners' distance changes by at most the motion of one relative to the other,
     which only the joints on the tree path between them cause, each once, so the sum that bounds
-    a point's motion (core/collision/certify.py) bounds it too. Not CLEAR: as `judge` says,
+    a point's motion (core/collision/_certify.py) bounds it too. Not CLEAR: as `judge` says,
     COLLIDES if an inner ball proves it, else MAYBE.
     """
     rot, pos, world, iworld, owc, local, placed = scratch
@@ -82,7 +82,7 @@ def certify(values: Any, travel: Any, cap: float, floats: Any, ints: Any, head: 
     """Write per state of a motion (rows of `values`) its verdict and configuration; return how many spheres judged.
 
     `travel[k]` bounds how far any robot point moves from the first state to state k (non-decreasing,
-    core/collision/certify.py). A state CLEAR with clearance c proves every later state whose travel
+    core/collision/_certify.py). A state CLEAR with clearance c proves every later state whose travel
     is less than c beyond its own free under the spheres: those are not judged, only looked up in the
     distance tables (which need no kinematics), and read CLEAR if the tables say apart.
     """

@@ -1,6 +1,6 @@
 """The certified states of a timed trajectory, placed by compiled code (numba).
 
-The same computation as core/collision/certify.py `trajectory_states`, with the samples of
+The same computation as core/collision/_certify.py `trajectory_states`, with the samples of
 core/trajectory.py `sample`; the peak rates come from timing's compiled twin, the numbers numpy's
 gives. numpy's version costs a tenth of a median MotionBenchMaker plan step in array calls on a
 few thousand numbers, this one a hundredth. The numbers agree to rounding

@@ -3,7 +3,7 @@
 Building the filter loads its kernels in under a second when numba has cached them, and compiles
 them for 15-60 s when it has not (a fresh install, a new numba). A one-shot command asks first,
 so that it can stay with coal rather than pay a compilation a short plan does not need
-(core/pipeline/checks.py). Importing numba to ask would cost half a second itself, so the index
+(core/pipeline/_checks.py). Importing numba to ask would cost half a second itself, so the index
 files are looked up where numba keeps them, as numba.core.caching names them.
 
 An index is pickled, and unpickling a file runs whatever code it names. numba unpickles its own

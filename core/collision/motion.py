@@ -10,7 +10,7 @@ loses only the little space between a mesh and its hull.
 
 Certification checks a trajectory as the controller interpolates it, at states so
 close that no point of the robot moves more than `step_m` between two of them
-(core/collision/certify.py bounds that motion). The spheres skip the states a clearance
+(core/collision/_certify.py bounds that motion). The spheres skip the states a clearance
 proves free (core/collision/_kernels.py `certify`); coal decides the rest in one batch.
 """
 
@@ -27,7 +27,7 @@ from ..errors import ConfigError
 from ..model import Robot, Scene
 from ..trajectory import interpolate
 from ..types import JointTrajectory
-from . import certify
+from . import _certify as certify
 from .checker import CollisionChecker, GeometryMode
 from .sphere_filter import CLEAR, COLLIDES, MAYBE, SphereFilter, UnsupportedJoint
 
@@ -156,7 +156,7 @@ class MotionChecker:
 
     def first_collision_on_trajectory(self, trajectory: JointTrajectory) -> NDArray[np.float64] | None:
         """Return the first colliding state along the interpolated trajectory, or None if it is free."""
-        # The built filter places the states compiled; its stand-in (core/pipeline/checks.py) has no numba yet.
+        # The built filter places the states compiled; its stand-in (core/pipeline/_checks.py) has no numba yet.
         place = getattr(self.spheres, "trajectory_states", certify.trajectory_states)
         return self._first_collision(*place(trajectory, self.reach, CERTIFY_STEP_M))
 

@@ -4,10 +4,10 @@ Compiled with numba (imported only when a filter is built, so commands that do n
 never pay its start-up). One call checks a batch of configurations: forward kinematics
 of the joint tree, then per owner (link or attached object) its bounding ball first and
 its spheres only if that ball touches something. Link pairs whose distance depends on
-one or two joints are looked up in distance tables instead (core/collision/pair_tables.py). A
+one or two joints are looked up in distance tables instead (core/collision/_pair_tables.py). A
 state is "clear" only if no sphere touches an obstacle or another owner's sphere and
 every tabulated pair is apart; since the spheres enclose the real geometry
-(core/collision/sphere_fit.py), a clear state is collision-free. A state where a ball inside a
+(core/collision/_sphere_fit.py), a clear state is collision-free. A state where a ball inside a
 convex hull touches an obstacle or another link's inner ball, or a table says a pair
 overlaps, surely collides under the hulls. Anything else is "maybe": the caller asks coal.
 """
@@ -23,13 +23,13 @@ from numpy.typing import NDArray
 from ..errors import UnsupportedJoint
 from ..model import Robot
 from ..types import CollisionObject, JointTrajectory
-from . import certify
+from . import _certify as certify
 from ._cache import announce_compilation
+from ._inner_spheres import inner_spheres
+from ._pair_tables import PairTable, pair_tables
+from ._sphere_fit import SphereSet, fit_shape, robot_spheres
 from ._verdicts import CLEAR, COLLIDES, MAYBE
-from .inner_spheres import inner_spheres
 from .kernel_cache import kernels_cached
-from .pair_tables import PairTable, pair_tables
-from .sphere_fit import SphereSet, fit_shape, robot_spheres
 
 __all__ = ["CLEAR", "COLLIDES", "MAYBE", "SphereFilter", "UnsupportedJoint", "kernels_loaded"]
 
@@ -96,12 +96,13 @@ class SphereFilter:
         self.tabulated = tuple((t.upper, t.lower) for t in tables)
         world = [obj for obj in objects if not obj.link]
         check = _world_checks(names, owner_joint, world, allowed)
-        from ..timing import _compiled as timing_kernels  # the peak rates the states are placed by
+        # the peak rates the states are placed by, and the timing passes of a plan with a filter
+        from ..timing import compiled_fastest_speeds, compiled_quintic_peak_rates
         from . import _clearance, _states  # numba too: the certification walk, the states it walks
         from . import _kernels as sphere_kernels  # numba: compiled once, then loaded from its disk cache
 
-        self._kernels, self._clearance, self._states, self._timing = sphere_kernels, _clearance, _states, \
-            timing_kernels
+        self._kernels, self._clearance, self._states = sphere_kernels, _clearance, _states
+        self._peak_rates = compiled_quintic_peak_rates
         base = robot.neutral() if base is None else base
         inner = inner_spheres(model, hulls or geometry, robot.config.urdf)
         # Packed once: the kernels run thousands of times per search, and a call costs per argument.
@@ -123,9 +124,9 @@ class SphereFilter:
         still = np.zeros((2, robot.dof))
         self.trajectory_states(JointTrajectory(robot.joint_names, np.array([0.0, 1.0]), still, still, still),
                                np.ones(robot.dof), 1.0)
-        # A plan with a filter times its paths with the compiled passes too (core/pipeline/step.py).
-        timing_kernels.fastest_speeds(np.array([0.0, 1.0]), np.ones((3, 1)), np.zeros((3, 1)), np.array([True]),
-                                      np.ones(1), np.ones(1))
+        # A plan with a filter times its paths with the compiled passes too (core/pipeline/_step.py).
+        compiled_fastest_speeds(np.array([0.0, 1.0]), np.ones((3, 1)), np.zeros((3, 1)), np.array([True]),
+                                np.ones(1), np.ones(1))
         _kernels_loaded = True
 
     def classify(
@@ -157,7 +158,7 @@ class SphereFilter:
     def trajectory_states(
         self, trajectory: JointTrajectory, reach_m: NDArray[np.float64], step_m: float
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Return core/collision/certify.py `trajectory_states` (the same numbers to rounding), compiled.
+        """Return core/collision/_certify.py `trajectory_states` (the same numbers to rounding), compiled.
 
         Placing a trajectory's certified states costs numpy a tenth of a median plan step.
         """
@@ -165,7 +166,7 @@ class SphereFilter:
             return certify.trajectory_states(trajectory, reach_m, step_m)
         knots, p, v, a = (_plain(x) for x in (trajectory.times_s, trajectory.positions, trajectory.velocities,
                                               trajectory.accelerations))
-        peak_v, peak_a = self._timing.quintic_peak_rates(knots, p, v, a)
+        peak_v, peak_a = self._peak_rates(knots, p, v, a)
         certify.state_count(float(peak_v @ reach_m) * float(knots[-1] - knots[0]), step_m)  # before numba places them
         return self._states.trajectory_states(knots, p, v, a, peak_v, peak_a, _plain(reach_m), step_m, certify.PIECE)
 

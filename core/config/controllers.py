@@ -20,8 +20,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
+from ._substitutions import load_substituted_yaml
 from .fields import boolean, check_keys, load_yaml, mapping, number, string_list
-from .substitutions import load_substituted_yaml
 
 __all__ = [
     "MAX_UPDATE_RATE_HZ", "ControllerConfig", "ExecutionConfig", "default_controller", "parse_controllers",

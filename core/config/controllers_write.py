@@ -18,7 +18,7 @@ from pathlib import Path
 import yaml
 
 from ..errors import ConfigError
-from .substitutions import substitute
+from ._substitutions import substitute
 
 __all__ = ["tuned_controllers_text", "yaml_float"]
 

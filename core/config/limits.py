@@ -9,9 +9,9 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
+from ._urdf import MOVABLE_JOINT_TYPES, UrdfJoint
 from .fields import MAX_MAGNITUDE, boolean, check_keys, load_yaml, mapping, number
 from .tasks import MIN_SCALING
-from .urdf import MOVABLE_JOINT_TYPES, UrdfJoint
 
 __all__ = ["DEFAULT_ACCELERATION", "DEFAULT_SOURCE", "JointLimit", "merge_limits", "parse_joint_limits"]
 

@@ -19,13 +19,15 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError, UnknownName
+from ._descriptions import check_xacro_args, expand, file_xacro_args
+from ._initial_state import initial_state
+from ._settings import parse_kinematics, planning_defaults
+from ._substitutions import read_substituted
+from ._urdf import CollisionMesh, UrdfJoint, parse_urdf, resolve_collision_meshes
 from .controllers import ControllerConfig, ExecutionConfig, parse_controllers, parse_execution
-from .descriptions import check_xacro_args, expand, file_xacro_args
 from .embed import carried_paths, embedded_files
 from .fields import read_input
-from .initial_state import initial_state
 from .limits import DEFAULT_SOURCE, JointLimit, merge_limits, parse_joint_limits
-from .settings import parse_kinematics, planning_defaults
 from .sources import (
     CONFIG_FILE,
     discover,
@@ -38,8 +40,6 @@ from .sources import (
     search_path,
 )
 from .srdf import Group, Srdf, parse_srdf
-from .substitutions import read_substituted
-from .urdf import CollisionMesh, UrdfJoint, parse_urdf, resolve_collision_meshes
 from .xacro import PackagePath
 
 __all__ = ["RobotConfig", "load_robot_config"]

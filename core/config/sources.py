@@ -3,7 +3,7 @@
 - A moveplan.yaml names them (relative to itself, or `package://pkg/...`); a URDF or
   SRDF ending in .xacro is expanded with its `xacro_args`, overridden by --xacro-arg.
 - A folder without moveplan.yaml is a MoveIt config package (or a plain folder). Its URDF
-  and SRDF are the ones MoveItConfigsBuilder would load (core/config/setup_assistant.py:
+  and SRDF are the ones MoveItConfigsBuilder would load (core/config/_setup_assistant.py:
   `config/<robot name>.urdf.xacro`, `.setup_assistant`, `config/<robot name>.srdf`), else
   the one *.srdf(.xacro) in the first of config/, srdf/, the folder that has any, and the one
   URDF in the first of config/, urdf/, robots/, the folder (*.urdf(.xacro); in urdf/ and
@@ -34,9 +34,9 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError, UsageError, known
+from ._setup_assistant import SETUP_ASSISTANT_FILE, builder_srdf, builder_urdf, read_setup_assistant, robot_names
+from ._workspace import workspace_src
 from .fields import check_keys, load_yaml, mapping, read_input_text, string_list
-from .setup_assistant import SETUP_ASSISTANT_FILE, builder_srdf, builder_urdf, read_setup_assistant, robot_names
-from .workspace import workspace_src
 from .xacro import PackagePath
 
 __all__ = [

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import ConfigError, UnknownName, known
-from .urdf import MOVABLE_JOINT_TYPES, UrdfJoint, float_attr, xml_root
+from ._urdf import MOVABLE_JOINT_TYPES, UrdfJoint, float_attr, xml_root
 
 __all__ = ["VIRTUAL_JOINT_TYPES", "Group", "Srdf", "VirtualJoint", "parse_srdf"]
 

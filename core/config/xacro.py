@@ -2,14 +2,14 @@
 
 A package is found as ROS finds it on ROS_PACKAGE_PATH: in the first folder of the
 search path that is the package, holds a folder of that name, or holds (below it, as
-colcon finds packages in a workspace: core/config/workspace.py) a folder whose
+colcon finds packages in a workspace: core/config/_workspace.py) a folder whose
 package.xml names it. The same lookup resolves `$(find pkg)` in xacro files and
 `package://pkg/...` URIs of meshes.
 
 xacro itself resolves `$(find pkg)` through ament_index_python, which needs a sourced
 ROS 2 install; here the PyPI `xacro` package runs with that one function replaced by
 the lookup above (xacro keeps it in a module global, looked up at each call), and with its
-expressions evaluated within the guards and bounds of core/config/xacro_sandbox.py (no
+expressions evaluated within the guards and bounds of core/config/_xacro_sandbox.py (no
 expression reaches Python's internals).
 """
 
@@ -30,7 +30,7 @@ import xacro as _xacro  # type: ignore[import-untyped]  # the PyPI package ships
 from xacro import substitution_args as _substitution_args
 
 from ..errors import ConfigError, UsageError
-from .workspace import duplicate_packages, package_name, packages_under
+from ._workspace import duplicate_packages, package_name, packages_under
 
 __all__ = ["PackagePath", "XacroResult", "parse_xacro_args", "process_xacro"]
 
@@ -214,8 +214,8 @@ def process_xacro(path: Path, args: Mapping[str, str], packages: PackagePath, sh
             xacro_sandbox refuses (naming the expression).
     """
     # Imported here: a command that expands no xacro (a plan file's config) does not pay for the guards.
-    from .xacro_expressions import Refused
-    from .xacro_sandbox import sandboxed
+    from ._xacro_expressions import Refused
+    from ._xacro_sandbox import sandboxed
 
     table = _RecordingArgs(args)
     _xacro.all_includes.clear()

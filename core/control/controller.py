@@ -25,8 +25,8 @@ from ..config import ControllerConfig, ExecutionConfig
 from ..errors import InputError, UsageError, known
 from ..trajectory import PointBefore, sample
 from ..types import JointTrajectory, frozen_array
-from .judging import judge
-from .moveit_checks import Timeout, check_start_state, expected_duration_s
+from ._judging import judge
+from ._moveit_checks import Timeout, check_start_state, expected_duration_s
 from .plants import Plant
 from .results import (
     GOAL_TOLERANCE_VIOLATED,

@@ -36,7 +36,7 @@ from ..control import (
 )
 from ..errors import InputError, UnknownName
 from ..types import TfSamples
-from .plan_files import plan_config, plan_controller, read_valid_plan
+from ._plan_files import plan_config, plan_controller, read_valid_plan
 
 if TYPE_CHECKING:
     from ..control import Disturbance, ExecutionReport, Plant

@@ -16,7 +16,7 @@ from ..bag import END_STATES_KEY, BagSummary, PlanFile, summarize
 from ..errors import InputError
 from ..trajectory import peak_rates
 from ..types import RobotState
-from .plan_files import plan_config, read_valid_plan
+from ._plan_files import plan_config, read_valid_plan
 
 __all__ = ["Inspection", "StepPeaks", "end_states", "inspect_file", "step_peaks"]
 

@@ -38,10 +38,10 @@ from ..planning import check_limits, joint_target, seed_planner
 from ..trajectory import sample
 from ..types import Plan, StepResult, TfSamples
 from ..version import moveplan_version
-from .checks import filter_threshold, problem_checks
+from ._checks import filter_threshold, problem_checks
+from ._step import plan_step
 from .request import PlanFlags, PlanRequest, resolve_request
 from .robot_state import RobotState, robot_state
-from .step import plan_step
 
 __all__ = ["PlanFlags", "PlanRequest", "PlanResult", "assemble", "plan", "plan_to_file", "resolve_request"]
 
@@ -102,7 +102,7 @@ def plan(
     each step's `stats["exact_valid"]` says whether its trajectory is free under the URDF's
     exact meshes, checked independently of the planner's geometry (1.0 or 0.0), and
     `stats["exact_check_s"]` how long that took [s]. The sphere filter
-    is built after `filter_after` checked states (core/pipeline/checks.py): 0, now.
+    is built after `filter_after` checked states (core/pipeline/_checks.py): 0, now.
 
     Raises:
         MoveplanError: Any error while planning a step carries the step's name (`step`), and
@@ -238,7 +238,7 @@ def _start_from(path: Path, robot: Robot) -> JointGoal:
 
     """
     # Imported here: execution's district (the controller simulation) is no part of planning.
-    from .plan_files import read_valid_plan
+    from ._plan_files import read_valid_plan
 
     plan = read_valid_plan(path)
     name = robot.config.name

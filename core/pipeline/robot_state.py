@@ -143,7 +143,7 @@ def _values(
 def _plan_state(request: StateRequest, path: Path) -> StateResult:
     """Return the state of a plan file at the end, a step's end, or a time (`request.step`, `request.at_s`)."""
     # Imported here: reading plan files is execution's business, and `state` without --from needs none of it.
-    from .plan_files import plan_config, read_valid_plan
+    from ._plan_files import plan_config, read_valid_plan
 
     plan = read_valid_plan(path)
     config = request.robot.load() if request.robot is not None else plan_config(plan, path)

@@ -26,11 +26,11 @@ from ..errors import ConfigError, NoPlan, StartInCollision, StartOutsideLimits
 from ..model import Robot, Scene, check_shape_count, first_repeated, resolve_frames
 from ..planning import check_limits, seed_planner
 from ..types import CollisionObject, Frame, JointTrajectory, Plan, StepResult
-from .checks import filter_threshold, problem_checks
+from ._checks import filter_threshold, problem_checks
+from ._plan_files import pick_controller
+from ._step import plan_step
 from .plan import assemble
-from .plan_files import pick_controller
 from .request import PlanRequest
-from .step import plan_step
 
 __all__ = [
     "ExecutionSettings", "MotionSettings", "cartesian_motion", "check_execution", "compose_scene", "execute_motion",

@@ -33,6 +33,7 @@ from ..control import (
     tune_joint,
 )
 from ..errors import ConfigError, InputError, UsageError, known
+from ._plan_files import plan_config, plan_controller, read_valid_plan
 from .execution import (
     CheckedRecording,
     CheckRequest,
@@ -41,7 +42,6 @@ from .execution import (
     check,
     execute,
 )
-from .plan_files import plan_config, plan_controller, read_valid_plan
 from .report import execution_document, finite_numbers
 
 __all__ = ["TuneRequest", "TuneResult", "tune", "tuning_document"]

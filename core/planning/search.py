@@ -29,7 +29,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from ..collision import setup_clock
+from ..collision import setup_time_spent
 from ..config import PLANNERS
 from ..errors import PlanningFailed, PlanningTimeExceeded, UsageError, known
 from ..types import frozen_array
@@ -113,7 +113,7 @@ class _Work:
         self.timeout_s = default_timeout(time_s) if timeout_s is None else timeout_s
         self.budget = max(1, math.ceil(time_s * _CHECKS_PER_S))
         self.deadline = time.perf_counter() + self.timeout_s
-        self.set_up_before = setup_clock.spent()
+        self.set_up_before = setup_time_spent()
         self.used = 0
 
     def until(self, checks: int) -> ob.PlannerTerminationCondition:
@@ -121,8 +121,8 @@ class _Work:
         return ob.PlannerTerminationCondition(lambda: self.used >= checks or self.out_of_time())
 
     def out_of_time(self) -> bool:
-        """Return True once the wall-clock limit is reached, not counting set-up done meanwhile (setup_clock)."""
-        return time.perf_counter() - (setup_clock.spent() - self.set_up_before) > self.deadline
+        """Return True once the wall-clock limit is reached, not counting set-up done meanwhile (add_setup_time)."""
+        return time.perf_counter() - (setup_time_spent() - self.set_up_before) > self.deadline
 
     def failure(self, planner: str, status: object) -> PlanningFailed:
         """Return the error for a search that found no path, naming what ended it."""

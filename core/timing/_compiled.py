@@ -1,10 +1,10 @@
-"""Compiled twins (numba) of core/timing/topp.py `fastest_speeds` and core/trajectory.py `quintic_peak_rates`.
+"""Compiled twins (numba) of core/timing/_topp.py `fastest_speeds` and core/trajectory.py `quintic_peak_rates`.
 
 numpy's versions spend a sixth of a median MotionBenchMaker plan step in array calls on a few
 hundred numbers and in plain Python loops. These repeat each of their floating-point operations
 in the same order (numba, like numpy, contracts nothing into fused multiply-adds), so a plan is
 byte for byte the same whichever runs; tests/timing/test_timing_properties.py holds them together.
-Imported only once the sphere filter has loaded numba (core/pipeline/step.py).
+Imported only once the sphere filter has loaded numba (core/pipeline/_step.py).
 """
 
 from __future__ import annotations
@@ -17,12 +17,12 @@ from numpy.typing import NDArray
 
 from .. import trajectory
 from ..errors import PlanningFailed
-from .topp import STILL, SpeedProfile
+from ._topp import STILL, SpeedProfile
 
-__all__ = ["fastest_speeds", "quintic_peak_rates"]
+__all__ = ["compiled_fastest_speeds", "compiled_quintic_peak_rates"]
 
 
-def fastest_speeds(
+def compiled_fastest_speeds(
     grid: NDArray[np.float64],
     first: NDArray[np.float64],
     second: NDArray[np.float64],
@@ -40,7 +40,7 @@ def fastest_speeds(
     return SpeedProfile(s, squared)
 
 
-def quintic_peak_rates(
+def compiled_quintic_peak_rates(
     knots: NDArray[np.float64], p: NDArray[np.float64], v: NDArray[np.float64], a: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Return trajectory.quintic_peak_rates(...) (same arguments, same result), computed by compiled code."""

@@ -29,8 +29,8 @@ from numpy.typing import NDArray
 from ..errors import PlanningFailed
 from ..trajectory import quintic_peak_rates
 from ..types import JointTrajectory, frozen_array
-from .blends import BlendedPath, blended_path, distinct_waypoints
-from .topp import SpeedProfile, fastest_speeds
+from ._blends import BlendedPath, blended_path, distinct_waypoints
+from ._topp import SpeedProfile, fastest_speeds
 
 __all__ = ["rest_to_rest", "time_parameterize"]
 
@@ -93,7 +93,7 @@ def time_parameterize(
     if compiled:
         from . import _compiled as twins  # numba: loaded already with the sphere filter's kernels
 
-        speeds, peaks = twins.fastest_speeds, twins.quintic_peak_rates
+        speeds, peaks = twins.compiled_fastest_speeds, twins.compiled_quintic_peak_rates
     else:
         speeds, peaks = fastest_speeds, quintic_peak_rates
     profile, law = _optimal_law(path, points, max_velocity, max_acceleration, speeds)

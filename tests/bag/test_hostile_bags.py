@@ -49,8 +49,8 @@ from test_hostile_recordings import PLAN, RECORDINGS, edited_plan, one_error_lin
 from moveplan.core.bag.jointstates import encode_joint_states, read_joint_states
 from moveplan.core.bag.plan_file import PlanStepRecord
 from moveplan.core.config.controllers import ExecutionConfig
-from moveplan.core.control.check.alignment import PROFILE_SAMPLES, StepProfile
-from moveplan.core.control.check.context import PLAN_PROFILE_SAMPLES, CheckContext
+from moveplan.core.control.check._alignment import PROFILE_SAMPLES, StepProfile
+from moveplan.core.control.check._context import PLAN_PROFILE_SAMPLES, CheckContext
 from moveplan.core.control.check.samples import source_of
 from moveplan.core.pipeline.inspection import inspect_file
 from moveplan.core.types import JointStateSeries

@@ -24,7 +24,7 @@ from moveplan.core.bag.container.summary import summarize
 from moveplan.core.bag.jointstates import open_joint_states, read_joint_states
 from moveplan.core.bag.plan_file import PlanStepRecord
 from moveplan.core.config.controllers import ControllerConfig, ExecutionConfig
-from moveplan.core.control.check import alignment
+from moveplan.core.control.check import _alignment as alignment
 from moveplan.core.control.check import samples as check_samples
 from moveplan.core.control.check.recording import check_recording
 from moveplan.core.control.check.samples import Samples, source_of

@@ -423,7 +423,7 @@ def test_partial_files_left_by_killed_runs_are_swept_when_the_entry_is_written(t
     assert sorted(p.name for p in tmp_path.iterdir()) == ["entry.pickle", young.name]
 
 
-# Plans enough states that the sphere filter is built, so that the cache is used (core/pipeline/checks.py).
+# Plans enough states that the sphere filter is built, so that the cache is used (core/pipeline/_checks.py).
 CACHE_PLAN = (SAMPLES / "panda_shelf_bays.yaml", "--seed", "0")
 
 

@@ -9,7 +9,7 @@ from conftest import ROOT
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from moveplan.core.collision import certify
+from moveplan.core.collision import _certify as certify
 from moveplan.core.collision.motion import CERTIFY_STEP_M, MotionChecker, exact_checks, scene_checks
 from moveplan.core.collision.sphere_filter import SphereFilter
 from moveplan.core.config.robot_config import load_robot_config

@@ -16,7 +16,7 @@ from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import ConfigError
 from moveplan.core.model.robot import Robot
 from moveplan.core.model.scene_file import load_scene
-from moveplan.core.pipeline import checks
+from moveplan.core.pipeline import _checks as checks
 
 PANDA = ROOT / "configs" / "panda"
 SHELF_SCENE = SAMPLES / "panda_shelf_scene.yaml"

@@ -8,7 +8,7 @@ import pinocchio as pin
 import pytest
 from conftest import UR10E
 
-from moveplan.core.collision import pair_tables
+from moveplan.core.collision import _pair_tables as pair_tables
 from moveplan.core.collision._kernels import tabled
 from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.collision.sphere_filter import CLEAR, COLLIDES, _table_arrays

@@ -9,11 +9,11 @@ import pinocchio as pin
 import pytest
 from conftest import ROOT, UR10E
 
-from moveplan.core.collision import sphere_fit as sphere_model
+from moveplan.core.collision import _sphere_fit as sphere_model
+from moveplan.core.collision._sphere_fit import fit_geometry, robot_spheres
 from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.collision.motion import MotionChecker
 from moveplan.core.collision.sphere_filter import CLEAR, COLLIDES, SphereFilter
-from moveplan.core.collision.sphere_fit import fit_geometry, robot_spheres
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.model.robot import Robot
 from moveplan.core.model.scene_file import load_scene

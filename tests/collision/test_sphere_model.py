@@ -9,9 +9,9 @@ import pytest
 from conftest import ROOT, SAMPLES
 from scipy.spatial import ConvexHull
 
-from moveplan.core.collision import sphere_fit as sphere_model
+from moveplan.core.collision import _sphere_fit as sphere_model
+from moveplan.core.collision._sphere_fit import fit_shape, robot_spheres
 from moveplan.core.collision.checker import CollisionChecker, coal_geometry
-from moveplan.core.collision.sphere_fit import fit_shape, robot_spheres
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.model.robot import Robot
 from moveplan.core.types import Shape

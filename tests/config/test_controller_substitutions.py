@@ -7,9 +7,9 @@ from pathlib import Path
 import pytest
 from conftest import REALWORLD, ROOT, Cli
 
+from moveplan.core.config._substitutions import substitute
 from moveplan.core.config.controllers import parse_controllers, parse_execution
 from moveplan.core.config.robot_config import load_robot_config
-from moveplan.core.config.substitutions import substitute
 from moveplan.core.errors import ConfigError
 
 PREFIXED_ARM = Path(__file__).parents[1] / "data" / "controller_substitutions" / "prefixed_arm"

@@ -10,10 +10,10 @@ import yaml
 from conftest import REALWORLD, ROOT, UR10E, Cli
 
 from moveplan.core import bag as recording
+from moveplan.core.config._setup_assistant import read_setup_assistant
+from moveplan.core.config._workspace import packages_under, workspace_src
 from moveplan.core.config.robot_config import load_robot_config
-from moveplan.core.config.setup_assistant import read_setup_assistant
 from moveplan.core.config.sources import discover, search_path
-from moveplan.core.config.workspace import packages_under, workspace_src
 from moveplan.core.config.xacro import PackagePath
 from moveplan.core.errors import ConfigError, UsageError
 

@@ -11,8 +11,8 @@ import pytest
 from conftest import Cli, run_process
 from test_hostile_packages import MESH_LINK, URDF, arm_package, description_package, one_line
 
-from moveplan.core.collision.certify import MAX_REACH_M, MAX_STATES
-from moveplan.core.config.urdf import MAX_DEGREES_OF_FREEDOM, MAX_LINKS
+from moveplan.core.collision._certify import MAX_REACH_M, MAX_STATES
+from moveplan.core.config._urdf import MAX_DEGREES_OF_FREEDOM, MAX_LINKS
 
 PLAN_ARGS = ("--start-joints", "0,0", "--joints", "0.5,0.5")
 ORIGIN = 'xyz="0 0 0.5"/><axis'

@@ -11,7 +11,7 @@ from conftest import SAMPLES, Cli
 from test_hostile_packages import CONTROLLERS, arm_package, one_line
 
 from moveplan.core.config.controllers import default_controller
-from moveplan.core.pipeline.plan_files import pick_controller
+from moveplan.core.pipeline._plan_files import pick_controller
 
 PLAN_ARGS = ("--start-joints", "0,0", "--joints", "0.5,0.5", "--seed", "0")
 SECOND = """arm2_controller:

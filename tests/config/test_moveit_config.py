@@ -16,7 +16,7 @@ from moveplan.core import bag as recording
 from moveplan.core.config.robot_config import RobotConfig, load_robot_config
 from moveplan.core.errors import ConfigError, UsageError
 from moveplan.core.model.robot import Robot
-from moveplan.core.pipeline.plan_files import plan_config
+from moveplan.core.pipeline._plan_files import plan_config
 
 DATA = ROOT / "tests" / "data"
 PACKAGE = DATA / "ur10e_moveit_config"

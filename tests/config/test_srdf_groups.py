@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 from conftest import REALWORLD, Cli
 
+from moveplan.core.config._urdf import parse_urdf
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.config.srdf import parse_srdf
-from moveplan.core.config.urdf import parse_urdf
 from moveplan.core.errors import ConfigError, UnknownName
 
 # A PR2-like mobile manipulator: planar virtual joint named in groups, <link> groups, subgroups.

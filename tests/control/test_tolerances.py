@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from moveplan.core.config.controllers import ControllerConfig, ExecutionConfig
-from moveplan.core.control.judging import judge, judge_spans
-from moveplan.core.control.moveit_checks import Timeout, check_start_state, expected_duration_s
+from moveplan.core.control._judging import judge, judge_spans
+from moveplan.core.control._moveit_checks import Timeout, check_start_state, expected_duration_s
 from moveplan.core.control.results import (
     GOAL_TOLERANCE_VIOLATED,
     PATH_TOLERANCE_VIOLATED,

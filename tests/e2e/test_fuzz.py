@@ -1164,7 +1164,7 @@ def test_a_db3_recording_with_ids_that_are_no_integers_is_refused_in_one_line(
     cli: Cli, files: Files, damage: str
 ) -> None:
     # Found by the fuzzer: in tables declared without types (any value in any column), a topic id
-    # of NULL raised TypeError from int() in core/bag/container/db3.py (an internal error); text ids too.
+    # of NULL raised TypeError from int() in core/bag/container/_db3.py (an internal error); text ids too.
     with scratch_folder() as scratch:
         recording = scratch / "run.db3"
         shutil.copy(files.db3, recording)
@@ -1213,7 +1213,7 @@ def test_a_chunk_too_short_for_its_header_is_damage_skipped_or_refused_in_one_li
     cli: Cli, files: Files, length: int, summary: bool, flags: tuple[str, ...]
 ) -> None:
     # Found by the fuzzer: a chunk record's length set below the 40 bytes of a chunk's header made
-    # core/bag/container/mcap_linear.py unpack past it (struct.error: an internal error of check-tolerances
+    # core/bag/container/_mcap_linear.py unpack past it (struct.error: an internal error of check-tolerances
     # --skip-damaged in a file without a summary) and inspect refuse the file with struct's message.
     for source in (files.executed_bytes, files.plain_executed):
         chunk = next(record for record in mcap_records(source) if record.opcode == CHUNK)

@@ -23,9 +23,10 @@ from mcap.reader import make_reader
 from mcap.writer import Writer
 
 from moveplan.core.collision import _cache, kernel_cache
-from moveplan.core.collision.pair_tables import PairTable
-from moveplan.core.collision.sphere_fit import SphereSet
-from moveplan.core.config import xacro_expressions, xacro_sandbox
+from moveplan.core.collision._pair_tables import PairTable
+from moveplan.core.collision._sphere_fit import SphereSet
+from moveplan.core.config import _xacro_expressions as xacro_expressions
+from moveplan.core.config import _xacro_sandbox as xacro_sandbox
 from moveplan.core.config.xacro import PackagePath, process_xacro
 from moveplan.core.errors import ConfigError
 

@@ -41,6 +41,16 @@ def _faces() -> list[str]:
                   for init in (ROOT / "core").rglob("__init__.py") if "msgs" not in init.parts)
 
 
+def test_imports_between_packages_go_through_the_packages_face() -> None:
+    """Renaming a module breaks only its own package: everyone outside imports the package's __init__."""
+    graph = grimp.build_graph("moveplan.core", "moveplan.cli", "moveplan.commander")
+    reaching_in = sorted(f"{importer} -> {imported}"
+                         for imported in graph.modules
+                         for importer in graph.find_modules_that_directly_import(imported)
+                         if not (importer + ".").startswith(_scope(imported) + "."))
+    assert reaching_in == []
+
+
 @pytest.mark.parametrize("face", _faces())
 def test_a_face_exports_what_it_lists_and_loads_it_on_first_use(face: str) -> None:
     """`from moveplan.core.X import name` gives the name, typed for mypy, and no name hides a submodule."""

@@ -19,9 +19,9 @@ import pytest
 from conftest import REALWORLD, ROOT, Cli, run_process
 
 from moveplan.core.bag.plan_file import read_plan
+from moveplan.core.config._urdf import parse_urdf
 from moveplan.core.config.limits import DEFAULT_ACCELERATION, merge_limits, parse_joint_limits
 from moveplan.core.config.robot_config import load_robot_config
-from moveplan.core.config.urdf import parse_urdf
 from moveplan.core.errors import ConfigError
 
 DATA = ROOT / "tests" / "data" / "limits_start"

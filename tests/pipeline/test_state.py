@@ -244,8 +244,8 @@ def test_end_states_of_a_file_without_or_with_a_damaged_record_are_computed_from
     from dataclasses import replace
 
     from moveplan.core.bag.plan_file import END_STATES_KEY
+    from moveplan.core.pipeline._plan_files import read_valid_plan
     from moveplan.core.pipeline.inspection import end_states
-    from moveplan.core.pipeline.plan_files import read_valid_plan
 
     path, document = pick_plan
     plan = read_valid_plan(path)

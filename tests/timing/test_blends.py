@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from moveplan.core.timing.blends import BlendedPath, blended_path
+from moveplan.core.timing._blends import BlendedPath, blended_path
 
 
 def polyline_distance(points: np.ndarray, waypoints: np.ndarray) -> np.ndarray:

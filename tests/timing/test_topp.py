@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from moveplan.core.timing.topp import SpeedProfile, fastest_speeds
+from moveplan.core.timing._topp import SpeedProfile, fastest_speeds
 
 
 def straight_line(length: float, direction: list[float]) -> tuple[np.ndarray, ...]:

@@ -16,9 +16,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...types import ControllerStates, JointTrajectory, PointSeries
+from ._primitives import CdrWriter, patched_copies, time_array
 from .definitions import POINT_SOURCES, controller_state_fields
 from .messages import quaternions_xyzw, seconds_to_ns
-from .primitives import CdrWriter, patched_copies, time_array
 
 __all__ = ["controller_states_cdr", "display_trajectory_cdr", "joint_trajectory_cdr", "tf_messages_cdr"]
 

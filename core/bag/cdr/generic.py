@@ -17,8 +17,8 @@ from collections.abc import Callable
 from functools import cache
 from typing import Any
 
+from ._primitives import CdrWriter
 from .definitions import Field, parse_definitions
-from .primitives import CdrWriter
 
 __all__ = ["Encoder", "encoder"]
 

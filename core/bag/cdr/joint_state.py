@@ -18,7 +18,7 @@ import numpy.typing as npt
 from numpy.typing import NDArray
 
 from ...errors import InputError
-from .primitives import CdrWriter, patched_copies
+from ._primitives import CdrWriter, patched_copies
 
 __all__ = [
     "JOINT_STATE_TYPE",

@@ -24,7 +24,7 @@ from mcap.records import Attachment, Channel, Header, McapRecord, Message, Metad
 from mcap.stream_reader import MAGIC_SIZE, StreamReader
 
 from ...errors import InputError
-from .files import check_regular
+from ._files import check_regular
 
 __all__ = ["DAMAGE", "ClampedReads", "Contents", "Kept", "open_mcap", "scan"]
 

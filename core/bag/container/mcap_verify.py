@@ -15,9 +15,8 @@ from pathlib import Path
 from typing import IO
 
 from ...errors import CorruptData, InputError
-from .chunk_codecs import DATA_SECTION, Codecs, Damage, Skips, crc32
-from .mcap_linear import CUT, DataRecord, data_records
-from .mcap_records import (
+from ._mcap_linear import CUT, DataRecord, data_records
+from ._mcap_records import (
     ATTACHMENT,
     CHUNK,
     FOOTER,
@@ -28,6 +27,7 @@ from .mcap_records import (
     chunk_records,
     read_summary,
 )
+from .chunk_codecs import DATA_SECTION, Codecs, Damage, Skips, crc32
 
 __all__ = ["Verified", "data_section_damage", "verify_mcap"]
 

@@ -2,7 +2,7 @@
 
 Of an MCAP file, taken from the summary section's statistics when they are complete, else
 counted in one linear pass (an unfinished or damaged file) through the message indexes
-that follow each chunk (core.bag.container.mcap_linear); either way after every CRC and size the
+that follow each chunk (core.bag.container._mcap_linear); either way after every CRC and size the
 file records has been checked (core.bag.container.mcap_verify). Of a rosbag2 sqlite3 file, counted
 by SQLite after its quick_check. Of a bag folder, its split files' summaries merged.
 """
@@ -17,13 +17,13 @@ from mcap.reader import SeekingReader
 from mcap.records import Channel, Header, Schema
 
 from ...types import SkippedData
+from ._db3 import check_pages, db3_info, open_db3, topic_counts
+from ._files import bag_files
+from ._mcap_linear import survey
+from ._qos import durability
 from .chunk_codecs import Skips
-from .db3 import check_pages, db3_info, open_db3, topic_counts
-from .files import bag_files
-from .mcap_linear import survey
 from .mcap_scan import DAMAGE, ClampedReads, open_mcap
 from .mcap_verify import verify_mcap
-from .qos import durability
 
 __all__ = ["BagSummary", "TopicSummary", "summarize"]
 

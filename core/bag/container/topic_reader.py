@@ -6,12 +6,12 @@ per chunk one read, one decompression (zstd, lz4 or none) and the chunk's Messag
 offsets of the topic's channels, and hands a sink the message payloads as numpy bytes: a
 (messages, bytes) view of the chunk where the records lie back to back with one length,
 else offsets and lengths into it. A file without a usable summary (a recording that was
-cut off, or written without one) is read by a linear scan (core.bag.container.mcap_linear), with a
+cut off, or written without one) is read by a linear scan (core.bag.container._mcap_linear), with a
 warning: chunk by chunk through the MessageIndex records that follow each chunk. A .db3
-file is read a batch of messages at a time (core.bag.container.db3). Only the current chunk or batch
+file is read a batch of messages at a time (core.bag.container._db3). Only the current chunk or batch
 is held: memory does not grow with the recording.
 
-The records are core.bag.container.mcap_records' to parse, without the mcap package. Each chunk
+The records are core.bag.container._mcap_records' to parse, without the mcap package. Each chunk
 read is checked whole (core.bag.container.chunk_codecs): decompressed no further than the size it
 declares, itself bounded, and its CRC compared where the writer computed one; the summary
 and data section CRCs too, where present. A damaged part is bad input, or with
@@ -34,11 +34,10 @@ from numpy.typing import NDArray
 
 from ...errors import CorruptData, InputError
 from ...types import SkippedData
-from .chunk_codecs import Damage, Skips
-from .db3 import db3_info, db3_messages, open_db3
-from .files import MCAP_MAGIC, bag_files
-from .mcap_linear import CUT, DataRecord, Definitions, data_records
-from .mcap_records import (
+from ._db3 import db3_info, db3_messages, open_db3
+from ._files import MCAP_MAGIC, bag_files
+from ._mcap_linear import CUT, DataRecord, Definitions, data_records
+from ._mcap_records import (
     CHANNEL,
     CHUNK,
     DATA_AT,
@@ -56,6 +55,7 @@ from .mcap_records import (
     schema_record,
     walk_positions,
 )
+from .chunk_codecs import Damage, Skips
 from .mcap_verify import data_section_damage
 
 __all__ = ["Channel", "MessageSink", "byte_rows", "read_topic"]
@@ -109,7 +109,7 @@ def read_topic(source: Path, topic: str, sink: MessageSink, skip_damaged: bool =
 
     Args:
         source: An MCAP or rosbag2 sqlite3 (.db3) file, or a rosbag2 bag folder whose
-            split files are read in order (core.bag.container.files).
+            split files are read in order (core.bag.container._files).
         topic: The topic to read.
         sink: Checks the topic's channels, then takes their payloads.
         skip_damaged: Skip an MCAP chunk that fails its CRC or size checks, the summary

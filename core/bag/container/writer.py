@@ -20,7 +20,7 @@ from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 
 from ...errors import InputError, UsageError
 from ...version import moveplan_version
-from .qos import offered_qos_profiles
+from ._qos import offered_qos_profiles
 
 __all__ = ["BagStream", "atomic_file", "open_bag", "output_problem", "staged_file", "write_bag"]
 

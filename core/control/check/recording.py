@@ -36,12 +36,12 @@ from ...config import ControllerConfig, ExecutionConfig
 from ...errors import InputError, UsageError
 from ...types import JointStateSeries
 from ..tolerances import velocity_error_computable
-from .alignment import find_gaps, first_start
-from .context import CheckContext, CheckedPlan
-from .cycles import all_cycles, already_running, executions
+from ._alignment import find_gaps, first_start
+from ._context import CheckContext, CheckedPlan
+from ._cycles import all_cycles, already_running, executions
+from ._verdicts import cycles_report, execution_report
 from .report import CheckReport, StepCheck
 from .samples import SampleSource, source_of
-from .verdicts import cycles_report, execution_report
 
 __all__ = ["SampleSource", "Start", "check_recording", "uses_velocities"]
 

@@ -22,6 +22,7 @@ from ...bag import PlanFile
 from ...control import SCAN_ROWS, SampleSource, Violation, in_controller_order, position_error
 from ...errors import InputError, UsageError
 from ...trajectory import PointBefore, peak_rates, sample
+from .._plan_files import plan_config
 from ..execution import (
     CheckedRecording,
     CheckRequest,
@@ -31,9 +32,8 @@ from ..execution import (
     check,
     execute,
 )
-from ..plan_files import plan_config
-from .figures import PlanCurves, plan_figure, write_png
-from .tracking import TrackedStep, Tracking, ViolationMark, tracking_figure
+from ._figures import PlanCurves, plan_figure, write_png
+from ._tracking import TrackedStep, Tracking, ViolationMark, tracking_figure
 
 if TYPE_CHECKING:
     from ...config import ControllerConfig, RobotConfig

@@ -25,9 +25,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import ConfigError, UnknownName
+from ._urdf import UrdfJoint, xml_root
 from .fields import MAX_MAGNITUDE, coordinate, load_yaml, mapping
 from .limits import JointLimit
-from .urdf import UrdfJoint, xml_root
 
 __all__ = ["DEFAULT_STATE", "InitialState", "default_position", "initial_state", "parse_initial_positions",
            "ros2_control_initial_positions"]

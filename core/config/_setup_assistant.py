@@ -25,8 +25,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
+from ._workspace import package_name
 from .fields import load_yaml, mapping
-from .workspace import package_name
 from .xacro import PackagePath
 
 __all__ = [

@@ -9,11 +9,11 @@ import numpy as np
 from ...trajectory import sample
 from ..results import INCOMPLETE, ExecutionResult
 from ..tolerances import position_error
-from .alignment import ZONE_RAD, cycle_starts, next_start
-from .context import CheckContext
+from ._alignment import ZONE_RAD, cycle_starts, next_start
+from ._context import CheckContext
+from ._verdicts import execution_verdict
+from ._windows import judge_steps
 from .report import CycleCheck, StepCheck
-from .verdicts import execution_verdict
-from .windows import judge_steps
 
 __all__ = ["all_cycles", "already_running", "executions"]
 

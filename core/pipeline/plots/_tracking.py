@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...types import frozen_array
-from .figures import blended, corner_note, finite_or_nan, grid, legend_line, step_lines
+from ._figures import blended, corner_note, finite_or_nan, grid, legend_line, step_lines
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

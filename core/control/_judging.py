@@ -17,8 +17,8 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
+from ._moveit_checks import Timeout
 from .margins import span_margins
-from .moveit_checks import Timeout
 from .results import (
     GOAL_TOLERANCE_VIOLATED,
     PATH_TOLERANCE_VIOLATED,

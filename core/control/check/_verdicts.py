@@ -7,7 +7,7 @@ from dataclasses import replace
 
 from ..margins import merged_margins
 from ..results import INCOMPLETE, SUCCESSFUL, ExecutionResult, Violation
-from .context import CheckContext
+from ._context import CheckContext
 from .report import CheckReport, CycleCheck, StepCheck
 
 __all__ = ["cycles_report", "execution_report", "execution_verdict"]

@@ -29,7 +29,7 @@ from typing import Any
 import xacro as _xacro  # type: ignore[import-untyped]  # the PyPI package ships no type hints
 from xacro import substitution_args as _substitution_args
 
-from .xacro_expressions import Refused, bounded_range, evaluator
+from ._xacro_expressions import Refused, bounded_range, evaluator
 
 __all__ = [
     "MAX_ELEMENTS", "MAX_FILE_BYTES", "MAX_INCLUDES", "MAX_INCLUDE_DEPTH", "MAX_ITERATIONS", "MAX_MACRO_DEPTH",

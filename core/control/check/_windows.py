@@ -14,12 +14,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...trajectory import PointBefore, sample
+from .._judging import judge_spans
+from .._moveit_checks import Timeout, check_start_state, expected_duration_s
 from ..controller import WAIT_LIMIT_S
-from ..judging import judge_spans
-from ..moveit_checks import Timeout, check_start_state, expected_duration_s
 from ..results import INCOMPLETE, TIMED_OUT, ExecutionResult, ToleranceReport
-from .alignment import StepProfile
-from .context import CheckContext
+from ._alignment import StepProfile
+from ._context import CheckContext
 
 __all__ = ["judge_steps"]
 

@@ -9,7 +9,7 @@ from typing import Protocol
 from ...config import ControllerConfig, ExecutionConfig
 from ...types import JointTrajectory
 from ..tolerances import SegmentTolerances, in_controller_order, segment_tolerances, velocity_error_computable
-from .alignment import ZONE_RAD, StepProfile
+from ._alignment import ZONE_RAD, StepProfile
 from .samples import Samples, SampleSource
 
 __all__ = ["PLAN_PROFILE_SAMPLES", "CheckContext", "CheckedPlan", "CheckedStep"]

@@ -9,7 +9,7 @@ rule: by then the hull checks have cost about what the filter's set-up does). Wh
 not compiled the kernels yet (a fresh install), the set-up costs a compilation, so the rule waits
 correspondingly longer: a first plan on a fresh machine costs what it costs warm unless it is
 one that would pay for the compilation anyway. A build inside a step is kept off the search's
-planning-time cap (core/collision/setup_clock.py). A process that has built one filter has the
+planning-time cap (core/collision/_setup_clock.py). A process that has built one filter has the
 kernels loaded, and builds the next at once.
 
 Every verdict is the same either way: a state the spheres clear is free under the hulls, and
@@ -32,11 +32,11 @@ from ..collision import (
     GeometryMode,
     MotionChecker,
     SphereFilter,
+    add_setup_time,
     build_sphere_filter,
     hull_checker,
     kernels_cached,
     kernels_loaded,
-    setup_clock,
 )
 from ..model import Robot, Scene
 from ..trajectory import interpolate
@@ -126,7 +126,7 @@ class OnDemandSpheres:
             logger.debug("building the sphere filter after %d states checked by coal alone", self._after)
             began = time.perf_counter()
             self._filter = self._build()
-            setup_clock.add(time.perf_counter() - began)
+            add_setup_time(time.perf_counter() - began)
             self._built(self._filter)
 
     def _spheres(self, count: int) -> SphereFilter | None:

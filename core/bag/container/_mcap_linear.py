@@ -21,8 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...errors import CorruptData, InputError
-from .chunk_codecs import DEFAULT_MAX_CHUNK_BYTES, MAX_CHUNK_ENV, Damage, Skips
-from .mcap_records import (
+from ._mcap_records import (
     ATTACHMENT,
     CHANNEL,
     CHUNK,
@@ -45,6 +44,7 @@ from .mcap_records import (
     schema_record,
     walk,
 )
+from .chunk_codecs import DEFAULT_MAX_CHUNK_BYTES, MAX_CHUNK_ENV, Damage, Skips
 
 __all__ = ["CUT", "DataRecord", "Definitions", "Survey", "data_records", "survey"]
 

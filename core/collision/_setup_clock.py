@@ -7,17 +7,17 @@ busy machine (the budget of checked motions, not the clock, decides the path).
 
 from __future__ import annotations
 
-__all__ = ["add", "spent"]
+__all__ = ["add_setup_time", "setup_time_spent"]
 
 _spent_s = 0.0
 
 
-def add(seconds: float) -> None:
+def add_setup_time(seconds: float) -> None:
     """Record `seconds` of set-up done inside a search; return None."""
     global _spent_s
     _spent_s += seconds
 
 
-def spent() -> float:
+def setup_time_spent() -> float:
     """Return the set-up seconds recorded in this process so far."""
     return _spent_s

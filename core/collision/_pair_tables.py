@@ -17,7 +17,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from . import _cache as disk_cache
-from .certify import farthest_point, is_prismatic
+from ._certify import farthest_point, is_prismatic
 
 __all__ = ["PairTable", "pair_tables"]
 

@@ -14,7 +14,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from . import _cache as disk_cache
-from .sphere_fit import SphereSet
+from ._sphere_fit import SphereSet
 
 __all__ = ["inner_spheres"]
 
