@@ -49,7 +49,9 @@ from .parsing import (
 )
 
 if TYPE_CHECKING:  # each command imports the core it runs, so that `moveplan --help` stays fast
+    from ..core.control import RecordingStart
     from ..core.pipeline import PlanFlags
+    from ..core.types import TimeSource
 
 __all__ = ["app", "main"]
 
@@ -245,8 +247,10 @@ def check_tolerances(
 
         if time_source not in ("header", "log"):
             raise UsageError(f"--time-source: expected header or log, got '{time_source}'")
-        when: str | float = start if start in ("auto", "all") else parse_time(start, "--start (auto, all or seconds)")
-        request = CheckRequest(plan_file, recording_file, topic, controllers, when, time_source, skip_damaged)
+        source: TimeSource = "log" if time_source == "log" else "header"
+        when: RecordingStart = ("auto" if start == "auto" else "all" if start == "all"
+                                else parse_time(start, "--start (auto, all or seconds)"))
+        request = CheckRequest(plan_file, recording_file, topic, controllers, when, source, skip_damaged)
         if plot is None:
             report = check(request)
         else:

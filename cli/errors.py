@@ -25,7 +25,7 @@ from typer.core import TyperGroup
 try:  # typer 0.28 parses with its own copy of click
     from typer._click.exceptions import UsageError as ClickUsageError
 except ImportError:
-    from click import UsageError as ClickUsageError
+    from click import UsageError as ClickUsageError  # type: ignore[assignment]  # an older typer: click's own
 
 from ..core.errors import MoveplanError, UsageError
 from .tables import escape_controls

@@ -106,7 +106,7 @@ def _short(goal: dict[str, Any]) -> str:
 def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
     """Print a robot config: groups, joints with limits and sources, named states, frames, controllers."""
     links = sorted({j.parent for j in config.urdf_joints.values()} | {j.child for j in config.urdf_joints.values()})
-    document = {
+    document: dict[str, Any] = {
         "name": config.name,
         "groups": {n: {"joints": list(g.joints), "base": g.base, "tip": g.tip} for n, g in config.srdf.groups.items()},
         "joints": {
@@ -194,7 +194,8 @@ def state_summary(result: StateResult, as_json: bool, quiet: bool) -> None:
 def inspect_summary(inspection: Inspection, as_json: bool, quiet: bool) -> None:
     """Print topics of any bag, and for a plan file each step's duration, peak rates and end state."""
     path, summary, plan = inspection.path, inspection.summary, inspection.plan
-    ends = [state.as_dict() for state in inspection.end_states] or [None] * len(inspection.steps)
+    ends: list[dict[str, Any] | None] = [state.as_dict() for state in inspection.end_states]
+    ends = ends or [None] * len(inspection.steps)
     steps = [{**asdict(step), "end_state": end} for step, end in zip(inspection.steps, ends, strict=True)]
     document = {
         "file": str(path), "profile": summary.profile, "library": summary.library,

@@ -114,7 +114,7 @@ class PlanningSettings:
 
 def _scaling(value: Any, where: str) -> float:
     """Return a scaling factor checked to lie in [MIN_SCALING, 1], else raise UsageError naming `where`."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not MIN_SCALING <= value <= 1.0:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not MIN_SCALING <= float(value) <= 1.0:
         raise UsageError(f"{where}: expected a value in the range from {MIN_SCALING:g} to 1 for scaling factor, "
                          f"got {value!r}")
     return float(value)

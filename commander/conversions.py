@@ -39,7 +39,8 @@ def list_to_pose(values: Sequence[float]) -> Pose:
     """
     numbers = _numbers(values, "pose list")
     if len(numbers) == 6:
-        quaternion = list(quaternion_from_euler(*numbers[3:]))
+        roll, pitch, yaw = numbers[3:]
+        quaternion = list(quaternion_from_euler(roll, pitch, yaw))
     elif len(numbers) == 7:
         quaternion = numbers[3:]
         quaternion_matrix(quaternion)  # refuses a zero quaternion here, not when planning

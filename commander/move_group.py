@@ -14,7 +14,7 @@ import math
 import numbers
 import time
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, cast
 
 from ..core.config import SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, StepSpec
 from ..core.control import ExecutionSummary
@@ -105,7 +105,7 @@ class MoveGroupCommander(PlanningSettings):
 
     def get_current_joint_values(self) -> list[float]:
         """Return the group's current joint values, in group order, in [rad] or [m]."""
-        return self._robot.values(self._world.q).tolist()
+        return cast(list[float], self._robot.values(self._world.q).tolist())
 
     def get_current_pose(self, end_effector_link: str = "") -> PoseStamped:
         """Return the current pose of the end-effector (or `end_effector_link`), stamped in the planning frame."""
@@ -148,8 +148,9 @@ class MoveGroupCommander(PlanningSettings):
         """Return the joint values of a joint or named target (the current values for a pose target)."""
         current = self._robot.values(self._world.q)
         if isinstance(self._target, JointGoal | NamedGoal):
-            return joint_target(self._robot, self._target, current, "get_joint_value_target").tolist()
-        return current.tolist()
+            target = joint_target(self._robot, self._target, current, "get_joint_value_target")
+            return cast(list[float], target.tolist())
+        return cast(list[float], current.tolist())
 
     def set_joint_value_target(self, arg1: Any, arg2: Any = None, arg3: Any = None) -> None:
         """Set a joint target: a list of all values, a dict joint: value, a JointState or (joint, value); return None.

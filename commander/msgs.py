@@ -8,7 +8,7 @@ rotation). Times are ROS 1's: `secs` and `nsecs`, with `to_sec()`.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import ClassVar, Self
 
 __all__ = [
     "AttachedCollisionObject", "CollisionObject", "Duration", "Header", "JointState", "JointTrajectory",
@@ -25,7 +25,7 @@ class Time:
     nsecs: int = 0
 
     @classmethod
-    def from_sec(cls, seconds: float) -> Time:
+    def from_sec(cls, seconds: float) -> Self:
         """Return the time `seconds` [s] after zero."""
         secs, nsecs = _split(seconds)
         return cls(secs, nsecs)

@@ -94,7 +94,7 @@ def quaternion_from_matrix(matrix: npt.ArrayLike) -> NDArray[np.float64]:
         q = [(r[0, 1] + r[1, 0]) / s, s / 4, (r[1, 2] + r[2, 1]) / s, (r[0, 2] - r[2, 0]) / s]
     else:
         q = [(r[0, 2] + r[2, 0]) / s, (r[1, 2] + r[2, 1]) / s, s / 4, (r[1, 0] - r[0, 1]) / s]
-    result = np.array(q) / np.linalg.norm(q)
+    result: NDArray[np.float64] = np.array(q) / np.linalg.norm(q)
     return -result if result[3] < 0 else result
 
 

@@ -118,10 +118,15 @@ def sampler(trajectory: JointTrajectory) -> Callable[[NDArray[np.float64], int],
     """
     knots, p, v, a = trajectory.times_s, trajectory.positions, trajectory.velocities, trajectory.accelerations
     if len(knots) == 1:
-        return lambda t, derivatives=2: _hold(p[0], v[0], a[0], len(t))
+        def held(t: NDArray[np.float64], derivatives: int = 2) -> Samples:
+            return _hold(p[0], v[0], a[0], len(t))
+        return held
     every = np.ones(len(knots), dtype=bool)
     coefficients = _coefficients(knots, p, v, a, every, every)
-    return lambda t, derivatives=2: _evaluate(knots, coefficients, p, v, a, t, derivatives)
+
+    def evaluated(t: NDArray[np.float64], derivatives: int = 2) -> Samples:
+        return _evaluate(knots, coefficients, p, v, a, t, derivatives)
+    return evaluated
 
 
 def peak_rates(trajectory: JointTrajectory) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

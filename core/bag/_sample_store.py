@@ -19,7 +19,7 @@ import os
 import tempfile
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -50,7 +50,7 @@ class _Column:
         """Write `values` (m rows) after the rows written so far."""
         if len(values) == 0:
             return
-        data = memoryview(np.ascontiguousarray(values, dtype=self.dtype)).cast("B")
+        data = np.ascontiguousarray(values, dtype=self.dtype).data.cast("B")
         try:
             while data:
                 written = self.file.write(data)
@@ -66,7 +66,7 @@ class _Column:
         out = np.empty(shape, dtype=self.dtype)
         if out.size == 0:
             return out
-        view = memoryview(out).cast("B")
+        view = out.data.cast("B")
         offset = begin * self.dtype.itemsize * max(self.width, 1)
         while view:
             count = os.preadv(self.file.fileno(), [view], offset)
@@ -208,9 +208,11 @@ class SampleSpool:
         pending, self._pending = self._pending, []
         if not pending:
             return
-        columns = [np.concatenate([p[i] for p in pending]) if len(pending) > 1 else pending[0][i]
-                   for i in (0, 1, 2, 4)]
-        stamps, log_times, positions, index = columns
+        def joined(i: int) -> NDArray[Any]:
+            parts = [cast(NDArray[Any], p[i]) for p in pending]
+            return np.concatenate(parts) if len(parts) > 1 else parts[0]
+
+        stamps, log_times, positions, index = (joined(i) for i in (0, 1, 2, 4))
         velocities = None
         if self.keep_velocities and self.all_velocities:
             velocities = np.concatenate([p[3] for p in pending]) if len(pending) > 1 else pending[0][3]
@@ -223,7 +225,7 @@ class SampleSpool:
         for name in self._times:
             self._watch_order(name, times[name], index, order)
         if self.finite is None or not self.finite.all():
-            finite = np.isfinite(positions).any(axis=0)
+            finite: NDArray[np.bool_] = np.isfinite(positions).any(axis=0)
             self.finite = finite if self.finite is None else self.finite | finite
         self._write(times, positions, velocities)
         self._batches.append(len(stamps))

@@ -25,7 +25,7 @@ import os
 import tempfile
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import pinocchio as pin
 
@@ -69,28 +69,36 @@ def path(name: str) -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "moveplan" / name
 
 
-def read(where: Path, kind: type) -> Any:
+_Entry = TypeVar("_Entry")
+
+def read(where: Path, kind: type[_Entry]) -> _Entry | None:
     """Return the object cached at `where` if it is a trustworthy `kind`, else None (missing or rebuilt)."""
     try:
         if where.stat().st_size > _MOST_BYTES:
-            return _untrusted(where, f"larger than {_MOST_BYTES:,} bytes")
+            _untrusted(where, f"larger than {_MOST_BYTES:,} bytes")
+            return None
         data = where.read_bytes()
     except FileNotFoundError:
         return None
     except OSError as exc:
-        return _untrusted(where, exc.strerror or str(exc))
+        _untrusted(where, exc.strerror or str(exc))
+        return None
     header, newline, payload = data.partition(b"\n")
     fields = header.split(b" ")
     if not newline or len(fields) != 3 or fields[0] != _MAGIC or fields[1] != str(FORMAT).encode():
-        return _untrusted(where, f"not a moveplan cache entry of format {FORMAT}: another version wrote it, or damaged")
+        _untrusted(where, f"not a moveplan cache entry of format {FORMAT}: another version wrote it, or damaged")
+        return None
     if fields[2] != hashlib.sha256(payload).hexdigest().encode():
-        return _untrusted(where, "checksum mismatch (a damaged file)")
+        _untrusted(where, "checksum mismatch (a damaged file)")
+        return None
     try:
         value = decode(payload)
     except Exception as exc:  # noqa: BLE001 - whatever a malformed payload raises, the entry is rebuilt
-        return _untrusted(where, f"{type(exc).__name__}: {exc}")
+        _untrusted(where, f"{type(exc).__name__}: {exc}")
+        return None
     if not isinstance(value, kind):
-        return _untrusted(where, f"holds a {type(value).__name__}, not a {kind.__name__}")
+        _untrusted(where, f"holds a {type(value).__name__}, not a {kind.__name__}")
+        return None
     return value
 
 

@@ -84,7 +84,8 @@ def _decoded(node: Any, blob: bytes) -> Any:
     if tag == "$bytes" and isinstance(content, str):
         return base64.b64decode(content.encode("ascii"), validate=True)
     if tag == "$array" and isinstance(content, list) and len(content) == 4:
-        return _array(*content, blob)
+        dtype, shape, offset, size = content
+        return _array(dtype, shape, offset, size, blob)
     if tag == "$dataclass" and isinstance(content, list) and len(content) == 2 and content[0] in _DATACLASSES \
             and isinstance(content[1], dict):
         cls = _dataclass(content[0])

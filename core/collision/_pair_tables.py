@@ -81,7 +81,7 @@ def _tabulable(
         for lower, jl in joint_of.items():
             if ju == jl or frozenset((upper, lower)) in disabled:
                 continue
-            between, j = [], jl
+            between, j = list[int](), jl
             while j > 0 and j != ju and len(between) <= 2:
                 between.append(j)
                 j = model.parents[j]

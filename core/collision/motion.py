@@ -84,7 +84,7 @@ class MotionChecker:
         self.base = base
         self.spheres = spheres
         self.reach = certify.reach(robot, checker.geometry)
-        self._stages = (checker,) if hulls is None else (hulls, checker)
+        self._stages: tuple[CollisionChecker, ...] = (checker,) if hulls is None else (hulls, checker)
         self.conservative_available = hulls is not None
 
     def free(self, values: NDArray[np.float64], conservative: bool = False) -> NDArray[np.bool_]:
@@ -104,7 +104,7 @@ class MotionChecker:
 
         What the spheres leave unsure goes to coal in one batch per geometry, hulls first.
         """
-        free = verdict == CLEAR
+        free: NDArray[np.bool_] = verdict == CLEAR
         maybe = np.flatnonzero(verdict == MAYBE)
         if len(maybe):
             free[maybe] = self._stages[0].free_batch(q[maybe].T)

@@ -14,7 +14,7 @@ overlaps, surely collides under the hulls. Anything else is "maybe": the caller 
 
 from __future__ import annotations
 
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 import pinocchio as pin
@@ -168,7 +168,8 @@ class SphereFilter:
                                               trajectory.accelerations))
         peak_v, peak_a = self._peak_rates(knots, p, v, a)
         certify.state_count(float(peak_v @ reach_m) * float(knots[-1] - knots[0]), step_m)  # before numba places them
-        return self._states.trajectory_states(knots, p, v, a, peak_v, peak_a, _plain(reach_m), step_m, certify.PIECE)
+        states = self._states.trajectory_states(knots, p, v, a, peak_v, peak_a, _plain(reach_m), step_m, certify.PIECE)
+        return cast(tuple[NDArray[np.float64], NDArray[np.float64]], states)
 
     def edge(
         self, a: NDArray[np.float64], b: NDArray[np.float64], resolution: float, stop: bool = False

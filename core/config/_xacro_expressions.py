@@ -31,7 +31,7 @@ import types
 from collections.abc import Callable
 from typing import Any
 
-import xacro as _xacro  # type: ignore[import-untyped]  # the PyPI package ships no type hints
+import xacro as _xacro  # the PyPI package ships no type hints (pyproject: ignore_missing_imports)
 
 __all__ = ["MAX_EXPRESSION_CHARS", "MAX_INT_BITS", "MAX_SEQUENCE", "Refused", "bounded_range", "evaluator"]
 
@@ -257,7 +257,8 @@ def _modulo(left: Any, right: Any) -> Any:
 def _formatted(value: Any, conversion: int, spec: str) -> str:
     """Return an f-string field: `value` converted (!s, !r, !a) and formatted with `spec`, within bounds."""
     _formatting(value, spec)
-    converted = {ord("s"): str, ord("r"): repr, ord("a"): ascii}.get(conversion)
+    conversions: dict[int, Callable[[object], str]] = {ord("s"): str, ord("r"): repr, ord("a"): ascii}
+    converted = conversions.get(conversion)
     return format(converted(value) if converted else value, spec)
 
 
@@ -301,12 +302,11 @@ def _converting(function: Callable[..., Any]) -> Callable[..., Any]:
 
 
 # Functions called with other than their own bounds, by identity (an expression may reach them by any name).
-_CALLS: dict[int, tuple[Any, Callable[..., Any]]] = {
-    id(f): (f, g) for f, g in [
-        (builtins.sum, _sum), (math.prod, _product), (builtins.str, _converting(str)),
-        (builtins.repr, _converting(repr)), *((f, _factorial_bound(f)) for f in (math.factorial, math.comb, math.perm)),
-    ]
-}
+_SWAPS: list[tuple[Any, Callable[..., Any]]] = [
+    (builtins.sum, _sum), (math.prod, _product), (builtins.str, _converting(str)),
+    (builtins.repr, _converting(repr)), *((f, _factorial_bound(f)) for f in (math.factorial, math.comb, math.perm)),
+]
+_CALLS: dict[int, tuple[Any, Callable[..., Any]]] = {id(f): (f, g) for f, g in _SWAPS}
 
 
 def _call(function: Any, /, *args: Any, **kwargs: Any) -> Any:
@@ -389,7 +389,7 @@ def bounded_range(function: Callable[..., Any]) -> Callable[..., Any]:
 
 def evaluator(step: Callable[[], None]) -> Callable[..., Any]:
     """Return a replacement of xacro.safe_eval, evaluating through the guards; `step` spends a comprehension step."""
-    guards = {
+    guards: dict[str, Callable[..., Any]] = {
         "__mp_attribute__": _attribute, "__mp_call__": _call, "__mp_power__": _power, "__mp_times__": _times,
         "__mp_shift__": _shift, "__mp_plus__": _plus, "__mp_modulo__": _modulo, "__mp_formatted__": _formatted,
         "__mp_iterate__": lambda iterable: _Counted(iterable, step),

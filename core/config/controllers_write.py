@@ -14,6 +14,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import cast
 
 import yaml
 
@@ -62,7 +63,7 @@ def tuned_controllers_text(
                for joint in missing]
     edits: list[Edit] = []
     if entries and holders:
-        edits.append(_insert(text, holders[-1].gains, "\n".join(entries)))
+        edits.append(_insert(text, cast(yaml.MappingNode, holders[-1].gains), "\n".join(entries)))
     elif entries:
         target = ([s for s in sections if not s.wildcard] or sections)[-1]
         edits.append(_insert(text, target.parameters, "gains:" + "".join("\n  " + e for e in entries)))
@@ -87,7 +88,7 @@ def yaml_float(value: float) -> str:
 
 def _sections(root: yaml.Node | None, controller: str, source: str, args: Mapping[str, str]) -> list[_Section]:
     """Return, in file order, the sections whose ros__parameters apply to the node `controller`."""
-    found = []
+    found: list[_Section] = []
     if not isinstance(root, yaml.MappingNode):
         return found
     for key, value in root.value:

@@ -20,11 +20,6 @@ import yaml
 
 from ..errors import ConfigError, MoveplanError, known
 
-try:
-    from yaml.cyaml import CParser as _CParser  # libyaml's parser, where PyYAML has it
-except ImportError:  # a PyYAML built without libyaml
-    _CParser = None
-
 __all__ = [
     "DEGREES", "MAX_ALIAS_EXPANSION", "MAX_EXPRESSION_LENGTH", "MAX_MAGNITUDE", "MAX_YAML_BYTES", "MAX_YAML_EVENTS",
     "TURN", "angle", "beyond_a_turn", "boolean", "check_keys", "coordinate", "expression", "load_yaml", "mapping",
@@ -32,6 +27,17 @@ __all__ = [
     "more_than_a_turn", "number", "parse_yaml", "pose_angle", "pose_angles", "string_list",
 ]
 
+
+def _libyaml_parser() -> Any:
+    """Return libyaml's parser class, None in a PyYAML built without libyaml."""
+    try:
+        from yaml.cyaml import CParser  # type: ignore[attr-defined]  # cyaml's __all__ omits it
+    except ImportError:
+        return None
+    return CParser
+
+
+_CParser = _libyaml_parser()
 
 MAX_MAGNITUDE = 1e6
 """Largest |value| of a position in [rad] or [m] or a time in [s] from a flag or a task: a million

@@ -268,8 +268,8 @@ def _with_subgroups(own: dict[str, set[str]], subgroups: dict[str, list[str]], p
     waiting = {name: set(subs) for name, subs in subgroups.items()}
     ready = [name for name, subs in waiting.items() if not subs]
     users: dict[str, list[str]] = {}
-    for name, subs in waiting.items():
-        for sub in subs:
+    for name, pending in waiting.items():
+        for sub in pending:
             users.setdefault(sub, []).append(name)
     while ready:
         name = ready.pop()

@@ -117,7 +117,7 @@ def parse_pose(entry: dict[str, Any], where: str) -> PoseGoal:
     Angles of `rpy` are radians, pi expressions or degrees (`90deg`); a unitless one beyond 2*pi is refused.
     """
     check_keys(entry, _POSE_KEYS, where)
-    names = {key: entry.get(key) for key in ("frame", "link")}
+    names: dict[str, Any] = {key: entry.get(key) for key in ("frame", "link")}
     for key, name in names.items():
         if name is not None and not isinstance(name, str):
             raise ConfigError(f"{where}.{key}: expected a frame or link name, got {name!r}")
@@ -202,7 +202,7 @@ def load_task(path: Path) -> TaskFile:
             return None
         if not isinstance(top[key], str):
             raise ConfigError(f"{source}: {key}: expected a path, got {top[key]!r}")
-        return folder / top[key]
+        return folder / str(top[key])
 
     start = _start(mapping(top.get("start"), f"{source}: start"), folder, f"{source}: start")
     defaults = mapping(top.get("defaults"), f"{source}: defaults")

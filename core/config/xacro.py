@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import xacro as _xacro  # type: ignore[import-untyped]  # the PyPI package ships no type hints
+import xacro as _xacro  # the PyPI package ships no type hints (pyproject: ignore_missing_imports)
 from xacro import substitution_args as _substitution_args
 
 from ..errors import ConfigError, UsageError

@@ -5,7 +5,16 @@ from typing import TYPE_CHECKING
 from .._faces import lazy_exports
 
 if TYPE_CHECKING:
-    from .check import SCAN_ROWS, CheckReport, CycleCheck, SampleSource, StepCheck, check_recording, uses_velocities
+    from .check import (
+        SCAN_ROWS,
+        CheckReport,
+        CycleCheck,
+        RecordingStart,
+        SampleSource,
+        StepCheck,
+        check_recording,
+        uses_velocities,
+    )
     from .controller import Disturbance, ExecutionReport, simulate
     from .goal_validation import validate_goal
     from .margins import merged_margins
@@ -42,6 +51,7 @@ __all__ = [
     "Plant",
     "PlantFit",
     "RecordedStep",
+    "RecordingStart",
     "SCAN_ROWS",
     "SampleSource",
     "StepCheck",
@@ -81,6 +91,7 @@ __getattr__ = lazy_exports(__name__, {
     "Plant": "plants",
     "PlantFit": "plants",
     "RecordedStep": "plants",
+    "RecordingStart": "check",
     "SCAN_ROWS": "check",
     "SampleSource": "check",
     "StepCheck": "check",

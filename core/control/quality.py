@@ -91,7 +91,8 @@ def crossings(values: npt.ArrayLike, band: float) -> NDArray[np.intp]:
     side = np.where(array > band, 1, np.where(array < -band, -1, 0))
     outside = np.flatnonzero(side)
     changed = side[outside[1:]] != side[outside[:-1]]
-    return outside[1:][changed]
+    indices: NDArray[np.intp] = outside[1:][changed]
+    return indices
 
 
 def tracking(

@@ -218,7 +218,7 @@ def _stage_i(setup: JointSetup, gains: Gains, start: Gains) -> tuple[float, list
 
 def _keep_i(setup: JointSetup, gains: Gains, start: Gains) -> list[Stage]:
     """Return stage 4 without a load: P alone reaches the setpoint; the file's I stays if it does not ring."""
-    i, stages = start.i, []
+    i, stages = start.i, list[Stage]()
     for _ in range(_BACK_OFFS):
         if i == 0.0 or start.i_clamp <= 0.0:
             break

@@ -84,7 +84,7 @@ class Robot:
 
     def values(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
         """Return the group's joint values in configuration `q`."""
-        out = q[self.q_index].astype(float)
+        out: NDArray[np.float64] = q[self.q_index].astype(float)
         cont = self.continuous
         out[cont] = np.arctan2(q[self.q_index[cont] + 1], q[self.q_index[cont]])
         return out
@@ -123,7 +123,9 @@ class Robot:
         joints = [j for j in self.config.urdf_joints.values() if j.type == "fixed"]
         return tuple(Frame(j.child, j.parent, self._relative(j.parent, j.child)) for j in joints)
 
-    def tf_samples(self, times_s: npt.ArrayLike, values: NDArray[np.float64], base: NDArray[np.float64]) -> TfSamples:
+    def tf_samples(
+        self, times_s: NDArray[np.float64], values: NDArray[np.float64], base: NDArray[np.float64]
+    ) -> TfSamples:
         """Return `parent_T_child` of every moving URDF joint for group values (M, dof) at `times_s`."""
         moving = [j for j in self.config.urdf_joints.values() if j.type != "fixed"]
         pairs = [(self.model.getFrameId(j.parent), self.model.getFrameId(j.child)) for j in moving]

@@ -224,14 +224,14 @@ def moveplan_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
         where = f"{source}: attached[{k}]"
         entry = mapping(entry, where)
         check_keys(entry, _ATTACHED_KEYS, where)
-        name, link = entry.get("name"), entry.get("link")
-        if not isinstance(name, str) or not isinstance(link, str):
+        name, carrier = entry.get("name"), entry.get("link")
+        if not isinstance(name, str) or not isinstance(carrier, str):
             raise ConfigError(f"{where}: 'name' and 'link' must be strings")
-        if link not in robot.link_names:
-            raise FrameNotFound(link, where, robot.link_names)
+        if carrier not in robot.link_names:
+            raise FrameNotFound(carrier, where, robot.link_names)
         touch = tuple(str(t) for t in entry.get("touch_links") or [])
         transform = _pose(entry, where)
-        objects.append(CollisionObject(name, _shape(entry, where, path.parent), transform, link, touch))
+        objects.append(CollisionObject(name, _shape(entry, where, path.parent), transform, carrier, touch))
     if (twice := first_repeated(o.name for o in objects)) is not None:
         raise ConfigError(f"{source}: object name '{twice}' is used twice")
     return Scene(source, tuple(frames), tuple(objects), anchors)

@@ -136,7 +136,7 @@ def run_benchmark(
     (None: the default for the budget).
     """
     context = multiprocessing.get_context("spawn")
-    results: queue_module.Queue[Any] = context.Queue()
+    results = context.Queue()
     pending = [(planner, seed) for planner in planners for seed in seeds]
     running: dict[tuple[str, int], Any] = {}
     runs: list[Run] = []
@@ -216,7 +216,7 @@ def _solve(problem: Problem, config: Any, planner: str, seed: int, budget: tuple
     flags = pipeline.PlanFlags(robot=config.root, scene=problem.scene, request=problem.request, planner=planner,
                                planning_time=budget[0], timeout=budget[1], seed=seed)
     request = pipeline.resolve_request(load_task(problem.task) if problem.task else None, flags)
-    where = {"problem": problem.name, "scenario": problem.scenario, "planner": planner, "seed": seed}
+    where: dict[str, Any] = {"problem": problem.name, "scenario": problem.scenario, "planner": planner, "seed": seed}
     try:
         plan = pipeline.plan(request, config=config, exact_check=True)
     except NoPlan as exc:
@@ -228,8 +228,8 @@ def _solve(problem: Problem, config: Any, planner: str, seed: int, budget: tuple
     def total(key: str) -> float:
         return float(sum(s.get(key, 0.0) for s in steps))
 
-    stages = {"search_s": total("plan_s"), "simplify_s": total("simplify_s"), "certify_s": total("certify_s"),
-              "timing_s": total("timing_s")}
+    stages: dict[str, Any] = {"search_s": total("plan_s"), "simplify_s": total("simplify_s"),
+                              "certify_s": total("certify_s"), "timing_s": total("timing_s")}
     return Run(
         **where, ok=True, **stages, total_s=sum(stages.values()),
         planning_time_s=sum(s.planning_time_s for s in plan.steps), whole_call_s=whole_call_s,

@@ -25,6 +25,7 @@ from ..control import (
     ExecutionResult,
     ExecutionSummary,
     JointTracking,
+    RecordingStart,
     SampleSource,
     Violation,
     check_recording,
@@ -35,7 +36,7 @@ from ..control import (
     uses_velocities,
 )
 from ..errors import InputError, UnknownName
-from ..types import TfSamples
+from ..types import TfSamples, TimeSource
 from ._plan_files import plan_config, plan_controller, read_valid_plan
 
 if TYPE_CHECKING:
@@ -74,8 +75,8 @@ class CheckRequest:
     recording: Path
     topic: str = "/joint_states"
     controllers: Path | None = None
-    start: str | float = "auto"
-    time_source: str = "header"
+    start: RecordingStart = "auto"
+    time_source: TimeSource = "header"
     skip_damaged: bool = False
 
 

@@ -100,14 +100,14 @@ def end_states(plan: PlanFile, path: Path) -> tuple[RobotState, ...]:
     except InputError as exc:
         logger.warning("%s: no end states: %s", path, exc)
         return ()
-    states = []
+    ends: list[RobotState] = []
     for step in plan.steps:
         trajectory = step.trajectory
         q = robot.neutral()
         for joint, value in zip(trajectory.joint_names, trajectory.positions[-1], strict=True):
             q = robot.set_joint(q, joint, float(value))
-        states.append(robot_state(robot, empty_scene(), q))
-    return tuple(states)
+        ends.append(robot_state(robot, empty_scene(), q))
+    return tuple(ends)
 
 
 def step_peaks(plan: PlanFile, path: Path) -> tuple[StepPeaks, ...]:

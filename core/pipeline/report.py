@@ -11,7 +11,7 @@ import math
 from collections.abc import Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import asdict
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 from .. import bag as recording
 from ..bag import ExecutedStep, ExecutionWriter, execution_writer, seconds_to_ns, stamps_ns
@@ -160,13 +160,13 @@ def execution_document(execution: PlanExecution) -> dict[str, Any]:
             }
         )
         start_ns += seconds_to_ns(report.duration_s)
-    return _finite_numbers({
+    return cast(dict[str, Any], _finite_numbers({
         **_verdict(execution.ok, execution.result, execution.violations, execution.margins),
         "controller": execution.controller.name,
         "duration_s": start_ns / 1e9,
         "steps": steps,
         "tracking": tracking_document(execution.tracking),
-    })
+    }))
 
 
 def check_document(report: CheckReport, recording: Path) -> dict[str, Any]:
@@ -210,7 +210,7 @@ def check_document(report: CheckReport, recording: Path) -> dict[str, Any]:
                               for c in report.cycles]
         document["failing_cycles"] = list(report.failing_cycles)
         document["incomplete_cycles"] = list(report.incomplete_cycles)
-    return _finite_numbers(document)
+    return cast(dict[str, Any], _finite_numbers(document))
 
 
 def tracking_document(figures: Mapping[str, JointTracking]) -> dict[str, dict[str, Any]]:

@@ -210,7 +210,7 @@ def resolve_request(task: TaskFile | None, flags: PlanFlags) -> PlanRequest:
     """
     motion = load_motion_plan_request(flags.request) if flags.request else None
     steps = _steps(task, motion, flags)
-    robot = _first(flags.robot, task and task.robot)
+    robot = _first(flags.robot, task.robot if task else None)
     if robot is None:
         raise UsageError("no robot: give --robot or a task file naming one")
     start = flags.start
@@ -218,8 +218,8 @@ def resolve_request(task: TaskFile | None, flags: PlanFlags) -> PlanRequest:
         start = task.start
     defaults = task.defaults if task is not None else {}
     return PlanRequest(
-        robot=Path(robot), steps=steps, scene=_first(flags.scene, task and task.scene),
-        group=_first(flags.group, motion and motion.group_name, task and task.group), start=start,
+        robot=Path(robot), steps=steps, scene=_first(flags.scene, task.scene if task else None),
+        group=_first(flags.group, motion.group_name if motion else None, task.group if task else None), start=start,
         planner=_first(flags.planner, motion and motion.planner, defaults.get("planner")),
         planning_time=_first(flags.planning_time, motion and motion.planning_time, defaults.get("planning_time")),
         timeout=flags.timeout,
@@ -227,7 +227,7 @@ def resolve_request(task: TaskFile | None, flags: PlanFlags) -> PlanRequest:
                                 defaults.get("velocity_scaling")),
         acceleration_scaling=_first(flags.acceleration_scaling, motion and motion.acceleration_scaling,
                                     defaults.get("acceleration_scaling")),
-        seed=_first(flags.seed, task and task.seed) or 0,
+        seed=_first(flags.seed, task.seed if task else None) or 0,
         min_fraction=1.0 if flags.min_fraction is None else flags.min_fraction,
         package_paths=flags.package_paths, xacro_args=dict(flags.xacro_args), task=task, motion_request=motion,
         urdf=flags.urdf, srdf=flags.srdf, strict_limits=flags.strict_limits,

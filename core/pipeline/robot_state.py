@@ -212,7 +212,8 @@ def _without_mesh_files(top: dict[str, Any]) -> dict[str, Any]:
     planned, and opening a plan file must read nothing of this machine's.
     """
     def objects(section: Any, key: str) -> list[Any]:
-        return section.get(key) if isinstance(section, dict) and isinstance(section.get(key), list) else []
+        found = section.get(key) if isinstance(section, dict) else None
+        return found if isinstance(found, list) else []
 
     copied = copy.deepcopy(top)
     attached = [a.get("object") for a in objects(copied.get("robot_state"), "attached_collision_objects")

@@ -67,7 +67,7 @@ def straight_line(
     origin = robot.frame_pose(robot.configuration(start, base), link)
     rotation = pin.log3(origin[:3, :3].T @ target[:3, :3])
     distance = float(np.linalg.norm(target[:3, 3] - origin[:3, 3]))
-    count = max(1, int(np.ceil(max(distance / _STEP_M, np.linalg.norm(rotation) / _STEP_RAD))))
+    count = max(1, int(np.ceil(max(distance / _STEP_M, float(np.linalg.norm(rotation)) / _STEP_RAD))))
 
     def pose_at(s: float) -> NDArray[np.float64]:
         pose = np.eye(4)

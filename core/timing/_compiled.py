@@ -46,7 +46,7 @@ def compiled_quintic_peak_rates(
     """Return trajectory.quintic_peak_rates(...) (same arguments, same result), computed by compiled code."""
     if len(knots) == 1:
         return np.abs(v[0]), np.abs(a[0])
-    return _peaks(*(_plain(x, np.float64) for x in (knots, p, v, a)))  # type: ignore[no-any-return]
+    return _peaks(*(_plain(x, np.float64) for x in (knots, p, v, a)))
 
 
 def _plain(values: NDArray[Any], dtype: type) -> NDArray[Any]:

@@ -65,3 +65,11 @@ def test_a_face_exports_what_it_lists_and_loads_it_on_first_use(face: str) -> No
     assert exported & children == set()
     for name in exported:
         assert getattr(package, name) is not None
+
+
+def test_the_packages_ship_their_types() -> None:
+    """`moveplan.commander` users' type checkers read moveplan's annotations (PEP 561: py.typed in the package)."""
+    data = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]
+    for package, folder in (("moveplan.core", "core"), ("moveplan.cli", "cli"), ("moveplan.commander", "commander")):
+        assert (ROOT / folder / "py.typed").is_file()
+        assert "py.typed" in data[package]

@@ -62,8 +62,8 @@ def verify_mcap(path: Path, stream: IO[bytes], size: int, skips: Skips) -> Verif
     try:
         try:
             read_summary(stream, size, codecs.limit)
-        except Damage as damage:
-            skips.take(path, damage)
+        except Damage as summary_damage:
+            skips.take(path, summary_damage)
             sound = False
         raw, out = bytearray(), bytearray()
         for record in data_records(stream, size, codecs.limit):

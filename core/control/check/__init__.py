@@ -11,13 +11,14 @@ from typing import TYPE_CHECKING
 from ..._faces import lazy_exports
 
 if TYPE_CHECKING:
-    from .recording import check_recording, uses_velocities
+    from .recording import RecordingStart, check_recording, uses_velocities
     from .report import CheckReport, CycleCheck, StepCheck
     from .samples import SCAN_ROWS, SampleSource
 
 __all__ = [
     "CheckReport",
     "CycleCheck",
+    "RecordingStart",
     "SCAN_ROWS",
     "SampleSource",
     "StepCheck",
@@ -28,6 +29,7 @@ __all__ = [
 __getattr__ = lazy_exports(__name__, {
     "CheckReport": "report",
     "CycleCheck": "report",
+    "RecordingStart": "recording",
     "SCAN_ROWS": "samples",
     "SampleSource": "samples",
     "StepCheck": "report",

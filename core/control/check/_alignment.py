@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -313,7 +314,7 @@ class _Zone:
         self.entries += (at + changes[(now == 1) & (before != 1)]).tolist()
         if len(now):
             self._state = int(now[-1])
-        return exits
+        return cast(NDArray[np.intp], exits)
 
     def result(self) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
         """Return the exits, and for each where the robot last entered the zone before it (0 if never)."""

@@ -43,9 +43,9 @@ from ._verdicts import cycles_report, execution_report
 from .report import CheckReport, StepCheck
 from .samples import SampleSource, source_of
 
-__all__ = ["SampleSource", "Start", "check_recording", "uses_velocities"]
+__all__ = ["RecordingStart", "SampleSource", "check_recording", "uses_velocities"]
 
-Start = float | Literal["auto", "all"]
+RecordingStart = float | Literal["auto", "all"]
 """Where the check starts: "auto", "all", or a time in [s] from the recording's first sample."""
 
 
@@ -55,7 +55,7 @@ def check_recording(
     controller: ControllerConfig,
     execution: ExecutionConfig,
     continuous_joints: Iterable[str] = (),
-    start: Start = "auto",
+    start: RecordingStart = "auto",
 ) -> CheckReport:
     """Return the verdict of the controller's and MoveIt's checks on a recorded execution.
 
@@ -101,7 +101,7 @@ def uses_velocities(plan: CheckedPlan, controller: ControllerConfig) -> bool:
         blends and "velocity" in controller.state_interfaces)
 
 
-def _first_start(context: CheckContext, start: Start, warnings: list[str]) -> tuple[float, str]:
+def _first_start(context: CheckContext, start: RecordingStart, warnings: list[str]) -> tuple[float, str]:
     """Return where the one execution checked starts, in [s], and how that was found."""
     if isinstance(start, str):
         if start != "auto":

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -135,8 +136,9 @@ def fit_plant(
                 if len(kept) and errors[kept[0], j] <= _INDIFFERENT * errors[best[j], j] + 1e-18:
                     best[j] = kept[0]
             current[key] = grid[best, np.arange(n)]
-    final = sum(_step_error(step, interface, dt, gains, current, continuous, np.array([shift]))
-                for step, shift in zip(steps, shifts, strict=True))
+    step_errors = (_step_error(step, interface, dt, gains, current, continuous, np.array([shift]))
+                   for step, shift in zip(steps, shifts, strict=True))
+    final = cast(NDArray[np.float64], sum(step_errors))
     counts = sum(len(s.times_s) for s in steps)
     noise = noise_level(np.vstack([s.positions for s in steps]))
     travel = np.max([np.ptp(s.positions, axis=0) for s in steps], axis=0)

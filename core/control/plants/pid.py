@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -176,7 +176,8 @@ def pid_parameters(params: Mapping[str, float], joints: Sequence[str]) -> dict[s
     return values
 
 
-_RANGES = {key: (">= 0", lambda v: v >= 0.0) for key in ("noise", "drive_tau")} | {
+_RANGES: dict[str, tuple[str, Callable[[float], bool]]] = {
+    key: (">= 0", lambda v: v >= 0.0) for key in ("noise", "drive_tau")} | {
     key: ("positive", lambda v: v > 0.0) for key in ("inertia", "max_effort", "max_velocity")} | {
     "load": ("a finite number", math.isfinite)}
 

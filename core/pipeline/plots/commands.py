@@ -289,10 +289,11 @@ def _recorded_step(
         error = position_error(reference, actual, continuous)
         parts.append(thinned(since + step.start_s - origin_s, reference, actual, error, every, last=stop == end))
     n = len(columns)
-    series = [np.concatenate([p[i] for p in parts]) if parts else np.zeros((0, n) if i else 0) for i in range(6)]
+    times_s, reference, actual, error, low, high = (
+        np.concatenate([p[i] for p in parts]) if parts else np.zeros((0, n) if i else 0) for i in range(6))
     start = step.start_s - origin_s
-    return TrackedStep(step.name, start, trajectory.duration_s, start + step.duration_s, *series,
-                       _marks(step.report.violations, start))
+    return TrackedStep(step.name, start, trajectory.duration_s, start + step.duration_s, times_s, reference, actual,
+                       error, low, high, _marks(step.report.violations, start))
 
 
 def _search(samples: SampleSource, time_s: float, side: Literal["left", "right"]) -> int:
@@ -319,10 +320,15 @@ def _step_budget(duration_s: float, total_s: float) -> int:
     return max(_MIN_STEP_POINTS, int(POINTS_PER_SERIES * share))
 
 
+_Series = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+                NDArray[np.float64], NDArray[np.float64]]
+"""Times, reference, actual, error, error min and error max of kept samples."""
+
+
 def thinned(
     times: NDArray[np.float64], reference: NDArray[np.float64], actual: NDArray[np.float64],
     error: NDArray[np.float64], every: int, last: bool,
-) -> tuple[NDArray[np.float64], ...]:
+) -> _Series:
     """Return every `every`-th row (and the final one if `last`): times, reference, actual, error, error min, max.
 
     The min and max are over the rows each kept row stands for, so a peak between kept rows still shows.
