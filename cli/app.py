@@ -141,7 +141,7 @@ def plan(
 
 def _plan_flags(args: dict[str, Any]) -> PlanFlags:
     """Return the plan command's flags as core's typed values; core checks the rules between them."""
-    from ..core.config import parse_xacro_args
+    from ..core.config import MotionSettings, parse_xacro_args
     from ..core.pipeline import PlanFlags
 
     def number(key: str) -> float | None:
@@ -154,9 +154,10 @@ def _plan_flags(args: dict[str, Any]) -> PlanFlags:
         joints=parse_optional(parse_joints, args["joints"], "--joints"), named=args["named"],
         pose=parse_optional(parse_pose, args["pose"], "--pose"), frame=args["frame"], link=args["link"],
         shift=parse_optional(parse_shift, args["shift"], "--shift"), shift_frame=args["shift_frame"],
-        linear=args["linear"], min_fraction=number("min_fraction"), planner=args["planner"],
-        planning_time=number("planning_time"), timeout=number("timeout"), seed=args["seed"],
-        velocity_scaling=number("velocity_scaling"), acceleration_scaling=number("acceleration_scaling"),
+        linear=args["linear"], min_fraction=number("min_fraction"),
+        motion=MotionSettings(args["planner"], number("planning_time"), number("velocity_scaling"),
+                              number("acceleration_scaling")),
+        timeout=number("timeout"), seed=args["seed"],
         package_paths=tuple(args["package_path"] or ()),
         xacro_args=parse_xacro_args(args["xacro_arg"] or ()), urdf=args["urdf"], srdf=args["srdf"],
         strict_limits=args["strict_limits"],

@@ -9,11 +9,12 @@ from __future__ import annotations
 import math
 import numbers
 import reprlib
+from dataclasses import replace
 from typing import Any
 
-from ..core.config import MIN_SCALING, PLANNERS
+from ..core.config import MIN_SCALING, PLANNERS, MotionSettings
 from ..core.errors import UsageError, known
-from ..core.pipeline import MotionSettings, check_planning_time
+from ..core.pipeline import check_planning_time
 from ._world import World
 
 __all__ = ["PLANNING_TIME_S", "PlanningSettings", "real_number"]
@@ -30,9 +31,8 @@ class PlanningSettings:
     _world: World
 
     def __init__(self) -> None:
-        self._planning_time = PLANNING_TIME_S
-        self._planner: str | None = None
-        self._scaling: dict[str, float | None] = {"velocity": None, "acceleration": None}
+        # What the setters set; the rest is the robot config's, as MoveIt's move_group gives it.
+        self._motion = MotionSettings(planning_time=PLANNING_TIME_S)
         self._tolerances = dict(_TOLERANCES)
 
     def get_goal_tolerance(self) -> tuple[float, float, float]:
@@ -69,15 +69,16 @@ class PlanningSettings:
 
     def get_planning_time(self) -> float:
         """Return the time a plan may search, in [s] (default 5, MoveIt's)."""
-        return self._planning_time
+        return float(self._motion.planning_time or PLANNING_TIME_S)
 
     def set_planning_time(self, seconds: float) -> None:
         """Set the time a plan may search, in [s]; return None."""
-        self._planning_time = check_planning_time(real_number(seconds, "set_planning_time"), "set_planning_time")
+        seconds = check_planning_time(real_number(seconds, "set_planning_time"), "set_planning_time")
+        self._motion = replace(self._motion, planning_time=seconds)
 
     def get_planner_id(self) -> str:
         """Return the planner set, or the robot config's when none was."""
-        return self._planner or str(self._world.config.planning["planner"])
+        return self._motion.planner or str(self._world.config.planning["planner"])
 
     def set_planner_id(self, planner_id: str) -> None:
         """Plan with an OMPL geometric planner ("RRTConnect"; MoveIt's "RRTConnectkConfigDefault" too); return None.
@@ -90,7 +91,7 @@ class PlanningSettings:
         if name and name not in PLANNERS:
             raise UsageError(f"set_planner_id: unknown planner '{planner_id}'; OMPL geometric planners: "
                              f"{known(PLANNERS)}")
-        self._planner = name or None
+        self._motion = replace(self._motion, planner=name or None)
 
     def set_num_planning_attempts(self, num_planning_attempts: int) -> None:
         """Accept MoveIt's number of attempts; a moveplan plan is one attempt, certified; return None."""
@@ -100,16 +101,16 @@ class PlanningSettings:
 
     def set_max_velocity_scaling_factor(self, value: float) -> None:
         """Scale the joints' velocity limits by `value` in (0, 1] (default: joint_limits.yaml's); return None."""
-        self._scaling["velocity"] = _scaling(value, "set_max_velocity_scaling_factor")
+        self._motion = replace(self._motion, velocity_scaling=_scaling(value, "set_max_velocity_scaling_factor"))
 
     def set_max_acceleration_scaling_factor(self, value: float) -> None:
         """Scale the joints' acceleration limits by `value` in (0, 1] (default: joint_limits.yaml's); return None."""
-        self._scaling["acceleration"] = _scaling(value, "set_max_acceleration_scaling_factor")
+        self._motion = replace(self._motion,
+                               acceleration_scaling=_scaling(value, "set_max_acceleration_scaling_factor"))
 
     def _settings(self) -> MotionSettings:
-        """Return the settings a motion is planned with now."""
-        return MotionSettings(self._planner, self._planning_time, self._scaling["velocity"],
-                              self._scaling["acceleration"], self._world.seed)
+        """Return the settings a motion is planned with now (None: the robot config's)."""
+        return self._motion
 
 
 def _scaling(value: Any, where: str) -> float:

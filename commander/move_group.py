@@ -324,7 +324,7 @@ class MoveGroupCommander(PlanningSettings):
         except NoPlan as exc:  # two parts that never move touch: no state is free
             logger.info("compute_cartesian_path: %s", exc)
             return to_message(None, self.get_planning_frame()), 0.0
-        step, fraction = cartesian_motion(self._robot, world.scene, checks, goals, q, self._settings())
+        step, fraction = cartesian_motion(self._robot, world.scene, checks, goals, q, self._settings(), world.seed)
         return to_message(step, self.get_planning_frame()), fraction
 
     def stop(self) -> None:
@@ -385,7 +385,7 @@ class MoveGroupCommander(PlanningSettings):
         began = time.perf_counter()
         try:
             step = plan_motion(self._robot, self._world.scene, self._world.checks(self._robot, q), spec, q,
-                               self._settings())
+                               self._settings(), self._world.seed)
         except NoPlan as exc:
             logger.info("plan: %s", exc)
             return None, exc, time.perf_counter() - began

@@ -30,6 +30,7 @@ if TYPE_CHECKING:
     from .goals import SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
     from .joint_units import check_joint_units
     from .limits import DEFAULT_ACCELERATION, JointLimit
+    from .motion import MotionSettings, Resolved, layered, resolved
     from .planners import PLANNERS
     from .robot_config import RobotConfig, load_robot_config
     from .sources import CONFIG_FILE
@@ -49,10 +50,12 @@ __all__ = [
     "MAX_MAGNITUDE",
     "MAX_SEED",
     "MIN_SCALING",
+    "MotionSettings",
     "NamedGoal",
     "PLANNERS",
     "PackagePath",
     "PoseGoal",
+    "Resolved",
     "RobotConfig",
     "SHIFT_AXES",
     "ShiftGoal",
@@ -67,6 +70,7 @@ __all__ = [
     "coordinate",
     "default_controller",
     "expression",
+    "layered",
     "load_robot_config",
     "load_task",
     "load_yaml",
@@ -79,6 +83,7 @@ __all__ = [
     "pose_angles",
     "read_input",
     "read_input_text",
+    "resolved",
     "tuned_controllers_text",
 ]
 
@@ -94,10 +99,12 @@ __getattr__ = lazy_exports(__name__, {
     "MAX_MAGNITUDE": "fields",
     "MAX_SEED": "tasks",
     "MIN_SCALING": "tasks",
+    "MotionSettings": "motion",
     "NamedGoal": "goals",
     "PLANNERS": "planners",
     "PackagePath": "xacro",
     "PoseGoal": "goals",
+    "Resolved": "motion",
     "RobotConfig": "robot_config",
     "SHIFT_AXES": "goals",
     "ShiftGoal": "goals",
@@ -112,6 +119,7 @@ __getattr__ = lazy_exports(__name__, {
     "coordinate": "fields",
     "default_controller": "controllers",
     "expression": "fields",
+    "layered": "motion",
     "load_robot_config": "robot_config",
     "load_task": "tasks",
     "load_yaml": "fields",
@@ -124,5 +132,6 @@ __getattr__ = lazy_exports(__name__, {
     "pose_angles": "fields",
     "read_input": "fields",
     "read_input_text": "fields",
+    "resolved": "motion",
     "tuned_controllers_text": "controllers_write",
 })

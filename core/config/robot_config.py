@@ -28,6 +28,7 @@ from .controllers import ControllerConfig, ExecutionConfig, parse_controllers, p
 from .embed import carried_paths, embedded_files
 from .fields import read_input
 from .limits import DEFAULT_SOURCE, JointLimit, merge_limits, parse_joint_limits
+from .motion import Resolved
 from .sources import (
     CONFIG_FILE,
     discover,
@@ -98,6 +99,12 @@ class RobotConfig:
     kinematics: dict[str, dict[str, Any]] = field(default_factory=dict)
     xacro_args: dict[str, str] = field(default_factory=dict)
     initial_sources: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def motion_defaults(self) -> Resolved:
+        """Return what a motion is planned with where nothing else says: moveplan.yaml's planner and time, scalings."""
+        return Resolved(self.planning["planner"], self.planning["planning_time"], self.default_velocity_scaling,
+                        self.default_acceleration_scaling)
 
     def group(self, name: str | None = None) -> Group:
         """Return the named planning group, or the config's default one."""

@@ -24,6 +24,7 @@ from .fields import (
     read_input,
 )
 from .goals import GOAL_KINDS, SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
+from .motion import MotionSettings
 from .sources import shipped_config
 
 __all__ = [
@@ -50,12 +51,9 @@ class StepSpec:
 
     name: str
     goal: Goal
-    velocity_scaling: float | None = None
-    acceleration_scaling: float | None = None
-    planner: str | None = None
-    planning_time: float | None = None
     linear: bool = False
     min_fraction: float | None = None
+    motion: MotionSettings = MotionSettings()
 
 
 @dataclass(frozen=True)
@@ -67,7 +65,7 @@ class TaskFile:
     scene: Path | None
     group: str | None
     start: Start
-    defaults: dict[str, Any]
+    defaults: MotionSettings
     steps: tuple[StepSpec, ...]
     seed: int | None = None
     raw: bytes = field(default=b"", repr=False)
@@ -163,19 +161,17 @@ def _start(entry: dict[str, Any], folder: Path, where: str) -> Start:
     return goal
 
 
-def _defaults(entry: dict[str, Any], where: str) -> dict[str, Any]:
-    result: dict[str, Any] = {}
-    for key in ("velocity_scaling", "acceleration_scaling"):
-        if key in entry:
-            result[key] = parse_scaling(entry[key], f"{where}.{key}")
-    if "planner" in entry:
-        if not isinstance(entry["planner"], str):
-            raise ConfigError(f"{where}.planner: expected a planner name, got {entry['planner']!r}")
-        result["planner"] = entry["planner"]
+def _motion(entry: dict[str, Any], where: str) -> MotionSettings:
+    """Return the motion settings a task's defaults or one of its steps sets."""
+    scalings = {key: parse_scaling(entry[key], f"{where}.{key}")
+                for key in ("velocity_scaling", "acceleration_scaling") if key in entry}
+    planner = entry.get("planner")
+    if planner is not None and not isinstance(planner, str):
+        raise ConfigError(f"{where}.planner: expected a planner name, got {planner!r}")
+    planning_time = None
     if "planning_time" in entry:
-        result["planning_time"] = number(entry["planning_time"], f"{where}.planning_time", positive=True,
-                                         bound=MAX_MAGNITUDE)
-    return result
+        planning_time = number(entry["planning_time"], f"{where}.planning_time", positive=True, bound=MAX_MAGNITUDE)
+    return MotionSettings(planner, planning_time, **scalings)
 
 
 def _robot(beside: Path | None, written: str | None) -> Path | None:
@@ -228,7 +224,7 @@ def load_task(path: Path) -> TaskFile:
         if linear and isinstance(goal, JointGoal | NamedGoal):
             raise ConfigError(f"{where}: linear applies to pose and shift goals, not {goal.kind}")
         steps.append(StepSpec(name=name, goal=goal, linear=linear, min_fraction=min_fraction,
-                              **_defaults(entry, where)))
+                              motion=_motion(entry, where)))
     names = [s.name for s in steps]
     for name in names:
         if names.count(name) > 1:
@@ -244,7 +240,7 @@ def load_task(path: Path) -> TaskFile:
         scene=relative("scene"),
         group=str(group) if group is not None else None,
         start=start,
-        defaults=_defaults(defaults, f"{source}: defaults"),
+        defaults=_motion(defaults, f"{source}: defaults"),
         steps=tuple(steps),
         seed=seed,
         raw=read_input(path),

@@ -42,6 +42,7 @@ from ..config import (
     MIN_SCALING,
     PLANNERS,
     JointGoal,
+    MotionSettings,
     PoseGoal,
     StepSpec,
     check_keys,
@@ -115,10 +116,8 @@ class MotionPlanRequest:
         start: start_state.joint_state as joint -> position in [rad] or [m]; may name joints
             outside the group (a Panda's fingers), which then hold those values.
         goal: The first goal alternative as a step, named after the file; None without goals.
-        planner: OMPL planner name.
-        planning_time: In [s].
-        velocity_scaling: Fraction of the velocity limits, in (0, 1].
-        acceleration_scaling: Fraction of the acceleration limits, in (0, 1].
+        motion: planner_id, allowed_planning_time and the scaling factors, as the settings
+            they give (None where the file leaves one to the default).
         raw: The file's bytes, embedded in plan files.
         attached: start_state.attached_collision_objects as written (each with a link name
             and an object id); attached to the scene with the robot at the start.
@@ -128,10 +127,7 @@ class MotionPlanRequest:
     group_name: str | None
     start: dict[str, float]
     goal: StepSpec | None
-    planner: str | None
-    planning_time: float | None
-    velocity_scaling: float | None
-    acceleration_scaling: float | None
+    motion: MotionSettings
     raw: bytes = b""
     attached: tuple[Any, ...] = ()
 
@@ -172,10 +168,12 @@ def load_motion_plan_request(path: Path) -> MotionPlanRequest:
         group_name=group or None,
         start=joints,
         goal=goal,
-        planner=planner_name(planner_id, f"{source}: planner_id"),
-        planning_time=planning_time or None,
-        velocity_scaling=_scaling(top, "max_velocity_scaling_factor", source),
-        acceleration_scaling=_scaling(top, "max_acceleration_scaling_factor", source),
+        motion=MotionSettings(
+            planner=planner_name(planner_id, f"{source}: planner_id"),
+            planning_time=planning_time or None,
+            velocity_scaling=_scaling(top, "max_velocity_scaling_factor", source),
+            acceleration_scaling=_scaling(top, "max_acceleration_scaling_factor", source),
+        ),
         raw=read_input(path),
         attached=tuple(attached),
     )

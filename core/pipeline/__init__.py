@@ -23,7 +23,6 @@ if TYPE_CHECKING:
     from .robot_state import StateRequest, StateResult, state
     from .session import (
         ExecutionSettings,
-        MotionSettings,
         cartesian_motion,
         check_execution,
         compose_scene,
@@ -42,7 +41,6 @@ __all__ = [
     "ExecuteRequest",
     "ExecutionSettings",
     "Inspection",
-    "MotionSettings",
     "PlanExecution",
     "PlanFlags",
     "PlanResult",
@@ -90,7 +88,6 @@ __getattr__ = lazy_exports(__name__, {
     "ExecuteRequest": "execution",
     "ExecutionSettings": "session",
     "Inspection": "inspection",
-    "MotionSettings": "session",
     "PlanExecution": "execution",
     "PlanFlags": "request",
     "PlanResult": "plan",

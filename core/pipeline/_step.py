@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..collision import MotionChecker, SphereFilter
-from ..config import JointGoal, NamedGoal, StepSpec
+from ..config import JointGoal, NamedGoal, StepSpec, resolved
 from ..errors import GoalInCollision, PlanningFailed, PlanningTimeExceeded
 from ..model import Robot, Scene, solve_ik
 from ..planning import (
@@ -113,15 +113,13 @@ def plan_step(
 
 def _settings(spec: StepSpec, request: PlanRequest, robot: Robot) -> _Settings:
     """Return a step's planner, planning time, scaled limits and minimum fraction."""
-    config = robot.config
-    velocity = spec.velocity_scaling or request.velocity_scaling or config.default_velocity_scaling
-    acceleration = spec.acceleration_scaling or request.acceleration_scaling or config.default_acceleration_scaling
+    motion = resolved(spec.motion, request.motion, defaults=robot.config.motion_defaults)
     return _Settings(
-        planner=spec.planner or request.planner or config.planning["planner"],
-        planning_time=spec.planning_time or request.planning_time or config.planning["planning_time"],
+        planner=motion.planner,
+        planning_time=motion.planning_time,
         timeout=request.timeout,
-        max_velocity=robot.max_velocity * velocity,
-        max_acceleration=robot.max_acceleration * acceleration,
+        max_velocity=robot.max_velocity * motion.velocity_scaling,
+        max_acceleration=robot.max_acceleration * motion.acceleration_scaling,
         min_fraction=spec.min_fraction if spec.min_fraction is not None else request.min_fraction,
     )
 

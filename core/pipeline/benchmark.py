@@ -209,12 +209,13 @@ def _solve(problem: Problem, config: Any, planner: str, seed: int, budget: tuple
     `budget` is the search's planning time and wall-clock timeout.
     """
     from ..bag import write_plan
-    from ..config import load_task
+    from ..config import MotionSettings, load_task
     from . import plan as pipeline
 
     began = time.perf_counter()
-    flags = pipeline.PlanFlags(robot=config.root, scene=problem.scene, request=problem.request, planner=planner,
-                               planning_time=budget[0], timeout=budget[1], seed=seed)
+    flags = pipeline.PlanFlags(robot=config.root, scene=problem.scene, request=problem.request,
+                               motion=MotionSettings(planner=planner, planning_time=budget[0]), timeout=budget[1],
+                               seed=seed)
     request = pipeline.resolve_request(load_task(problem.task) if problem.task else None, flags)
     where: dict[str, Any] = {"problem": problem.name, "scenario": problem.scenario, "planner": planner, "seed": seed}
     try:

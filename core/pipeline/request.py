@@ -16,6 +16,7 @@ from ..config import (
     MAX_MAGNITUDE,
     MIN_SCALING,
     JointGoal,
+    MotionSettings,
     NamedGoal,
     PoseGoal,
     RobotConfig,
@@ -24,6 +25,7 @@ from ..config import (
     StartFrom,
     StepSpec,
     TaskFile,
+    layered,
     load_robot_config,
 )
 from ..errors import UsageError
@@ -89,11 +91,11 @@ class PlanFlags:
         shift_frame: Axes of `shift` (default "tool").
         linear: Move the tip along a straight line.
         min_fraction: With `linear`, the smallest fraction of the line that is a success, in [0, 1].
-        planner: OMPL planner name.
-        planning_time: Seconds the planner may search per step, positive: a budget of work.
+        motion: --planner, --planning-time (seconds the planner may search per step,
+            positive: a budget of work), --velocity-scaling and --acceleration-scaling
+            (fractions of the limits, in [MIN_SCALING, 1]).
         timeout: Wall-clock safety limit of each search in [s], positive.
         seed: Random seed.
-        velocity_scaling, acceleration_scaling: Fractions of the limits, in (0, 1].
         package_paths: Folders searched for package:// URIs.
         xacro_args: xacro arguments, name -> value.
         urdf, srdf: The URDF and SRDF (a file or `package://pkg/path`), replacing the config's.
@@ -116,12 +118,9 @@ class PlanFlags:
     shift_frame: str | None = None
     linear: bool = False
     min_fraction: float | None = None
-    planner: str | None = None
-    planning_time: float | None = None
+    motion: MotionSettings = MotionSettings()
     timeout: float | None = None
     seed: int | None = None
-    velocity_scaling: float | None = None
-    acceleration_scaling: float | None = None
     package_paths: tuple[Path, ...] = ()
     xacro_args: Mapping[str, str] = field(default_factory=dict)
     urdf: str | None = None
@@ -141,12 +140,12 @@ class PlanFlags:
             raise UsageError("--linear goes with --pose or --shift")
         if self.min_fraction is not None and not 0.0 <= self.min_fraction <= 1.0:
             raise UsageError(f"--min-fraction: expected a number in [0, 1], got {self.min_fraction:g}")
-        if self.planning_time is not None:
-            check_planning_time(self.planning_time)
+        if self.motion.planning_time is not None:
+            check_planning_time(self.motion.planning_time)
         if self.timeout is not None:
             check_planning_time(self.timeout, "--timeout")
         for name in ("velocity_scaling", "acceleration_scaling"):
-            factor = getattr(self, name)
+            factor = getattr(self.motion, name)
             if factor is not None and not MIN_SCALING <= factor <= 1.0:
                 raise UsageError(f"{_flag(name)}: expected a factor in [{MIN_SCALING:g}, 1], got {factor:g}")
 
@@ -185,11 +184,8 @@ class PlanRequest:
     scene: Path | None = None
     group: str | None = None
     start: Start = None
-    planner: str | None = None
-    planning_time: float | None = None
+    motion: MotionSettings = MotionSettings()
     timeout: float | None = None
-    velocity_scaling: float | None = None
-    acceleration_scaling: float | None = None
     seed: int = 0
     min_fraction: float = 1.0
     package_paths: tuple[Path, ...] = ()
@@ -216,17 +212,12 @@ def resolve_request(task: TaskFile | None, flags: PlanFlags) -> PlanRequest:
     start = flags.start
     if start is None and task is not None and not (motion is not None and motion.start):
         start = task.start
-    defaults = task.defaults if task is not None else {}
     return PlanRequest(
         robot=Path(robot), steps=steps, scene=_first(flags.scene, task.scene if task else None),
         group=_first(flags.group, motion.group_name if motion else None, task.group if task else None), start=start,
-        planner=_first(flags.planner, motion and motion.planner, defaults.get("planner")),
-        planning_time=_first(flags.planning_time, motion and motion.planning_time, defaults.get("planning_time")),
+        motion=layered(flags.motion, motion.motion if motion else MotionSettings(),
+                       task.defaults if task else MotionSettings()),
         timeout=flags.timeout,
-        velocity_scaling=_first(flags.velocity_scaling, motion and motion.velocity_scaling,
-                                defaults.get("velocity_scaling")),
-        acceleration_scaling=_first(flags.acceleration_scaling, motion and motion.acceleration_scaling,
-                                    defaults.get("acceleration_scaling")),
         seed=_first(flags.seed, task.seed if task else None) or 0,
         min_fraction=1.0 if flags.min_fraction is None else flags.min_fraction,
         package_paths=flags.package_paths, xacro_args=dict(flags.xacro_args), task=task, motion_request=motion,

@@ -20,7 +20,15 @@ from numpy.typing import NDArray
 
 from ..bag import write_plan
 from ..collision import MotionChecker
-from ..config import ControllerConfig, PoseGoal, RobotConfig, StepSpec, default_controller, parse_controllers
+from ..config import (
+    ControllerConfig,
+    MotionSettings,
+    PoseGoal,
+    RobotConfig,
+    StepSpec,
+    default_controller,
+    parse_controllers,
+)
 from ..control import ExecutionReport, make_plant, simulate, validate_goal
 from ..errors import ConfigError, NoPlan, StartInCollision, StartOutsideLimits
 from ..model import Robot, Scene, check_shape_count, first_repeated, resolve_frames
@@ -33,29 +41,11 @@ from .plan import assemble
 from .request import PlanRequest
 
 __all__ = [
-    "ExecutionSettings", "MotionSettings", "cartesian_motion", "check_execution", "compose_scene", "execute_motion",
+    "ExecutionSettings", "cartesian_motion", "check_execution", "compose_scene", "execute_motion",
     "frame_in_root", "motion_checks", "plan_motion", "session_plan", "start_configuration", "write_session",
 ]
 
 logger = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class MotionSettings:
-    """How one motion is planned; None leaves a setting to the robot config, as the CLI does.
-
-    Attributes:
-        planner: OMPL planner name.
-        planning_time: Seconds the planner may search.
-        velocity_scaling, acceleration_scaling: Fractions of the joint limits, in (0, 1].
-        seed: Seeds OMPL and the IK restarts; each motion is seeded anew, as one `moveplan plan` is.
-    """
-
-    planner: str | None = None
-    planning_time: float | None = None
-    velocity_scaling: float | None = None
-    acceleration_scaling: float | None = None
-    seed: int = 0
 
 
 @dataclass(frozen=True)
@@ -126,9 +116,12 @@ def motion_checks(robot: Robot, scene: Scene, q: NDArray[np.float64]) -> MotionC
 
 def plan_motion(
     robot: Robot, scene: Scene, checks: MotionChecker, spec: StepSpec, q: NDArray[np.float64],
-    settings: MotionSettings,
+    settings: MotionSettings, seed: int = 0,
 ) -> StepResult:
     """Return one motion planned from the configuration `q` (`checks` built for it): a step of `moveplan plan`.
+
+    `settings` leave what they do not set to the robot config, as the CLI does; `seed` seeds OMPL
+    and the IK restarts, each motion anew, as one `moveplan plan` is.
 
     Raises:
         StartOutsideLimits, StartInCollision: The start is unusable.
@@ -139,18 +132,14 @@ def plan_motion(
     pair = checks.colliding_pair(start)
     if pair:
         raise StartInCollision(pair)
-    seed_planner(settings.seed)
-    request = PlanRequest(
-        robot=Path(robot.config.name), steps=(spec,), planner=settings.planner, planning_time=settings.planning_time,
-        velocity_scaling=settings.velocity_scaling, acceleration_scaling=settings.acceleration_scaling,
-        seed=settings.seed,
-    )
+    seed_planner(seed)
+    request = PlanRequest(robot=Path(robot.config.name), steps=(spec,), motion=settings, seed=seed)
     return plan_step(spec, request, robot, scene, checks, start)
 
 
 def cartesian_motion(
     robot: Robot, scene: Scene, checks: MotionChecker, waypoints: Sequence[PoseGoal], q: NDArray[np.float64],
-    settings: MotionSettings, name: str = "cartesian",
+    settings: MotionSettings, seed: int = 0, name: str = "cartesian",
 ) -> tuple[StepResult | None, float]:
     """Return the straight-line motion through `waypoints` in turn, and the fraction of the way it covers.
 
@@ -165,7 +154,7 @@ def cartesian_motion(
         start = q if not legs else robot.configuration(legs[-1].trajectory.positions[-1], q)
         spec = StepSpec(f"{name}[{k}]", goal, linear=True, min_fraction=0.0)
         try:
-            leg = plan_motion(robot, scene, checks, spec, start, settings)
+            leg = plan_motion(robot, scene, checks, spec, start, settings, seed)
         except NoPlan as exc:
             # MoveIt too returns the path up to where it could not go on.
             logger.info("%s: the path stops before waypoint %d: %s", name, k, exc)

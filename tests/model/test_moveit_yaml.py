@@ -170,9 +170,9 @@ def test_mbm_request_gives_group_start_goal_planner_and_moveit_scaling() -> None
     goal = dict(zip([f"panda_joint{i}" for i in range(1, 8)], GOAL, strict=True))
     assert request.goal.goal == JointGoal.by_name(goal)
     assert request.goal.goal.describe() == {"joints": goal}
-    assert (request.planner, request.planning_time) == ("BKPIECE1", 60.0)
+    assert (request.motion.planner, request.motion.planning_time) == ("BKPIECE1", 60.0)
     # MoveIt reads a scaling factor of 0 as 1.0.
-    assert (request.velocity_scaling, request.acceleration_scaling) == (1.0, 1.0)
+    assert (request.motion.velocity_scaling, request.motion.acceleration_scaling) == (1.0, 1.0)
     assert request.raw == REQUEST.read_bytes()
 
 
@@ -194,15 +194,15 @@ def test_planner_id_of_no_available_planner_is_an_error(planner_id: str) -> None
 @pytest.mark.parametrize(("value", "expected"), [(0.3, 0.3), (1, 1.0), (0, 1.0), (1.5, 1.0), (-0.2, 1.0)])
 def test_scaling_outside_zero_one_means_full_limits_as_in_moveit(tmp_path: Path, value: float, expected: float) -> None:
     path = write(tmp_path / "r.yaml", request_with(max_velocity_scaling_factor=value))
-    assert load_motion_plan_request(path).velocity_scaling == expected
+    assert load_motion_plan_request(path).motion.velocity_scaling == expected
 
 
 def test_request_without_scaling_leaves_it_to_the_defaults(tmp_path: Path) -> None:
     content = request_with(allowed_planning_time=0, planner_id="")
     del content["max_velocity_scaling_factor"]
     request = load_motion_plan_request(write(tmp_path / "r.yaml", content))
-    assert (request.velocity_scaling, request.acceleration_scaling) == (None, 1.0)
-    assert (request.planner, request.planning_time) == (None, None)
+    assert (request.motion.velocity_scaling, request.motion.acceleration_scaling) == (None, 1.0)
+    assert (request.motion.planner, request.motion.planning_time) == (None, None)
 
 
 def test_first_goal_alternative_is_used_with_a_warning(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:

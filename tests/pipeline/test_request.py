@@ -8,6 +8,7 @@ import pytest
 from conftest import ROOT
 
 from moveplan.core.config.goals import JointGoal, NamedGoal, PoseGoal, ShiftGoal, StartFrom
+from moveplan.core.config.motion import MotionSettings, Resolved, layered, resolved
 from moveplan.core.config.tasks import StepSpec, load_task
 from moveplan.core.errors import UsageError
 from moveplan.core.pipeline.request import PlanFlags, check_planning_time, resolve_request
@@ -56,9 +57,11 @@ def test_start_flags_become_typed_starts() -> None:
     ({"pose": PoseGoal(), "shift_frame": "base"}, "--shift-frame goes with --shift"),
     ({"named": "home", "linear": True}, "--linear goes with --pose or --shift"),
     ({"named": "home", "min_fraction": 1.5}, r"--min-fraction: expected a number in \[0, 1\], got 1.5"),
-    ({"named": "home", "planning_time": 0.0}, r"--planning-time: expected a positive number of seconds .*, got 0"),
-    ({"named": "home", "velocity_scaling": 0.0}, r"--velocity-scaling: expected a factor in \[0.001, 1\], got 0"),
-    ({"named": "home", "acceleration_scaling": 1.5}, r"--acceleration-scaling: .* got 1.5"),
+    ({"named": "home", "motion": MotionSettings(planning_time=0.0)},
+     r"--planning-time: expected a positive number of seconds .*, got 0"),
+    ({"named": "home", "motion": MotionSettings(velocity_scaling=0.0)},
+     r"--velocity-scaling: expected a factor in \[0.001, 1\], got 0"),
+    ({"named": "home", "motion": MotionSettings(acceleration_scaling=1.5)}, r"--acceleration-scaling: .* got 1.5"),
 ])
 def test_flags_that_break_a_rule_are_a_usage_error(flags: dict[str, object], message: str) -> None:
     with pytest.raises(UsageError, match=message):
@@ -74,10 +77,12 @@ def test_planning_time_check_names_the_flag() -> None:
 def test_flag_wins_over_request_which_wins_over_task(tmp_path: Path) -> None:
     task = load_task(task_file(tmp_path, "robot: r\ngroup: arm\ndefaults: {planner: PRM, planning_time: 2, "
                                          "velocity_scaling: 0.2, acceleration_scaling: 0.3}\nseed: 7\n"))
-    request = resolve_request(task, PlanFlags(request=REQUEST, planner="RRTstar", velocity_scaling=0.5))
+    flags = PlanFlags(request=REQUEST, motion=MotionSettings(planner="RRTstar", velocity_scaling=0.5))
+    request = resolve_request(task, flags)
     assert request.robot == tmp_path / "r"
-    assert (request.planner, request.velocity_scaling) == ("RRTstar", 0.5)  # flags
-    assert (request.group, request.planning_time, request.acceleration_scaling) == ("panda_arm", 60.0, 1.0)  # request
+    assert (request.motion.planner, request.motion.velocity_scaling) == ("RRTstar", 0.5)  # flags
+    assert request.group == "panda_arm"  # request
+    assert (request.motion.planning_time, request.motion.acceleration_scaling) == (60.0, 1.0)  # request
     assert request.seed == 7  # task
     assert request.steps[0].name == "request0001" and isinstance(request.steps[0].goal, JointGoal)
 
@@ -86,7 +91,7 @@ def test_task_settings_apply_where_no_flag_is_given(tmp_path: Path) -> None:
     task = load_task(task_file(tmp_path, "robot: r\nstart: {named: ready}\ndefaults: {planner: PRM}\n"
                                          "steps: [{named: home}]\n"))
     request = resolve_request(task, PlanFlags(robot=ROBOT, seed=3))
-    assert (request.robot, request.planner, request.seed, request.min_fraction) == (ROBOT, "PRM", 3, 1.0)
+    assert (request.robot, request.motion.planner, request.seed, request.min_fraction) == (ROBOT, "PRM", 3, 1.0)
     assert request.start == NamedGoal("ready") and request.steps == task.steps
 
 
@@ -116,3 +121,20 @@ def test_without_goal_or_robot_the_usage_error_says_how_to_give_one() -> None:
         resolve_request(None, PlanFlags(robot=ROBOT))
     with pytest.raises(UsageError, match="no robot: give --robot or a task file naming one"):
         resolve_request(None, PlanFlags(named="home"))
+
+
+def test_one_rule_layers_the_motion_settings_each_from_the_first_place_that_sets_it() -> None:
+    step = MotionSettings(velocity_scaling=0.1)
+    flags = MotionSettings(planner="PRM", velocity_scaling=0.5)
+    task = MotionSettings(planner="RRTstar", planning_time=3.0)
+    assert layered(step, flags, task) == MotionSettings("PRM", 3.0, 0.1, None)
+    defaults = Resolved("RRTConnect", 1.0, 0.2, 0.3)
+    assert resolved(step, flags, task, defaults=defaults) == Resolved("PRM", 3.0, 0.1, 0.3)
+    assert resolved(defaults=defaults) == defaults
+
+
+def test_a_steps_own_scaling_wins_over_the_tasks_defaults(tmp_path: Path) -> None:
+    task = load_task(task_file(tmp_path, "robot: r\ndefaults: {velocity_scaling: 0.2, planner: PRM}\n"
+                                         "steps: [{named: home, velocity_scaling: 0.7}, {named: ready}]\n"))
+    assert task.defaults == MotionSettings(planner="PRM", velocity_scaling=0.2)
+    assert [s.motion for s in task.steps] == [MotionSettings(velocity_scaling=0.7), MotionSettings()]
