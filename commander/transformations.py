@@ -1,8 +1,10 @@
 """The part of ROS's tf.transformations that workshop scripts use: quaternions, Euler angles, 4x4 matrices.
 
 Quaternions are [x, y, z, w]; Euler angles are ROS's default "sxyz" (roll, pitch, yaw about
-the fixed x, y, z axes, R = Rz(yaw) Ry(pitch) Rx(roll)), the convention of URDF's rpy and of
-MoveGroupCommander's six-number poses. Other axis conventions are refused.
+the fixed x, y, z axes, R = Rz(yaw) Ry(pitch) Rx(roll)), the convention of URDF's rpy, of
+MoveGroupCommander's six-number poses and of core/rotations.py. Other axis conventions are
+refused. The formulas are tf.transformations' own, in numpy: a script's numbers are what they
+were under ROS to the last bit, which pinocchio's (core/rotations.py) are not.
 """
 
 from __future__ import annotations

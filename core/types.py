@@ -13,6 +13,8 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
+from .rotations import quaternion_from_matrix, rpy_from_matrix
+
 __all__ = [
     "ControllerStates",
     "PointSeries",
@@ -348,14 +350,9 @@ class LinkPose:
     @classmethod
     def of(cls, link: str, frame: str, frame_T_link: NDArray[np.float64]) -> LinkPose:
         """Return the pose a 4x4 transform `frame_T_link` holds."""
-        import pinocchio as pin  # only where a pose is computed: a plan file read back carries its poses
-
         rotation = frame_T_link[:3, :3]
-        x, y, z, w = (float(c) for c in pin.Quaternion(rotation).normalized().coeffs())
-        sign = -1.0 if w < 0 else 1.0  # q and -q are one rotation: report the one with w >= 0
         px, py, pz = (float(c) for c in frame_T_link[:3, 3])
-        roll, pitch, yaw = (float(a) for a in pin.rpy.matrixToRpy(rotation))
-        return cls(link, frame, (px, py, pz), (sign * x, sign * y, sign * z, sign * w), (roll, pitch, yaw))
+        return cls(link, frame, (px, py, pz), quaternion_from_matrix(rotation), rpy_from_matrix(rotation))
 
     def as_dict(self) -> dict[str, object]:
         """Return the pose as the JSON documents give it: link, frame, position, quaternion, rpy."""

@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
-import pinocchio as pin
 from numpy.typing import NDArray
 
 from ..config import MAX_MAGNITUDE, number
 from ..errors import ConfigError
+from ..rotations import matrix_from_quaternion, matrix_from_rpy
 
 __all__ = ["pose_matrix", "vector"]
 
@@ -22,13 +21,12 @@ def pose_matrix(xyz: Any, rpy: Any, quat: Any, where: str) -> NDArray[np.float64
     if rpy is not None and quat is not None:
         raise ConfigError(f"{where}: give rpy or quat, not both")
     if quat is not None:
-        x, y, z, w = vector(quat, 4, f"{where}.quat")
-        norm = math.sqrt(x * x + y * y + z * z + w * w)
-        if norm < 1e-9:
-            raise ConfigError(f"{where}.quat: a quaternion [x, y, z, w] of zero norm is not a rotation")
-        transform[:3, :3] = pin.Quaternion(w / norm, x / norm, y / norm, z / norm).toRotationMatrix()
+        try:
+            transform[:3, :3] = matrix_from_quaternion(vector(quat, 4, f"{where}.quat"))
+        except ValueError as exc:
+            raise ConfigError(f"{where}.quat: {exc}") from None
     elif rpy is not None:
-        transform[:3, :3] = pin.rpy.rpyToMatrix(*vector(rpy, 3, f"{where}.rpy"))
+        transform[:3, :3] = matrix_from_rpy(*vector(rpy, 3, f"{where}.rpy"))
     return transform
 
 

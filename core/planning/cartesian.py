@@ -14,11 +14,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-import pinocchio as pin
 from numpy.typing import NDArray
 
 from ..errors import GoalUnreachable
 from ..model import Robot, solve_ik
+from ..rotations import matrix_from_rotation_vector, rotation_vector
 from ..trajectory import interpolate
 from ..types import frozen_array
 from .goals import pose_error
@@ -65,14 +65,14 @@ def straight_line(
 ) -> LinearPath:
     """Return the joint path moving `link` in a straight line from where it is to `target` (root frame)."""
     origin = robot.frame_pose(robot.configuration(start, base), link)
-    rotation = pin.log3(origin[:3, :3].T @ target[:3, :3])
+    rotation = rotation_vector(origin[:3, :3].T @ target[:3, :3])
     distance = float(np.linalg.norm(target[:3, 3] - origin[:3, 3]))
     count = max(1, int(np.ceil(max(distance / _STEP_M, float(np.linalg.norm(rotation)) / _STEP_RAD))))
 
     def pose_at(s: float) -> NDArray[np.float64]:
         pose = np.eye(4)
         pose[:3, 3] = origin[:3, 3] + s * (target[:3, 3] - origin[:3, 3])
-        pose[:3, :3] = origin[:3, :3] @ pin.exp3(s * rotation)
+        pose[:3, :3] = origin[:3, :3] @ matrix_from_rotation_vector(s * rotation)
         return pose
 
     waypoints = [np.asarray(start, dtype=float)]

@@ -15,12 +15,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pinocchio as pin
 from numpy.typing import NDArray
 
 from ..config import JointGoal, NamedGoal, PoseGoal, ShiftGoal
 from ..errors import ConfigError, GoalOutsideLimits, OutsideLimits, UnknownName, UsageError
 from ..model import PositionGoal, Robot, Scene, pose_matrix, solve_ik
+from ..rotations import matrix_from_rpy, rpy_from_matrix
 
 __all__ = [
     "check_limits", "joint_target", "named_state", "orientation_tolerance", "pose_error", "tip_target",
@@ -129,7 +129,7 @@ def _shifted(robot: Robot, scene: Scene, shift: ShiftGoal, q: NDArray[np.float64
         # MoveGroupCommander.shift_pose_target: add to [x, y, z, roll, pitch, yaw] of the
         # pose in the planning frame, angles as fixed-axis (sxyz) Euler angles.
         goal[:3, 3] += t
-        goal[:3, :3] = pin.rpy.rpyToMatrix(*(pin.rpy.matrixToRpy(now[:3, :3]) + rpy))
+        goal[:3, :3] = matrix_from_rpy(*(np.array(rpy_from_matrix(now[:3, :3])) + rpy))
         return goal
     if frame in ("base", "planning"):
         axes = np.eye(3)

@@ -15,10 +15,11 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from ...rotations import quaternions_xyzw
 from ...types import ControllerStates, JointTrajectory, PointSeries
 from ._primitives import CdrWriter, patched_copies, time_array
 from .definitions import POINT_SOURCES, controller_state_fields
-from .messages import quaternions_xyzw, seconds_to_ns
+from .messages import seconds_to_ns
 
 __all__ = ["controller_states_cdr", "display_trajectory_cdr", "joint_trajectory_cdr", "tf_messages_cdr"]
 

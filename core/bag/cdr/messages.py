@@ -17,6 +17,7 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
+from ...rotations import quaternions_xyzw
 from ...types import CollisionObject, ControllerStates, JointTrajectory, PointSeries
 from .definitions import POINT_SOURCES, controller_state_fields
 
@@ -27,7 +28,6 @@ __all__ = [
     "joint_state",
     "joint_trajectory",
     "marker_array",
-    "quaternions_xyzw",
     "seconds_to_ns",
     "stamps_ns",
     "string_message",
@@ -226,34 +226,6 @@ def _quaternion(transform: NDArray[np.float64]) -> Message:
     """Return the rotation of a 4x4 transform as a unit quaternion with w >= 0."""
     x, y, z, w = quaternions_xyzw(transform).tolist()
     return {"x": x, "y": y, "z": z, "w": w}
-
-
-def quaternions_xyzw(transforms: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Return the rotations of 4x4 transforms (..., 4, 4) as unit quaternions xyzw with w >= 0."""
-    (m00, m01, m02), (m10, m11, m12), (m20, m21, m22) = np.moveaxis(
-        transforms[..., :3, :3], (-2, -1), (0, 1)
-    )
-    trace = m00 + m11 + m22
-    # Shepperd's method: divide by the largest of the four candidates, for accuracy. All
-    # four are computed and one kept, so the others may divide by zero or take sqrt(< 0).
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = 2.0 * np.sqrt(1.0 + trace)
-        q0 = [(m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s, s / 4]
-        s = 2.0 * np.sqrt(1.0 + m00 - m11 - m22)
-        q1 = [s / 4, (m01 + m10) / s, (m02 + m20) / s, (m21 - m12) / s]
-        s = 2.0 * np.sqrt(1.0 + m11 - m00 - m22)
-        q2 = [(m01 + m10) / s, s / 4, (m12 + m21) / s, (m02 - m20) / s]
-        s = 2.0 * np.sqrt(1.0 + m22 - m00 - m11)
-        q3 = [(m02 + m20) / s, (m12 + m21) / s, s / 4, (m10 - m01) / s]
-    # np.select takes the first true condition, like an if/elif chain.
-    conditions = [trace > 0.0, (m00 > m11) & (m00 > m22), m11 > m22]
-    candidates = [np.stack(q, axis=-1) for q in (q0, q1, q2, q3)]
-    xyzw = np.select([c[..., None] for c in conditions], candidates[:3], candidates[3])
-    # The norm as a plain sum over the last axis, not BLAS: the same bits for one transform
-    # or many, whatever the machine.
-    xyzw /= np.linalg.norm(xyzw, axis=-1, keepdims=True)
-    result: NDArray[np.float64] = np.where(xyzw[..., 3:] < 0.0, -xyzw, xyzw)
-    return result
 
 
 def trajectory_from_message(message: Any) -> JointTrajectory:

@@ -1,0 +1,57 @@
+"""Rotations in ROS's convention: [x, y, z, w] quaternions with w >= 0, rpy about the fixed x, y, z axes."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from moveplan.commander import transformations
+from moveplan.core.rotations import (
+    matrix_from_quaternion,
+    matrix_from_rotation_vector,
+    matrix_from_rpy,
+    quaternion_from_matrix,
+    quaternions_xyzw,
+    rotation_vector,
+    rpy_from_matrix,
+)
+
+
+def test_rpy_is_about_the_fixed_axes_yaw_last_as_urdf_and_tf() -> None:
+    # R = Rz(yaw) Ry(pitch) Rx(roll): roll first, about the fixed x axis (x stays, y goes to z), then yaw
+    # about the fixed z axis (x goes to y; z stays).
+    rotation = matrix_from_rpy(math.pi / 2, 0.0, math.pi / 2)
+    np.testing.assert_allclose(rotation @ [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], atol=1e-15)
+    np.testing.assert_allclose(rotation @ [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], atol=1e-15)
+    np.testing.assert_allclose(rotation, transformations.euler_matrix(math.pi / 2, 0.0, math.pi / 2)[:3, :3],
+                               atol=1e-15)
+
+
+def test_a_known_rotation_has_the_ros_quaternion_with_w_first_positive() -> None:
+    half_turn_about_z = matrix_from_rpy(0.0, 0.0, math.pi)
+    np.testing.assert_allclose(quaternion_from_matrix(half_turn_about_z), (0.0, 0.0, 1.0, 0.0), atol=1e-15)
+    minus_quarter = matrix_from_quaternion([0.0, 0.0, -math.sin(math.pi / 4), -math.cos(math.pi / 4)])
+    x, y, z, w = quaternion_from_matrix(minus_quarter)
+    assert w > 0 and z > 0  # -q is the same rotation; the one handed out has w >= 0
+
+
+def test_round_trips_and_the_vectorised_path_agree() -> None:
+    rng = np.random.default_rng(7)
+    transforms = np.tile(np.eye(4), (50, 1, 1))
+    for k in range(50):
+        roll, pitch, yaw = rng.uniform(-3.0, 3.0), rng.uniform(-1.5, 1.5), rng.uniform(-3.0, 3.0)
+        rotation = matrix_from_rpy(roll, pitch, yaw)
+        np.testing.assert_allclose(rpy_from_matrix(rotation), (roll, pitch, yaw), atol=1e-12)
+        np.testing.assert_allclose(matrix_from_quaternion(quaternion_from_matrix(rotation)), rotation, atol=1e-12)
+        np.testing.assert_allclose(matrix_from_rotation_vector(rotation_vector(rotation)), rotation, atol=1e-12)
+        transforms[k, :3, :3] = rotation
+    one_by_one = np.array([quaternion_from_matrix(t[:3, :3]) for t in transforms])
+    np.testing.assert_allclose(quaternions_xyzw(transforms), one_by_one, atol=1e-12)
+
+
+def test_a_quaternion_of_any_length_is_normalised_and_a_zero_one_is_no_rotation() -> None:
+    np.testing.assert_allclose(matrix_from_quaternion([0.0, 0.0, 0.0, 5.0]), np.eye(3))
+    with pytest.raises(ValueError, match="zero norm"):
+        matrix_from_quaternion([0.0, 0.0, 0.0, 0.0])
