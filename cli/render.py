@@ -8,7 +8,6 @@ import sys
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -39,16 +38,17 @@ logger = logging.getLogger("moveplan")
 
 def plan_summary(plan: PlanResult, output: Path, as_json: bool, quiet: bool) -> None:
     """Print what was planned: one row per step and where each ends, or the plan JSON document."""
-    steps = _step_documents(plan)
+    from ..core.pipeline import plan_document
+
+    document = plan_document(plan, output)
     if as_json:
-        _emit({"ok": True, "output": str(output), "robot": plan.robot_name, "group": plan.group,
-               "steps": steps, "error": None})
+        _emit(document)
         return
     if quiet:
         return
     rows = table(f"{plan.robot_name} / {plan.group} -> {output}",
                  ("step", "goal", "planner", "planning [ms]", "duration [s]", "points"), left=3)
-    for s in steps:
+    for s in document["steps"]:
         rows.add_row(s["name"], _short(s["goal"]), s["planner"], f"{1e3 * s['planning_time_s']:.1f}",
                      f"{s['duration_s']:.3f}", str(s["points"]))
     show(rows)
@@ -57,26 +57,10 @@ def plan_summary(plan: PlanResult, output: Path, as_json: bool, quiet: bool) -> 
 
 
 def plan_failure(error: MoveplanError) -> dict[str, Any]:
-    """Return what a failed plan's JSON document holds besides its error: the steps planned, then the failing one."""
-    plan: PlanResult | None = error.partial
-    steps = _step_documents(plan) if plan else []
-    if error.step is not None:
-        steps.append({"name": error.step, "status": "error"})
-    return {"output": None, "robot": plan.robot_name if plan else None, "group": plan.group if plan else None,
-            "steps": steps}
+    """Return what a failed plan's JSON document holds besides its error (core's plan_failure_document)."""
+    from ..core.pipeline import plan_failure_document
 
-
-def _step_documents(plan: PlanResult) -> list[dict[str, Any]]:
-    """Return the plan JSON document's "steps": each planned step, its goal, planning, trajectory and end state."""
-    return [
-        {
-            "name": s.name, "status": "ok", "goal": s.goal, "planner": s.planner,
-            "planning_time_s": round(s.planning_time_s, 6), "duration_s": round(s.trajectory.duration_s, 6),
-            "fraction": s.fraction, "residual": s.residual, "points": len(s.trajectory.times_s),
-            "end_state": end.as_dict(),
-        }
-        for s, end in zip(plan.steps, plan.end_states, strict=True)
-    ]
+    return plan_failure_document(error)
 
 
 def _end_poses(names: list[str], states: tuple[RobotState, ...]) -> None:
@@ -105,38 +89,9 @@ def _short(goal: dict[str, Any]) -> str:
 
 def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
     """Print a robot config: groups, joints with limits and sources, named states, frames, controllers."""
-    links = sorted({j.parent for j in config.urdf_joints.values()} | {j.child for j in config.urdf_joints.values()})
-    document: dict[str, Any] = {
-        "name": config.name,
-        "groups": {n: {"joints": list(g.joints), "base": g.base, "tip": g.tip} for n, g in config.srdf.groups.items()},
-        "joints": {
-            n: {"lower": lim.lower, "upper": lim.upper, "max_velocity": lim.max_velocity,
-                "max_acceleration": None if np.isnan(lim.max_acceleration) else lim.max_acceleration,
-                "continuous": lim.continuous, "source": lim.source}
-            for n, lim in config.limits.items()
-        },
-        "named_states": {
-            group: {name: [values.get(j) for j in config.srdf.groups[group].joints] for name, values in states.items()}
-            for group, states in config.srdf.group_states.items()
-        },
-        "frames": links,
-        "default_scaling": {"velocity": config.default_velocity_scaling,
-                            "acceleration": config.default_acceleration_scaling},
-        "controllers": {
-            n: {"joints": list(c.joints), "update_rate": c.update_rate_hz,
-                "command_interfaces": list(c.command_interfaces), "state_interfaces": list(c.state_interfaces),
-                "constraints": {"goal_time": c.goal_time_s, "stopped_velocity_tolerance": c.stopped_velocity_tolerance,
-                                **{j: {"trajectory": c.trajectory_tolerance[j], "goal": c.goal_tolerance[j]}
-                                   for j in c.joints}}}
-            for n, c in config.controllers.items()
-        },
-        "initial_positions": config.initial_positions,
-        "initial_sources": config.initial_sources,
-        "sources": {k: str(v) for k, v in config.sources.items()},
-        "kinematics": config.kinematics,
-        "xacro_args": config.xacro_args,
-        "missing_acceleration": list(config.missing_acceleration_limits()),
-    }
+    from ..core.pipeline import robot_document
+
+    document = robot_document(config)
     if as_json:
         _emit(document)
         return
@@ -157,7 +112,7 @@ def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
             _console.print(f"named state {group}/{name}: {values}")
     for name, controller in document["controllers"].items():
         _console.print(f"controller {name} @ {controller['update_rate']:g} Hz: {controller['constraints']}")
-    _console.print(f"frames: {', '.join(links)}")
+    _console.print(f"frames: {', '.join(document['frames'])}")
     for setting, source in document["sources"].items():
         _console.print(f"{setting} from {source}")
     if document["missing_acceleration"]:
@@ -170,10 +125,11 @@ def robot_summary(config: RobotConfig, as_json: bool, quiet: bool) -> None:
 
 def state_summary(result: StateResult, as_json: bool, quiet: bool) -> None:
     """Print a robot state: a table of joint values, then the link's pose in the frame; or its JSON document."""
+    from ..core.pipeline import state_document
+
     state, pose = result.state, result.state.pose
     if as_json:
-        _emit({"ok": True, "robot": result.robot, "group": result.group, "source": result.source,
-               **state.as_dict(), "error": None})
+        _emit(state_document(result))
         return
     if quiet:
         return
@@ -193,19 +149,11 @@ def state_summary(result: StateResult, as_json: bool, quiet: bool) -> None:
 
 def inspect_summary(inspection: Inspection, as_json: bool, quiet: bool) -> None:
     """Print topics of any bag, and for a plan file each step's duration, peak rates and end state."""
+    from ..core.pipeline import inspect_document
+
     path, summary, plan = inspection.path, inspection.summary, inspection.plan
-    ends: list[dict[str, Any] | None] = [state.as_dict() for state in inspection.end_states]
-    ends = ends or [None] * len(inspection.steps)
-    steps = [{**asdict(step), "end_state": end} for step, end in zip(inspection.steps, ends, strict=True)]
-    document = {
-        "file": str(path), "profile": summary.profile, "library": summary.library,
-        "duration_s": summary.duration_s,
-        "topics": [{"topic": t.topic, "type": t.type, "encoding": t.encoding, "count": t.count,
-                    "durability": t.qos_durability} for t in summary.topics],
-        "metadata": list(summary.metadata), "attachments": list(summary.attachments),
-        "plan": None if plan is None else {"robot": plan.robot_name, "group": plan.group, "steps": steps},
-        "skipped": [part.as_dict() for part in summary.skipped],
-    }
+    document = inspect_document(inspection)
+    steps = document["plan"]["steps"] if document["plan"] else []
     if as_json:
         _emit(document)
         return
@@ -392,7 +340,9 @@ def _progress_lines(total: int) -> Callable[[Run], None]:
 def benchmark_summary(runs: list[Run], rows: list[dict[str, Any]], as_json: bool, quiet: bool) -> None:
     """Print one row per scenario and planner, or the benchmark JSON document."""
     if as_json:
-        _emit({"ok": True, "runs": [r.as_dict() for r in runs], "summary": rows, "error": None})
+        from ..core.pipeline import benchmark_document
+
+        _emit(benchmark_document(runs, rows))
         return
     if quiet:
         return
