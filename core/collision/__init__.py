@@ -5,12 +5,11 @@ from typing import TYPE_CHECKING
 from .._faces import lazy_exports
 
 if TYPE_CHECKING:
-    from ._setup_clock import add_setup_time, setup_time_spent
     from ._verdicts import MAYBE
     from .checker import CollisionChecker, GeometryMode
-    from .kernel_cache import kernels_cached
+    from .compiled import add_setup_time, kernels_loaded, kernels_ready, setup_time_spent
     from .motion import MotionChecker, build_sphere_filter, exact_checks, hull_checker
-    from .sphere_filter import SphereFilter, kernels_loaded
+    from .sphere_filter import SphereFilter
 
 __all__ = [
     "CollisionChecker",
@@ -22,8 +21,8 @@ __all__ = [
     "build_sphere_filter",
     "exact_checks",
     "hull_checker",
-    "kernels_cached",
     "kernels_loaded",
+    "kernels_ready",
     "setup_time_spent",
 ]
 
@@ -33,11 +32,11 @@ __getattr__ = lazy_exports(__name__, {
     "MAYBE": "_verdicts",
     "MotionChecker": "motion",
     "SphereFilter": "sphere_filter",
-    "add_setup_time": "_setup_clock",
+    "add_setup_time": "compiled",
     "build_sphere_filter": "motion",
     "exact_checks": "motion",
     "hull_checker": "motion",
-    "kernels_cached": "kernel_cache",
-    "kernels_loaded": "sphere_filter",
-    "setup_time_spent": "_setup_clock",
+    "kernels_loaded": "compiled",
+    "kernels_ready": "compiled",
+    "setup_time_spent": "compiled",
 })

@@ -87,6 +87,11 @@ class MotionChecker:
         self._stages: tuple[CollisionChecker, ...] = (checker,) if hulls is None else (hulls, checker)
         self.conservative_available = hulls is not None
 
+    @property
+    def compiled(self) -> bool:
+        """Return True if a built sphere filter answers: its kernels are loaded, so timing takes its compiled passes."""
+        return isinstance(self.spheres, SphereFilter)
+
     def free(self, values: NDArray[np.float64], conservative: bool = False) -> NDArray[np.bool_]:
         """Return per group state (rows of `values`) True if it is collision-free.
 

@@ -29,17 +29,10 @@ from ._inner_spheres import inner_spheres
 from ._pair_tables import PairTable, pair_tables
 from ._sphere_fit import SphereSet, fit_shape, robot_spheres
 from ._verdicts import CLEAR, COLLIDES, MAYBE
-from .kernel_cache import kernels_cached
+from .compiled import kernels_ready, mark_kernels_loaded
 
-__all__ = ["CLEAR", "COLLIDES", "MAYBE", "SphereFilter", "UnsupportedJoint", "kernels_loaded"]
+__all__ = ["CLEAR", "COLLIDES", "MAYBE", "SphereFilter", "UnsupportedJoint"]
 
-
-_kernels_loaded = False  # set once a filter has its kernels: a later one in this process compiles nothing
-
-
-def kernels_loaded() -> bool:
-    """Return True once a filter built in this process has its kernels: the next one costs no numba start-up."""
-    return _kernels_loaded
 
 # Joint kinds the kernel knows; anything else (planar, free-flyer, ...) makes the filter unavailable.
 _REVOLUTE, _PRISMATIC, _UNBOUNDED = 1, 2, 3
@@ -115,9 +108,8 @@ class SphereFilter:
         # Reused by every `edge` call: returning fresh arrays from compiled code costs more than judging a state.
         self._verdicts, self._unclear = np.empty(64, dtype=np.int8), np.empty((64, model.nq))
         # Compile (or load) the kernels now, not mid-search.
-        global _kernels_loaded
         announce_compilation("compiling the collision kernels (once per install; numba caches them)",
-                             compiled=_kernels_loaded or kernels_cached())
+                             compiled=kernels_ready())
         self.classify(robot.values(base)[None, :])
         self.edge(robot.values(base), robot.values(base), 1.0)
         self.certify(robot.values(base)[None, :], np.zeros(1))
@@ -127,7 +119,7 @@ class SphereFilter:
         # A plan with a filter times its paths with the compiled passes too (core/pipeline/_step.py).
         compiled_fastest_speeds(np.array([0.0, 1.0]), np.ones((3, 1)), np.zeros((3, 1)), np.array([True]),
                                 np.ones(1), np.ones(1))
-        _kernels_loaded = True
+        mark_kernels_loaded()
 
     def classify(
         self, values: NDArray[np.float64], stop: bool = False

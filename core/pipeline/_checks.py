@@ -9,7 +9,7 @@ rule: by then the hull checks have cost about what the filter's set-up does). Wh
 not compiled the kernels yet (a fresh install), the set-up costs a compilation, so the rule waits
 correspondingly longer: a first plan on a fresh machine costs what it costs warm unless it is
 one that would pay for the compilation anyway. A build inside a step is kept off the search's
-planning-time cap (core/collision/_setup_clock.py). A process that has built one filter has the
+planning-time cap (core/collision/compiled.py). A process that has built one filter has the
 kernels loaded, and builds the next at once.
 
 Every verdict is the same either way: a state the spheres clear is free under the hulls, and
@@ -35,8 +35,8 @@ from ..collision import (
     add_setup_time,
     build_sphere_filter,
     hull_checker,
-    kernels_cached,
     kernels_loaded,
+    kernels_ready,
 )
 from ..model import Robot, Scene
 from ..trajectory import interpolate
@@ -53,7 +53,7 @@ FILTER_AFTER_STATES_UNCOMPILED = 1_000_000
 
 def filter_threshold() -> int:
     """Return how many states a one-shot command checks with coal before it builds the sphere filter."""
-    return FILTER_AFTER_STATES if kernels_loaded() or kernels_cached() else FILTER_AFTER_STATES_UNCOMPILED
+    return FILTER_AFTER_STATES if kernels_ready() else FILTER_AFTER_STATES_UNCOMPILED
 
 
 def problem_checks(

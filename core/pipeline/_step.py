@@ -16,7 +16,7 @@ from functools import partial
 import numpy as np
 from numpy.typing import NDArray
 
-from ..collision import MotionChecker, SphereFilter
+from ..collision import MotionChecker
 from ..config import JointGoal, NamedGoal, StepSpec, resolved
 from ..errors import GoalInCollision, PlanningFailed, PlanningTimeExceeded
 from ..model import Robot, Scene, solve_ik
@@ -228,7 +228,7 @@ class _Certifier:
         mark = time.perf_counter()
         trajectory = time_parameterize(self.robot.joint_names, path.waypoints, self.settings.max_velocity,
                                        self.settings.max_acceleration, max_step=max_step,
-                                       compiled=isinstance(self.checks.spheres, SphereFilter))
+                                       compiled=self.checks.compiled)
         timed = time.perf_counter()
         hit = self.checks.first_collision_on_trajectory(trajectory)
         self._add(path, timed - mark, time.perf_counter() - timed)

@@ -22,7 +22,8 @@ from conftest import SAMPLES, UR10E, Cli
 from mcap.reader import make_reader
 from mcap.writer import Writer
 
-from moveplan.core.collision import _cache, kernel_cache
+from moveplan.core.collision import _cache
+from moveplan.core.collision import _kernel_cache as kernel_cache
 from moveplan.core.collision._pair_tables import PairTable
 from moveplan.core.collision._sphere_fit import SphereSet
 from moveplan.core.config import _xacro_expressions as xacro_expressions

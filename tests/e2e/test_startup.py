@@ -96,11 +96,11 @@ def test_compilation_is_announced_only_when_the_kernels_are_not_compiled(caplog:
 
 _FILTERED_PLAN = (
     "from pathlib import Path\nfrom moveplan.cli.options import setup_logging\n"
-    "from moveplan.core.collision import sphere_filter\nfrom moveplan.core.config.tasks import load_task\n"
+    "from moveplan.core.collision import compiled\nfrom moveplan.core.config.tasks import load_task\n"
     "from moveplan.core.pipeline.plan import PlanFlags, plan, resolve_request\n"
     "setup_logging(False, False)\n"
     "plan(resolve_request(load_task(Path('samples/ur10e_joint_goals.yaml')), PlanFlags()), filter_after=0)\n"
-    "assert sphere_filter._kernels_loaded, 'no sphere filter was built'\n")
+    "assert compiled.kernels_loaded(), 'no sphere filter was built'\n")
 _COMPILING = "moveplan: compiling the collision kernels (once per install; numba caches them)"
 _SLOW_LOAD = (  # the filter's first kernel call takes 1.5 s longer, as on a loaded machine
     "import time\nfrom moveplan.core.timing import _compiled\nfastest, calls = _compiled.compiled_fastest_speeds, []\n"
