@@ -16,16 +16,16 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.collision import MotionChecker
 from ..core.control import ExecutionSummary
 from ..core.errors import UsageError
 from ..core.model import Robot, Scene, empty_scene, load_scene
 from ..core.pipeline import (
     ExecutionSettings,
+    Problem,
     RobotSource,
     compose_scene,
     frame_in_root,
-    motion_checks,
+    motion_problem,
     session_plan,
     start_configuration,
     write_session,
@@ -68,7 +68,7 @@ class World:
                                            self._robot_state)
         self.q = start_configuration(robot, self._scene)
         self.start_q = self.q.copy()
-        self._checks: dict[tuple[str, bytes], MotionChecker] = {}
+        self._problems: dict[tuple[str, bytes], Problem] = {}
         self.executed: list[Executed] = []
 
     def robot(self, group: str | None) -> Robot:
@@ -106,15 +106,15 @@ class World:
                                     self.robot(None), self._allowed, self._robot_state)
         self._frames, self._objects = new_frames, new_objects
         if objects is not None:
-            self._checks.clear()
+            self._problems.clear()
 
-    def checks(self, robot: Robot, q: NDArray[np.float64]) -> MotionChecker:
-        """Return the collision checks of `robot`'s group in the scene, the other joints as in `q` (built once)."""
+    def problem(self, robot: Robot, q: NDArray[np.float64]) -> Problem:
+        """Return the problem of `robot`'s group in the scene, the other joints as in `q` (built once)."""
         others = robot.configuration(np.zeros(robot.dof), q)
         key = (robot.group.name, others.tobytes())
-        if key not in self._checks:
-            self._checks[key] = motion_checks(robot, self._scene, q)
-        return self._checks[key]
+        if key not in self._problems:
+            self._problems[key] = motion_problem(robot, self._scene, q)
+        return self._problems[key]
 
     def pose(self, frame: str, q: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         """Return `root_T_frame` of a link, scene frame or the planning frame, the robot at `q` (default: now)."""

@@ -320,11 +320,11 @@ class MoveGroupCommander(PlanningSettings):
                  for k, point in enumerate(waypoints)]
         world = self._world
         try:
-            checks = world.checks(self._robot, q)
+            problem = world.problem(self._robot, q)
         except NoPlan as exc:  # two parts that never move touch: no state is free
             logger.info("compute_cartesian_path: %s", exc)
             return to_message(None, self.get_planning_frame()), 0.0
-        step, fraction = cartesian_motion(self._robot, world.scene, checks, goals, q, self._settings(), world.seed)
+        step, fraction = cartesian_motion(problem, goals, q, self._settings(), world.seed)
         return to_message(step, self.get_planning_frame()), fraction
 
     def stop(self) -> None:
@@ -384,8 +384,7 @@ class MoveGroupCommander(PlanningSettings):
         spec = StepSpec(_step_name(self._target), self._target)
         began = time.perf_counter()
         try:
-            step = plan_motion(self._robot, self._world.scene, self._world.checks(self._robot, q), spec, q,
-                               self._settings(), self._world.seed)
+            step = plan_motion(self._world.problem(self._robot, q), spec, q, self._settings(), self._world.seed)
         except NoPlan as exc:
             logger.info("plan: %s", exc)
             return None, exc, time.perf_counter() - began

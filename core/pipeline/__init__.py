@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING
 from .._faces import lazy_exports
 
 if TYPE_CHECKING:
-    from .benchmark import Run, find_problems, plot_benchmark, run_benchmark, summarize, write_csv
+    from ._checks import Problem
+    from .benchmark import ProblemFiles, Run, find_problems, plot_benchmark, run_benchmark, summarize, write_csv
     from .documents import (
         benchmark_document,
         inspect_document,
@@ -36,7 +37,7 @@ if TYPE_CHECKING:
         compose_scene,
         execute_motion,
         frame_in_root,
-        motion_checks,
+        motion_problem,
         plan_motion,
         session_plan,
         start_configuration,
@@ -52,6 +53,8 @@ __all__ = [
     "PlanExecution",
     "PlanFlags",
     "PlanResult",
+    "Problem",
+    "ProblemFiles",
     "RobotSource",
     "Run",
     "StateRequest",
@@ -76,7 +79,7 @@ __all__ = [
     "frame_in_root",
     "inspect_document",
     "inspect_file",
-    "motion_checks",
+    "motion_problem",
     "plan_document",
     "plan_failure_document",
     "plan_motion",
@@ -105,6 +108,8 @@ __getattr__ = lazy_exports(__name__, {
     "PlanExecution": "execution",
     "PlanFlags": "request",
     "PlanResult": "plan",
+    "Problem": "_checks",
+    "ProblemFiles": "benchmark",
     "RobotSource": "request",
     "Run": "benchmark",
     "StateRequest": "robot_state",
@@ -129,7 +134,7 @@ __getattr__ = lazy_exports(__name__, {
     "frame_in_root": "session",
     "inspect_document": "documents",
     "inspect_file": "inspection",
-    "motion_checks": "session",
+    "motion_problem": "session",
     "plan_document": "documents",
     "plan_failure_document": "documents",
     "plan_motion": "session",

@@ -22,6 +22,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -41,7 +42,7 @@ from ..collision import (
 from ..model import Robot, Scene
 from ..trajectory import interpolate
 
-__all__ = ["FILTER_AFTER_STATES", "FILTER_AFTER_STATES_UNCOMPILED", "filter_threshold", "problem_checks"]
+__all__ = ["FILTER_AFTER_STATES", "FILTER_AFTER_STATES_UNCOMPILED", "Problem", "build_problem", "filter_threshold"]
 
 logger = logging.getLogger(__name__)
 
@@ -56,13 +57,41 @@ def filter_threshold() -> int:
     return FILTER_AFTER_STATES if kernels_ready() else FILTER_AFTER_STATES_UNCOMPILED
 
 
-def problem_checks(
+@dataclass(frozen=True)
+class Problem:
+    """One planning problem: the robot's group, the scene, and their collision checks, built once for its steps.
+
+    Attributes:
+        robot: The robot and its planning group.
+        scene: Its collision objects and frames.
+        checks: Collision checks of the group in the scene; `checks.base` holds the joints
+            outside the group.
+    """
+
+    robot: Robot
+    scene: Scene
+    checks: MotionChecker
+
+    @property
+    def base(self) -> NDArray[np.float64]:
+        """Return the configuration the joints outside the group keep."""
+        return self.checks.base
+
+
+def build_problem(
     robot: Robot, scene: Scene, geometry: GeometryMode, base: NDArray[np.float64], after: int = 0
-) -> MotionChecker:
-    """Return the checks of `robot` (other joints at `base`) in `scene`; the sphere filter comes after `after` states.
+) -> Problem:
+    """Return the problem of `robot` (other joints at `base`) in `scene`; the sphere filter comes after `after` states.
 
     With `after` 0 the filter is built now, as a benchmark wants (its set-up outside the timed steps).
     """
+    return Problem(robot, scene, _checks(robot, scene, geometry, base, after))
+
+
+def _checks(
+    robot: Robot, scene: Scene, geometry: GeometryMode, base: NDArray[np.float64], after: int
+) -> MotionChecker:
+    """Return the checks of `robot` (other joints at `base`) in `scene`, the filter built after `after` states."""
     checker = CollisionChecker(robot, scene.objects, scene.source, geometry=geometry, allowed=scene.allowed)
     hulls = hull_checker(robot, checker, scene)
 

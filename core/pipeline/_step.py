@@ -34,6 +34,7 @@ from ..planning import (
 )
 from ..timing import rest_to_rest, time_parameterize
 from ..types import JointTrajectory, StepResult
+from ._checks import Problem
 from .request import PlanRequest
 
 __all__ = ["plan_step"]
@@ -84,15 +85,14 @@ class _Target:
 def plan_step(
     spec: StepSpec,
     request: PlanRequest,
-    robot: Robot,
-    scene: Scene,
-    checks: MotionChecker,
+    problem: Problem,
     start: NDArray[np.float64],
 ) -> StepResult:
     """Return one step planned from `start`: target, search, certified timing, residual."""
     began = time.perf_counter()
+    robot, checks = problem.robot, problem.checks
     settings = _settings(spec, request, robot)
-    target = _target(spec, request, robot, scene, checks, start)
+    target = _target(spec, request, robot, problem.scene, checks, start)
     search, fraction = _search(spec, settings, robot, checks, start, target)
     path, trajectory, stats = _certified(spec, settings, robot, checks, start, target, search)
     stats["path_length"] = float(np.sum(np.linalg.norm(np.diff(path.waypoints, axis=0), axis=1)))

@@ -28,7 +28,9 @@ from ..bag import atomic_file
 from ..errors import ConfigError, InputError, MoveplanError, NoPlan, UsageError
 from .request import RobotSource
 
-__all__ = ["STAGES", "Problem", "Run", "find_problems", "plot_benchmark", "run_benchmark", "summarize", "write_csv"]
+__all__ = [
+    "STAGES", "ProblemFiles", "Run", "find_problems", "plot_benchmark", "run_benchmark", "summarize", "write_csv",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -39,7 +41,7 @@ STAGES = ("search", "simplify", "certify", "timing", "total", "planning_time", "
 
 
 @dataclass(frozen=True)
-class Problem:
+class ProblemFiles:
     """One planning problem: a scene + request pair, or a task file (`request` is then None)."""
 
     name: str
@@ -84,15 +86,15 @@ class Run:
         return {k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in asdict(self).items()}
 
 
-def find_problems(paths: Sequence[Path], count: int | None = None) -> tuple[Problem, ...]:
+def find_problems(paths: Sequence[Path], count: int | None = None) -> tuple[ProblemFiles, ...]:
     """Return the problems in `paths`: folders of scene/request pairs (searched recursively) or task files.
 
     `count` keeps the first problems of each folder.
     """
-    problems: list[Problem] = []
+    problems: list[ProblemFiles] = []
     for path in paths:
         if path.is_file():
-            problems.append(Problem(path.stem, path.parent.name, None, None, task=path))
+            problems.append(ProblemFiles(path.stem, path.parent.name, None, None, task=path))
             continue
         if not path.is_dir():
             raise ConfigError(f"{path}: no such problem folder or task file")
@@ -108,19 +110,19 @@ def find_problems(paths: Sequence[Path], count: int | None = None) -> tuple[Prob
                 request = folder / f"request{match.group(1)}{scene.suffix}"
                 if not request.is_file():
                     raise ConfigError(f"{scene}: no matching {request.name} beside it")
-                found.append(Problem(f"{folder.name}/{match.group(1)}", folder.name, scene, request))
+                found.append(ProblemFiles(f"{folder.name}/{match.group(1)}", folder.name, scene, request))
             problems.extend(found[:count] if count else found)
     if not problems:
         raise UsageError("no problems to run")
     return tuple(problems)
 
 
-RunProblem = Callable[[Problem], Run]
+RunProblem = Callable[[ProblemFiles], Run]
 
 
 def run_benchmark(
     robot: Path | RobotSource,
-    problems: Sequence[Problem],
+    problems: Sequence[ProblemFiles],
     planners: Sequence[str],
     seeds: Sequence[int],
     planning_time: float,
@@ -180,7 +182,7 @@ def _rebuild(payload: dict[str, Any]) -> Exception:
     return RuntimeError(f"benchmark worker failed: {payload['message']}\n{payload['traceback']}")
 
 
-def _worker(robot: Path | RobotSource, problems: tuple[Problem, ...], planner: str, seed: int,
+def _worker(robot: Path | RobotSource, problems: tuple[ProblemFiles, ...], planner: str, seed: int,
             budget: tuple[float, float | None], results: Any) -> None:
     """Run every problem with one planner and seed, and put each run on `results`."""
     key = (planner, seed)
@@ -202,7 +204,7 @@ def _worker(robot: Path | RobotSource, problems: tuple[Problem, ...], planner: s
     results.put(("done", key, None))
 
 
-def _solve(problem: Problem, config: Any, planner: str, seed: int, budget: tuple[float, float | None],
+def _solve(problem: ProblemFiles, config: Any, planner: str, seed: int, budget: tuple[float, float | None],
            output: Path) -> Run:
     """Return the run of one problem, its plan written to `output`; no plan is a failed run, bad input an error.
 

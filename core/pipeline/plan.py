@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..bag import END_STATES_KEY, write_plan
-from ..collision import MotionChecker, exact_checks
+from ..collision import exact_checks
 from ..config import (
     DEFAULT_ACCELERATION,
     JointGoal,
@@ -38,7 +38,7 @@ from ..planning import check_limits, joint_target, seed_planner
 from ..trajectory import sample
 from ..types import Plan, StepResult, TfSamples
 from ..version import moveplan_version
-from ._checks import filter_threshold, problem_checks
+from ._checks import Problem, build_problem, filter_threshold
 from ._step import plan_step
 from .request import PlanFlags, PlanRequest, resolve_request
 from .robot_state import RobotState, robot_state
@@ -123,20 +123,20 @@ def plan(
     base, current = _start_values(request, robot, scene)
     if request.motion_request is not None:  # objects the request's start state carries
         scene = attach_request_objects(scene, request.motion_request, robot, robot.configuration(current, base))
-    checks = problem_checks(robot, scene, config.planning["collision"], base, filter_after)
-    pair = checks.colliding_pair(current)
+    problem = build_problem(robot, scene, config.planning["collision"], base, filter_after)
+    pair = problem.checks.colliding_pair(current)
     if pair:
         raise StartInCollision(pair)
     steps: list[StepResult] = []
     try:
-        for step in _planned_steps(request, robot, scene, checks, current):
+        for step in _planned_steps(request, problem, current):
             steps.append(step)
     except MoveplanError as exc:
         if steps:
             exc.partial = assemble(request, config, robot, scene, base, steps)
         raise
     if exact_check:
-        referee = exact_checks(checks, scene)
+        referee = exact_checks(problem.checks, scene)
         for step in steps:
             began = time.perf_counter()
             step.stats["exact_valid"] = float(referee.first_collision_on_trajectory(step.trajectory) is None)
@@ -253,14 +253,12 @@ def _start_from(path: Path, robot: Robot) -> JointGoal:
     return JointGoal.by_name({j: values[j] for j in shared})
 
 
-def _planned_steps(
-    request: PlanRequest, robot: Robot, scene: Scene, checks: MotionChecker, start: NDArray[np.float64]
-) -> Iterator[StepResult]:
+def _planned_steps(request: PlanRequest, problem: Problem, start: NDArray[np.float64]) -> Iterator[StepResult]:
     """Yield every step planned in order, each from where the previous one ended."""
     current = start
     for spec in request.steps:
         try:
-            step = plan_step(spec, request, robot, scene, checks, current)
+            step = plan_step(spec, request, problem, current)
         except MoveplanError as exc:
             raise exc.in_step(spec.name) from None
         yield step
@@ -271,7 +269,11 @@ def assemble(
     request: PlanRequest, config: RobotConfig, robot: Robot, scene: Scene, base: NDArray[np.float64],
     steps: list[StepResult],
 ) -> PlanResult:
-    """Return the plan of the planned steps, with what replaying and checking it needs, and where each step ends."""
+    """Return the plan of the planned steps, with what replaying and checking it needs, and where each step ends.
+
+    It takes the robot, scene and base, not a Problem: a commander session assembles its executed
+    motions without building collision checks.
+    """
     ends = tuple(robot_state(robot, scene, robot.configuration(step.trajectory.positions[-1], base)) for step in steps)
     return PlanResult(
         robot_name=config.name,

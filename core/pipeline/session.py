@@ -19,7 +19,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..bag import write_plan
-from ..collision import MotionChecker
 from ..config import (
     ControllerConfig,
     MotionSettings,
@@ -34,7 +33,7 @@ from ..errors import ConfigError, NoPlan, StartInCollision, StartOutsideLimits
 from ..model import Robot, Scene, check_shape_count, first_repeated, resolve_frames
 from ..planning import check_limits, seed_planner
 from ..types import CollisionObject, Frame, JointTrajectory, Plan, StepResult
-from ._checks import filter_threshold, problem_checks
+from ._checks import Problem, build_problem, filter_threshold
 from ._plan_files import pick_controller
 from ._step import plan_step
 from .plan import assemble
@@ -42,7 +41,7 @@ from .request import PlanRequest
 
 __all__ = [
     "ExecutionSettings", "cartesian_motion", "check_execution", "compose_scene", "execute_motion",
-    "frame_in_root", "motion_checks", "plan_motion", "session_plan", "start_configuration", "write_session",
+    "frame_in_root", "motion_problem", "plan_motion", "session_plan", "start_configuration", "write_session",
 ]
 
 logger = logging.getLogger(__name__)
@@ -106,19 +105,18 @@ def frame_in_root(robot: Robot, scene: Scene, q: NDArray[np.float64], frame: str
     return robot.frame_pose(q, link) @ link_T_frame
 
 
-def motion_checks(robot: Robot, scene: Scene, q: NDArray[np.float64]) -> MotionChecker:
-    """Return the collision checks of `robot`'s group in `scene`, the other joints as in `q`.
+def motion_problem(robot: Robot, scene: Scene, q: NDArray[np.float64]) -> Problem:
+    """Return the problem of `robot`'s group in `scene`, the other joints as in `q`.
 
-    The sphere filter is built when `moveplan plan` would build it (checks.filter_threshold).
+    The sphere filter is built when `moveplan plan` would build it (_checks.filter_threshold).
     """
-    return problem_checks(robot, scene, robot.config.planning["collision"], q, filter_threshold())
+    return build_problem(robot, scene, robot.config.planning["collision"], q, filter_threshold())
 
 
 def plan_motion(
-    robot: Robot, scene: Scene, checks: MotionChecker, spec: StepSpec, q: NDArray[np.float64],
-    settings: MotionSettings, seed: int = 0,
+    problem: Problem, spec: StepSpec, q: NDArray[np.float64], settings: MotionSettings, seed: int = 0,
 ) -> StepResult:
-    """Return one motion planned from the configuration `q` (`checks` built for it): a step of `moveplan plan`.
+    """Return one motion planned from the configuration `q` (`problem` built for it): a step of `moveplan plan`.
 
     `settings` leave what they do not set to the robot config, as the CLI does; `seed` seeds OMPL
     and the IK restarts, each motion anew, as one `moveplan plan` is.
@@ -127,19 +125,20 @@ def plan_motion(
         StartOutsideLimits, StartInCollision: The start is unusable.
         NoPlan: Any other reason the step has no plan (IK, search, a linear path cut short).
     """
+    robot = problem.robot
     start = robot.values(q)
     check_limits(robot, start, StartOutsideLimits)
-    pair = checks.colliding_pair(start)
+    pair = problem.checks.colliding_pair(start)
     if pair:
         raise StartInCollision(pair)
     seed_planner(seed)
     request = PlanRequest(robot=Path(robot.config.name), steps=(spec,), motion=settings, seed=seed)
-    return plan_step(spec, request, robot, scene, checks, start)
+    return plan_step(spec, request, problem, start)
 
 
 def cartesian_motion(
-    robot: Robot, scene: Scene, checks: MotionChecker, waypoints: Sequence[PoseGoal], q: NDArray[np.float64],
-    settings: MotionSettings, seed: int = 0, name: str = "cartesian",
+    problem: Problem, waypoints: Sequence[PoseGoal], q: NDArray[np.float64], settings: MotionSettings, seed: int = 0,
+    name: str = "cartesian",
 ) -> tuple[StepResult | None, float]:
     """Return the straight-line motion through `waypoints` in turn, and the fraction of the way it covers.
 
@@ -151,10 +150,10 @@ def cartesian_motion(
     legs: list[StepResult] = []
     fraction = 0.0
     for k, goal in enumerate(waypoints):
-        start = q if not legs else robot.configuration(legs[-1].trajectory.positions[-1], q)
+        start = q if not legs else problem.robot.configuration(legs[-1].trajectory.positions[-1], q)
         spec = StepSpec(f"{name}[{k}]", goal, linear=True, min_fraction=0.0)
         try:
-            leg = plan_motion(robot, scene, checks, spec, start, settings, seed)
+            leg = plan_motion(problem, spec, start, settings, seed)
         except NoPlan as exc:
             # MoveIt too returns the path up to where it could not go on.
             logger.info("%s: the path stops before waypoint %d: %s", name, k, exc)
