@@ -25,7 +25,7 @@ from moveplan.core.config.fields import MAX_YAML_EVENTS
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import ConfigError, GoalUnreachable
 from moveplan.core.model.kinematics import solve_ik
-from moveplan.core.model.moveit_request import PositionGoal, load_motion_plan_request
+from moveplan.core.config.moveit_request import PositionGoal, load_motion_plan_request
 from moveplan.core.model.planning_scene import attach_request_objects
 from moveplan.core.model.robot import Robot
 from moveplan.core.model.scene_file import load_scene

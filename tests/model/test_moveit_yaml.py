@@ -18,7 +18,7 @@ from moveplan.core.collision.checker import CollisionChecker, coal_geometry
 from moveplan.core.config.goals import JointGoal, PoseGoal
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import ConfigError, FrameNotFound
-from moveplan.core.model.moveit_request import load_motion_plan_request, planner_name
+from moveplan.core.config.moveit_request import load_motion_plan_request, planner_name
 from moveplan.core.model.robot import Robot
 from moveplan.core.model.scene_file import load_scene
 
