@@ -16,10 +16,19 @@ import time
 from collections.abc import Sequence
 from typing import Any, cast
 
-from ..core.config import SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, StepSpec
+from ..core.config import (
+    SHIFT_AXES,
+    Goal,
+    JointGoal,
+    NamedGoal,
+    PoseGoal,
+    PositionGoal,
+    ShiftGoal,
+    StepSpec,
+    pose_matrix,
+)
 from ..core.control import ExecutionSummary
 from ..core.errors import NoPlan, UnknownName, UsageError
-from ..core.model import PositionGoal, pose_matrix
 from ..core.pipeline import cartesian_motion, execute_motion, plan_motion
 from ..core.planning import joint_target
 from ..core.types import StepResult

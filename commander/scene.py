@@ -17,9 +17,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.config import MAX_MAGNITUDE
+from ..core.config import MAX_MAGNITUDE, mesh_file
 from ..core.errors import UnknownName, UsageError
-from ..core.model import mesh_file
 from ..core.types import CollisionObject, Shape
 from ._targets import frame_name
 from ._world import World, current_world

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 from .._faces import lazy_exports
 
 if TYPE_CHECKING:
+    from .collision_objects import AttachedMessage, ObjectMessage, attached_collision_object
     from .controllers import ControllerConfig, ExecutionConfig, default_controller, parse_controllers
     from .controllers_write import tuned_controllers_text
     from .embed import check_carried
@@ -30,19 +31,26 @@ if TYPE_CHECKING:
     from .goals import SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
     from .joint_units import check_joint_units
     from .limits import DEFAULT_ACCELERATION, JointLimit
+    from .meshes import mesh_file
     from .motion import MotionSettings, Resolved, layered, resolved
+    from .moveit_request import MotionPlanRequest, PositionGoal, load_motion_plan_request
     from .planners import PLANNERS
+    from .planning_scene_yaml import PLANNING_SCENE_KEYS, FixedTransform, PlanningSceneFile, parse_planning_scene
+    from .poses import pose_matrix
     from .robot_config import RobotConfig, load_robot_config
+    from .scene_yaml import SceneFile, check_shape_count, first_repeated, parse_scene
     from .sources import CONFIG_FILE
     from .srdf import Group
     from .tasks import MAX_SEED, MIN_SCALING, StepSpec, TaskFile, load_task
     from .xacro import PackagePath, parse_xacro_args
 
 __all__ = [
+    "AttachedMessage",
     "CONFIG_FILE",
     "ControllerConfig",
     "DEFAULT_ACCELERATION",
     "ExecutionConfig",
+    "FixedTransform",
     "Goal",
     "Group",
     "JointGoal",
@@ -50,37 +58,51 @@ __all__ = [
     "MAX_MAGNITUDE",
     "MAX_SEED",
     "MIN_SCALING",
+    "MotionPlanRequest",
     "MotionSettings",
     "NamedGoal",
+    "ObjectMessage",
     "PLANNERS",
+    "PLANNING_SCENE_KEYS",
     "PackagePath",
+    "PlanningSceneFile",
     "PoseGoal",
+    "PositionGoal",
     "Resolved",
     "RobotConfig",
     "SHIFT_AXES",
+    "SceneFile",
     "ShiftGoal",
     "Start",
     "StartFrom",
     "StepSpec",
     "TaskFile",
     "angle",
+    "attached_collision_object",
     "check_carried",
     "check_joint_units",
     "check_keys",
+    "check_shape_count",
     "coordinate",
     "default_controller",
     "expression",
+    "first_repeated",
     "layered",
+    "load_motion_plan_request",
     "load_robot_config",
     "load_task",
     "load_yaml",
     "mapping",
+    "mesh_file",
     "number",
     "parse_controllers",
+    "parse_planning_scene",
+    "parse_scene",
     "parse_xacro_args",
     "parse_yaml",
     "pose_angle",
     "pose_angles",
+    "pose_matrix",
     "read_input",
     "read_input_text",
     "resolved",
@@ -88,10 +110,12 @@ __all__ = [
 ]
 
 __getattr__ = lazy_exports(__name__, {
+    "AttachedMessage": "collision_objects",
     "CONFIG_FILE": "sources",
     "ControllerConfig": "controllers",
     "DEFAULT_ACCELERATION": "limits",
     "ExecutionConfig": "controllers",
+    "FixedTransform": "planning_scene_yaml",
     "Goal": "goals",
     "Group": "srdf",
     "JointGoal": "goals",
@@ -99,37 +123,51 @@ __getattr__ = lazy_exports(__name__, {
     "MAX_MAGNITUDE": "fields",
     "MAX_SEED": "tasks",
     "MIN_SCALING": "tasks",
+    "MotionPlanRequest": "moveit_request",
     "MotionSettings": "motion",
     "NamedGoal": "goals",
+    "ObjectMessage": "collision_objects",
     "PLANNERS": "planners",
+    "PLANNING_SCENE_KEYS": "planning_scene_yaml",
     "PackagePath": "xacro",
+    "PlanningSceneFile": "planning_scene_yaml",
     "PoseGoal": "goals",
+    "PositionGoal": "moveit_request",
     "Resolved": "motion",
     "RobotConfig": "robot_config",
     "SHIFT_AXES": "goals",
+    "SceneFile": "scene_yaml",
     "ShiftGoal": "goals",
     "Start": "goals",
     "StartFrom": "goals",
     "StepSpec": "tasks",
     "TaskFile": "tasks",
     "angle": "fields",
+    "attached_collision_object": "collision_objects",
     "check_carried": "embed",
     "check_joint_units": "joint_units",
     "check_keys": "fields",
+    "check_shape_count": "scene_yaml",
     "coordinate": "fields",
     "default_controller": "controllers",
     "expression": "fields",
+    "first_repeated": "scene_yaml",
     "layered": "motion",
+    "load_motion_plan_request": "moveit_request",
     "load_robot_config": "robot_config",
     "load_task": "tasks",
     "load_yaml": "fields",
     "mapping": "fields",
+    "mesh_file": "meshes",
     "number": "fields",
     "parse_controllers": "controllers",
+    "parse_planning_scene": "planning_scene_yaml",
+    "parse_scene": "scene_yaml",
     "parse_xacro_args": "xacro",
     "parse_yaml": "fields",
     "pose_angle": "fields",
     "pose_angles": "fields",
+    "pose_matrix": "poses",
     "read_input": "fields",
     "read_input_text": "fields",
     "resolved": "motion",

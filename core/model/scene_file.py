@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..config import load_yaml, mapping
+from ..config import PLANNING_SCENE_KEYS, load_yaml, mapping
 from .planning_scene import read_planning_scene
 from .robot import Robot
-from .scene import PLANNING_SCENE_KEYS, Scene, moveplan_scene
+from .scene import Scene, moveplan_scene
 
 __all__ = ["load_scene"]
 

@@ -16,6 +16,7 @@ from ..config import (
     MAX_MAGNITUDE,
     MIN_SCALING,
     JointGoal,
+    MotionPlanRequest,
     MotionSettings,
     NamedGoal,
     PoseGoal,
@@ -26,10 +27,10 @@ from ..config import (
     StepSpec,
     TaskFile,
     layered,
+    load_motion_plan_request,
     load_robot_config,
 )
 from ..errors import UsageError
-from ..model import MotionPlanRequest, load_motion_plan_request
 
 __all__ = ["PlanFlags", "PlanRequest", "RobotSource", "check_planning_time", "resolve_request"]
 

@@ -14,9 +14,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config import JointGoal, NamedGoal, RobotConfig, check_joint_units, mapping, parse_yaml
+from ..config import PLANNING_SCENE_KEYS, JointGoal, NamedGoal, RobotConfig, check_joint_units, mapping, parse_yaml
 from ..errors import FrameNotFound, InputError, OutsideLimits, UnknownName, UsageError
-from ..model import PLANNING_SCENE_KEYS, Robot, Scene, empty_scene, load_scene, moveplan_scene, read_planning_scene
+from ..model import Robot, Scene, empty_scene, load_scene, moveplan_scene, read_planning_scene
 from ..planning import joint_target
 from ..trajectory import sample
 from ..types import LinkPose, RobotState

@@ -25,12 +25,14 @@ from ..config import (
     PoseGoal,
     RobotConfig,
     StepSpec,
+    check_shape_count,
     default_controller,
+    first_repeated,
     parse_controllers,
 )
 from ..control import ExecutionReport, make_plant, simulate, validate_goal
 from ..errors import ConfigError, NoPlan, StartInCollision, StartOutsideLimits
-from ..model import Robot, Scene, check_shape_count, first_repeated, resolve_frames
+from ..model import Robot, Scene, resolve_frames
 from ..planning import check_limits, seed_planner
 from ..types import CollisionObject, Frame, JointTrajectory, Plan, StepResult
 from ._checks import Problem, build_problem, filter_threshold

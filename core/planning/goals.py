@@ -17,9 +17,9 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config import JointGoal, NamedGoal, PoseGoal, ShiftGoal
+from ..config import JointGoal, NamedGoal, PoseGoal, PositionGoal, ShiftGoal, pose_matrix
 from ..errors import ConfigError, GoalOutsideLimits, OutsideLimits, UnknownName, UsageError
-from ..model import PositionGoal, Robot, Scene, pose_matrix, solve_ik
+from ..model import Robot, Scene, solve_ik
 from ..rotations import matrix_from_rpy, rpy_from_matrix
 
 __all__ = [

@@ -22,10 +22,10 @@ from rosbags.highlevel import AnyReader
 from moveplan.core.bag import read_plan
 from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.config.fields import MAX_YAML_EVENTS
+from moveplan.core.config.moveit_request import PositionGoal, load_motion_plan_request
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import ConfigError, GoalUnreachable
 from moveplan.core.model.kinematics import solve_ik
-from moveplan.core.model.moveit_request import PositionGoal, load_motion_plan_request
 from moveplan.core.model.planning_scene import attach_request_objects
 from moveplan.core.model.robot import Robot
 from moveplan.core.model.scene_file import load_scene
@@ -307,24 +307,6 @@ def test_request_numbers_are_bounded_like_flags(cli: Cli, tmp_path: Path, change
     assert result.exit_code == 3, result.stderr
     assert f"{path}: {message}" in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1 and not out.exists()
-
-
-def test_position_goal_with_a_target_point_offset_is_refused(tmp_path: Path) -> None:
-    content = request_with()
-    content["goal_constraints"][0]["position_constraints"][0]["target_point_offset"] = {"z": 0.1}
-    with pytest.raises(ConfigError, match=r"position_constraints\[0\].target_point_offset: not supported in a goal "
-                                          "without an orientation constraint"):
-        load_motion_plan_request(write(tmp_path / "request.yaml", content))
-
-
-def test_orientation_constraint_alone_is_refused(tmp_path: Path) -> None:
-    content = request_with()
-    goal = content["goal_constraints"][0]
-    goal["orientation_constraints"] = [{"link_name": "panda_hand", "orientation": {"w": 1.0}}]
-    goal["position_constraints"] = []
-    with pytest.raises(ConfigError, match=r"goal_constraints\[0\]: a goal needs joint constraints, or one position "
-                                          r"constraint and at most one orientation constraint \(got 0 and 1\)"):
-        load_motion_plan_request(write(tmp_path / "request.yaml", content))
 
 
 # --- a scene too large to read ------------------------------------------------------------------

@@ -7,9 +7,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config import MAX_MAGNITUDE, number
 from ..errors import ConfigError
 from ..rotations import matrix_from_quaternion, matrix_from_rpy
+from .fields import MAX_MAGNITUDE, number
 
 __all__ = ["pose_matrix", "vector"]
 

@@ -1,9 +1,7 @@
-"""Readers for the ROS message types MoveIt's YAML files are made of: poses, states and collision objects.
+"""Readers for moveit_msgs/CollisionObject and AttachedCollisionObject as MoveIt's YAML files write them.
 
-A message field left out takes its ROS 2 default (zero, empty; a quaternion's w is 1).
-Points, vectors and quaternions may be written as lists ([x, y, z], [x, y, z, w], as
-MotionBenchMaker writes them) or as mappings ({x: .., y: .., z: ..}, as ROS 2 writes them).
-Coordinates, joint positions and quaternion parts are finite and within MAX_MAGNITUDE.
+An object's shapes (primitives, then meshes) are placed in the object frame and the object in its
+header frame; mesh files are checked where they are named.
 """
 
 from __future__ import annotations
@@ -16,36 +14,17 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config import MAX_MAGNITUDE, PackagePath, check_keys, coordinate, mapping, number
-from ..errors import ConfigError, UnknownName
-from ..types import Shape
-from .poses import pose_matrix
-from .robot import Robot
-from .scene import mesh_file
+from ..errors import ConfigError
+from ..types import Shape, frozen_array
+from .fields import MAX_MAGNITUDE, check_keys, mapping, number
+from .meshes import mesh_file
+from .ros_messages import header_frame, is_empty_pose, point, pose, string_list, yaml_list
+from .xacro import PackagePath
 
-__all__ = [
-    "ObjectMessage",
-    "attached_object",
-    "collision_object",
-    "header_frame",
-    "is_empty_pose",
-    "joint_positions",
-    "known_joints",
-    "point",
-    "pose",
-    "quaternion",
-    "robot_state",
-    "string_list",
-    "transform",
-    "yaml_list",
-]
+__all__ = ["AttachedMessage", "ObjectMessage", "attached_collision_object", "attached_object", "collision_object"]
 
 logger = logging.getLogger(__name__)
 
-_ROBOT_STATE_KEYS = {"joint_state", "multi_dof_joint_state", "attached_collision_objects", "is_diff"}
-_JOINT_STATE_KEYS = {"header", "name", "position", "velocity", "effort"}
-_MULTI_DOF_KEYS = {"header", "joint_names", "transforms", "twist", "wrench"}
-_HEADER_KEYS = {"stamp", "frame_id", "seq"}  # seq: headers written by ROS 1
 _ATTACHED_KEYS = {"link_name", "object", "touch_links", "detach_posture", "weight"}
 _OBJECT_KEYS = {
     "header", "pose", "id", "type", "primitives", "primitive_poses", "meshes", "mesh_poses", "planes",
@@ -68,6 +47,7 @@ class ObjectMessage:
         parts: (name, shape, `object_T_shape`) per shape; empty for an object given by id alone
             (attaching the world object of that id).
         subframes: Subframe name -> `object_T_subframe`.
+        where: The object's place in its file, for messages ("scene.yaml: world.collision_objects[0]").
     """
 
     id: str
@@ -75,141 +55,31 @@ class ObjectMessage:
     header_T_object: NDArray[np.float64]
     parts: tuple[tuple[str, Shape, NDArray[np.float64]], ...]
     subframes: dict[str, NDArray[np.float64]]
+    where: str
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "header_T_object", frozen_array(self.header_T_object, (4, 4), "header_T_object"))
+        object.__setattr__(self, "parts", tuple((name, shape, frozen_array(shape_T, (4, 4), "object_T_shape"))
+                                                for name, shape, shape_T in self.parts))
+        object.__setattr__(self, "subframes", {name: frozen_array(sub_T, (4, 4), "object_T_subframe")
+                                               for name, sub_T in self.subframes.items()})
 
 
-def header_frame(entry: dict[str, Any], where: str, default: str) -> str:
-    """Return a message's header.frame_id without a leading slash, or `default` when empty."""
-    header = mapping(entry.get("header"), f"{where}.header")
-    check_keys(header, _HEADER_KEYS, f"{where}.header")
-    frame = header.get("frame_id", "")
-    if not isinstance(frame, str):
-        raise ConfigError(f"{where}.header.frame_id: expected a frame name, got {frame!r}")
-    return frame.lstrip("/") or default
+@dataclass(frozen=True)
+class AttachedMessage:
+    """A moveit_msgs/AttachedCollisionObject, parsed.
 
-
-def robot_state(value: Any, where: str) -> tuple[dict[str, float], list[Any]]:
-    """Return a moveit_msgs/RobotState's joint positions and its attached objects (as written)."""
-    entry = mapping(value, where)
-    check_keys(entry, _ROBOT_STATE_KEYS, where)
-    joints = joint_positions(entry.get("joint_state"), f"{where}.joint_state")
-    multi = mapping(entry.get("multi_dof_joint_state"), f"{where}.multi_dof_joint_state")
-    check_keys(multi, _MULTI_DOF_KEYS, f"{where}.multi_dof_joint_state")
-    names = string_list(multi.get("joint_names"), f"{where}.multi_dof_joint_state.joint_names")
-    for k, item in enumerate(yaml_list(multi.get("transforms"), f"{where}.multi_dof_joint_state.transforms")):
-        at = f"{where}.multi_dof_joint_state.transforms[{k}]"
-        if not np.allclose(transform(item, at), np.eye(4), atol=1e-9):
-            joint = names[k] if k < len(names) else "?"
-            raise ConfigError(f"{at}: joint '{joint}' is away from the identity; moveplan plans in the URDF "
-                              "root frame and cannot move a virtual joint")
-    return joints, yaml_list(entry.get("attached_collision_objects"), f"{where}.attached_collision_objects")
-
-
-def joint_positions(value: Any, where: str) -> dict[str, float]:
-    """Return joint name -> position of a sensor_msgs/JointState."""
-    entry = mapping(value, where)
-    check_keys(entry, _JOINT_STATE_KEYS, where)
-    names = string_list(entry.get("name"), f"{where}.name")
-    positions = yaml_list(entry.get("position"), f"{where}.position")
-    if len(positions) != len(names):
-        raise ConfigError(f"{where}.position: {len(positions)} positions for {len(names)} names")
-    if len(set(names)) != len(names):
-        twice = next(name for name in names if names.count(name) > 1)
-        raise ConfigError(f"{where}.name: joint '{twice}' is listed twice")
-    return {name: coordinate(v, f"{where}.position[{i}]")
-            for i, (name, v) in enumerate(zip(names, positions, strict=True))}
-
-
-def known_joints(joints: dict[str, float], robot: Robot, where: str) -> dict[str, float]:
-    """Return the joints that have a position in `robot`, after checking every name is a URDF joint.
-
-    Fixed joints (a Panda's fingers in some URDFs) are known but have no position: left out.
+    Attributes:
+        link: The robot link (by name, not yet checked against a robot) the object is attached to.
+        object: The object; with no parts when given by id alone (the world object of that id).
+        touch_links: Links (or objects) the object may touch.
+        where: The entry's place in its file, for messages.
     """
-    for joint in joints:
-        if joint not in robot.config.urdf_joints:
-            raise UnknownName("joint", joint, where, robot.config.limits)
-    return {j: v for j, v in joints.items() if robot.model.existJointName(j)}
 
-
-def yaml_list(value: Any, where: str) -> list[Any]:
-    """Return `value` if it is a list, [] if it is missing, else raise ConfigError at `where`."""
-    if value is None:
-        return []
-    if not isinstance(value, list):
-        raise ConfigError(f"{where}: expected a list, got {type(value).__name__}")
-    return value
-
-
-def string_list(value: Any, where: str) -> list[str]:
-    """Return `value` if it is a list of strings ([] if missing), else raise ConfigError at `where`."""
-    items = yaml_list(value, where)
-    for i, item in enumerate(items):
-        if not isinstance(item, str):
-            raise ConfigError(f"{where}[{i}]: expected a name, got {item!r}")
-    return items
-
-
-def point(value: Any, where: str) -> list[float]:
-    """Return [x, y, z] of a Point or Vector3 written as a list or a mapping (missing fields are 0)."""
-    if isinstance(value, list):
-        if len(value) != 3:
-            raise ConfigError(f"{where}: expected [x, y, z], got {value!r}")
-        return [coordinate(v, f"{where}[{i}]") for i, v in enumerate(value)]
-    entry = mapping(value, where)
-    check_keys(entry, {"x", "y", "z"}, where)
-    return [coordinate(entry.get(axis, 0.0), f"{where}.{axis}") for axis in "xyz"]
-
-
-def quaternion(value: Any, where: str) -> list[float] | None:
-    """Return [x, y, z, w] of a Quaternion written as a list or a mapping; None means the identity.
-
-    Missing fields take ROS 2's defaults (w = 1). All zeros is read as the identity, as MoveIt does.
-    """
-    if value is None:
-        return None
-    quat = _quaternion_values(value, where)
-    if not any(quat):
-        logger.warning("%s: quaternion of zeros read as the identity, as MoveIt does", where)
-        return None
-    return quat
-
-
-def _quaternion_values(value: Any, where: str) -> list[float]:
-    """Return [x, y, z, w] as written (the identity when missing)."""
-    if value is None:
-        return [0.0, 0.0, 0.0, 1.0]
-    if isinstance(value, list):
-        if len(value) != 4:
-            raise ConfigError(f"{where}: expected [x, y, z, w], got {value!r}")
-        return [coordinate(v, f"{where}[{i}]") for i, v in enumerate(value)]
-    entry = mapping(value, where)
-    check_keys(entry, {"x", "y", "z", "w"}, where)
-    return [coordinate(entry.get(axis, 1.0 if axis == "w" else 0.0), f"{where}.{axis}") for axis in "xyzw"]
-
-
-def pose(value: Any, where: str) -> NDArray[np.float64]:
-    """Return the 4x4 transform of a geometry_msgs/Pose {position, orientation}; missing parts are identity."""
-    entry = mapping(value, where)
-    check_keys(entry, {"position", "orientation"}, where)
-    xyz = point(entry.get("position", [0.0, 0.0, 0.0]), f"{where}.position")
-    return pose_matrix(xyz, None, quaternion(entry.get("orientation"), f"{where}.orientation"), where)
-
-
-def transform(value: Any, where: str) -> NDArray[np.float64]:
-    """Return the 4x4 transform of a geometry_msgs/Transform {translation, rotation}."""
-    entry = mapping(value, where)
-    check_keys(entry, {"translation", "rotation"}, where)
-    xyz = point(entry.get("translation", [0.0, 0.0, 0.0]), f"{where}.translation")
-    return pose_matrix(xyz, None, quaternion(entry.get("rotation"), f"{where}.rotation"), where)
-
-
-def is_empty_pose(value: Any, where: str) -> bool:
-    """Return True for a pose left out, or written as all zeros (MoveIt's isEmpty)."""
-    if value is None:
-        return True
-    entry = mapping(value, where)
-    position = point(entry.get("position", [0.0, 0.0, 0.0]), f"{where}.position")
-    orientation = _quaternion_values(entry.get("orientation"), f"{where}.orientation")
-    return not any(position) and not any(orientation)
+    link: str
+    object: ObjectMessage
+    touch_links: tuple[str, ...]
+    where: str
 
 
 def attached_object(value: Any, where: str) -> tuple[str, dict[str, Any], tuple[str, ...]]:
@@ -224,6 +94,12 @@ def attached_object(value: Any, where: str) -> tuple[str, dict[str, Any], tuple[
         raise ConfigError(f"{where}.object.id: expected an object name, got {written.get('id')!r}")
     number(entry.get("weight", 0.0), f"{where}.weight", bound=MAX_MAGNITUDE)
     return link, written, tuple(string_list(entry.get("touch_links"), f"{where}.touch_links"))
+
+
+def attached_collision_object(value: Any, where: str, folder: Path, packages: PackagePath) -> AttachedMessage:
+    """Return a moveit_msgs/AttachedCollisionObject with its object read as `collision_object` reads one."""
+    link, written, touch = attached_object(value, where)
+    return AttachedMessage(link, collision_object(written, f"{where}.object", folder, packages), touch, where)
 
 
 def collision_object(value: Any, where: str, folder: Path, packages: PackagePath) -> ObjectMessage:
@@ -268,7 +144,7 @@ def collision_object(value: Any, where: str, folder: Path, packages: PackagePath
         raise ConfigError(f"{where}.subframe_poses: {len(sub_poses)} poses for {len(sub_names)} subframe_names")
     subframes = {sub: pose(p, f"{where}.subframe_poses[{i}]")
                  for i, (sub, p) in enumerate(zip(sub_names, sub_poses, strict=True))}
-    return ObjectMessage(name, header_frame(entry, where, ""), header_T_object, parts, subframes)
+    return ObjectMessage(name, header_frame(entry, where, ""), header_T_object, parts, subframes, where)
 
 
 def _primitive(value: Any, where: str) -> Shape:

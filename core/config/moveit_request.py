@@ -17,8 +17,9 @@ Read as move_group reads one, with these choices:
   parameterisation reads them, a value in (0, 1] is used and anything else (0 included,
   MoveIt's "not set") means 1.0, the full limits; values other than 0 log a warning.
   A factor left out of the file is not set: the task's or robot config's default applies.
-- `start_state.attached_collision_objects` are attached to the scene as MoveIt attaches them
-  (core/model/planning_scene.py `attach_request_objects`).
+- `start_state.attached_collision_objects` are checked here and kept as written; they are
+  attached to the scene as MoveIt attaches them (core/model/planning_scene.py
+  `attach_request_objects`), their mesh files found through the robot config's packages.
 - Ignored: `num_planning_attempts` (one search per step), `workspace_parameters` (the
   joint limits bound the search), `pipeline_id`, `reference_trajectories` and Cartesian
   speed limits (warnings where set). Path and trajectory constraints and visibility
@@ -37,24 +38,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config import (
-    MAX_MAGNITUDE,
-    MIN_SCALING,
-    PLANNERS,
-    JointGoal,
-    MotionSettings,
-    PoseGoal,
-    StepSpec,
-    check_keys,
-    coordinate,
-    load_yaml,
-    mapping,
-    number,
-    read_input,
-)
 from ..errors import ConfigError, known
-from .moveit_messages import attached_object, header_frame, point, pose, quaternion, robot_state, yaml_list
+from .collision_objects import attached_object
+from .fields import MAX_MAGNITUDE, check_keys, coordinate, load_yaml, mapping, number, read_input
+from .goals import JointGoal, PoseGoal
+from .motion import MotionSettings
+from .planners import PLANNERS
 from .poses import pose_matrix
+from .ros_messages import header_frame, point, pose, quaternion, robot_state, yaml_list
+from .tasks import MIN_SCALING, StepSpec
 
 __all__ = ["MAX_ATTEMPTS", "MotionPlanRequest", "PositionGoal", "load_motion_plan_request", "planner_name"]
 
