@@ -16,6 +16,7 @@ if TYPE_CHECKING:
     from .benchmark import Run, find_problems, plot_benchmark, run_benchmark, summarize, write_csv
     from .documents import (
         benchmark_document,
+        failure_document,
         inspect_document,
         plan_document,
         plan_failure_document,
@@ -72,6 +73,7 @@ __all__ = [
     "execute_plotted",
     "execute_to_file",
     "execution_document",
+    "failure_document",
     "find_problems",
     "frame_in_root",
     "inspect_document",
@@ -125,6 +127,7 @@ __getattr__ = lazy_exports(__name__, {
     "execute_plotted": "plots",
     "execute_to_file": "report",
     "execution_document": "report",
+    "failure_document": "documents",
     "find_problems": "benchmark",
     "frame_in_root": "session",
     "inspect_document": "documents",
