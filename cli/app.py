@@ -127,9 +127,10 @@ def plan(
 ) -> None:
     """Plan collision-free, time-parameterised motions and write them to MCAP."""
     setup_logging(verbose, quiet)
+    from ..core.pipeline import plan_failure_document
     from . import render
 
-    with exit_codes(as_json, render.plan_failure):
+    with exit_codes(as_json, plan_failure_document):
         check_outputs({"-o": output}, {"TASK": task, "--robot": robot, "--scene": scene, "--request": motion_request,
                                        "--start-from": start_from, **description_inputs(urdf, srdf)})
         flags = _plan_flags(locals())

@@ -268,10 +268,12 @@ def _internal(exc: BaseException) -> str:
             f"[{detail.filename.rsplit('/', 1)[-1]}:{detail.lineno}]")
 
 
-def _report(code: int, message: str, as_json: bool, *, kind: str, **document: Any) -> None:
+def _report(code: int, message: str, as_json: bool, *, kind: str, **context: Any) -> None:
     message = escape_controls(message)
     if as_json:
-        print(json.dumps({"ok": False, **document, "error": {"exit_code": code, "kind": kind, "message": message}}))
+        from ..core.pipeline import failure_document
+
+        print(json.dumps(failure_document(code, kind, message, context)))
     else:
         _say(f"moveplan: error: {message}")
     raise typer.Exit(code)

@@ -24,13 +24,12 @@ from .tables import number as _number
 if TYPE_CHECKING:  # each command imports only the core modules it runs
     from ..core.config import RobotConfig
     from ..core.control import CheckReport
-    from ..core.errors import MoveplanError
     from ..core.pipeline import Inspection, PlanExecution, PlanResult, Run, StateResult
     from ..core.types import RobotState
 
 __all__ = [
     "PROGRESS_EVERY_S", "benchmark_progress", "benchmark_summary", "check_summary", "execution_summary",
-    "inspect_summary", "plan_failure", "plan_summary", "robot_summary", "state_summary",
+    "inspect_summary", "plan_summary", "robot_summary", "state_summary",
 ]
 
 logger = logging.getLogger("moveplan")
@@ -54,13 +53,6 @@ def plan_summary(plan: PlanResult, output: Path, as_json: bool, quiet: bool) -> 
     show(rows)
     if plan.end_states:
         _end_poses([s.name for s in plan.steps], plan.end_states)
-
-
-def plan_failure(error: MoveplanError) -> dict[str, Any]:
-    """Return what a failed plan's JSON document holds besides its error (core's plan_failure_document)."""
-    from ..core.pipeline import plan_failure_document
-
-    return plan_failure_document(error)
 
 
 def _end_poses(names: list[str], states: tuple[RobotState, ...]) -> None:
@@ -180,9 +172,7 @@ def execution_summary(outcome: PlanExecution, output: Path | None, as_json: bool
     """Print the result, every violation and the per-joint margins, or the JSON document."""
     from ..core.pipeline import execution_document
 
-    document = execution_document(outcome)
-    if output is not None:
-        document["output"] = str(output)
+    document = execution_document(outcome, output)
     if as_json:
         _emit(document)
         return

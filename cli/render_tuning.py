@@ -22,9 +22,7 @@ def tuning_summary(result: TuneResult, plot: Path | None, as_json: bool, quiet: 
     """Print per joint the stages of the tuning, the fitted plant, the verification; or the tune-pid JSON document."""
     from ..core.pipeline import tuning_document
 
-    document = tuning_document(result)
-    if plot is not None:
-        document["plot"] = str(plot)
+    document = tuning_document(result, plot)
     if as_json:
         _emit(document)
         return

@@ -17,6 +17,7 @@ if TYPE_CHECKING:
     from .benchmark import ProblemFiles, Run, find_problems, plot_benchmark, run_benchmark, summarize, write_csv
     from .documents import (
         benchmark_document,
+        failure_document,
         inspect_document,
         plan_document,
         plan_failure_document,
@@ -75,6 +76,7 @@ __all__ = [
     "execute_plotted",
     "execute_to_file",
     "execution_document",
+    "failure_document",
     "find_problems",
     "frame_in_root",
     "inspect_document",
@@ -130,6 +132,7 @@ __getattr__ = lazy_exports(__name__, {
     "execute_plotted": "plots",
     "execute_to_file": "report",
     "execution_document": "report",
+    "failure_document": "documents",
     "find_problems": "benchmark",
     "frame_in_root": "session",
     "inspect_document": "documents",

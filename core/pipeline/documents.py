@@ -1,16 +1,17 @@
-"""The result documents of plan, robot, state, inspect and benchmark: what `--json` prints, built here.
+"""The result documents of plan, robot, state, inspect and benchmark, and of a failed command: what `--json` prints.
 
 cli/ renders them (JSON as built, tables drawn from them) and adds nothing; execute's and
 check-tolerances' documents are report.py's, tune-pid's tuning.py's. docs/cli.md lists the keys.
+Only the standard library is imported here: the CLI builds a failure's document on any error.
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Mapping
 from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
-
-import numpy as np
 
 if TYPE_CHECKING:
     from ..config import RobotConfig
@@ -21,8 +22,8 @@ if TYPE_CHECKING:
     from .robot_state import StateResult
 
 __all__ = [
-    "benchmark_document", "inspect_document", "plan_document", "plan_failure_document", "robot_document",
-    "state_document", "step_documents",
+    "benchmark_document", "failure_document", "inspect_document", "plan_document", "plan_failure_document",
+    "robot_document", "state_document", "step_documents",
 ]
 
 
@@ -63,7 +64,7 @@ def robot_document(config: RobotConfig) -> dict[str, Any]:
         "groups": {n: {"joints": list(g.joints), "base": g.base, "tip": g.tip} for n, g in config.srdf.groups.items()},
         "joints": {
             n: {"lower": lim.lower, "upper": lim.upper, "max_velocity": lim.max_velocity,
-                "max_acceleration": None if np.isnan(lim.max_acceleration) else lim.max_acceleration,
+                "max_acceleration": None if math.isnan(lim.max_acceleration) else lim.max_acceleration,
                 "continuous": lim.continuous, "source": lim.source}
             for n, lim in config.limits.items()
         },
@@ -117,3 +118,10 @@ def inspect_document(inspection: Inspection) -> dict[str, Any]:
 def benchmark_document(runs: list[Run], rows: list[dict[str, Any]]) -> dict[str, Any]:
     """Return the document of a benchmark: every run, and the summary rows per scenario and planner."""
     return {"ok": True, "runs": [r.as_dict() for r in runs], "summary": rows, "error": None}
+
+
+def failure_document(
+    exit_code: int, kind: str, message: str, context: Mapping[str, Any] | None = None
+) -> dict[str, Any]:
+    """Return the document of a failed command: what the command adds (`context`, a plan's steps), then the error."""
+    return {"ok": False, **(context or {}), "error": {"exit_code": exit_code, "kind": kind, "message": message}}

@@ -137,14 +137,15 @@ def write_execution(path: Path, execution: PlanExecution, distro: str = "jazzy",
         recorder.finish(execution)
 
 
-def execution_document(execution: PlanExecution) -> dict[str, Any]:
+def execution_document(execution: PlanExecution, output: Path | None = None) -> dict[str, Any]:
     """Return the result document of an execution: the executed file's, and `execute --json`'s.
 
     Keys: ok, result {code, name, message}, violations (each with its step: step, check,
     joint, time_s, reference, actual, error, tolerance; times from the step's start),
     margins {joint: margin}, then controller, duration_s and steps (name, ok, result,
     start_s and duration_s on the execution's timeline, tracking) and tracking (per joint, the
-    worst over the steps: core.control.quality). Non-finite numbers are null.
+    worst over the steps: core.control.quality); last output, the executed file written, if
+    `output` is given (the file's own document has none). Non-finite numbers are null.
     """
     steps, start_ns = [], 0
     for step in execution.steps:
@@ -160,13 +161,16 @@ def execution_document(execution: PlanExecution) -> dict[str, Any]:
             }
         )
         start_ns += seconds_to_ns(report.duration_s)
-    return cast(dict[str, Any], _finite_numbers({
+    document: dict[str, Any] = {
         **_verdict(execution.ok, execution.result, execution.violations, execution.margins),
         "controller": execution.controller.name,
         "duration_s": start_ns / 1e9,
         "steps": steps,
         "tracking": tracking_document(execution.tracking),
-    }))
+    }
+    if output is not None:
+        document["output"] = str(output)
+    return cast(dict[str, Any], _finite_numbers(document))
 
 
 def check_document(report: CheckReport, recording: Path) -> dict[str, Any]:

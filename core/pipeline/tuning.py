@@ -219,14 +219,15 @@ def _recorded_steps(checked: CheckedRecording) -> list[RecordedStep]:
     return steps
 
 
-def tuning_document(result: TuneResult) -> dict[str, Any]:
+def tuning_document(result: TuneResult, plot: Path | None = None) -> dict[str, Any]:
     """Return the tune-pid JSON document: per joint its stages and gains, the plant, the fit and the verification.
 
     Keys: ok, output, controller, source, interface, plant (the parameters tuned on), fit (null
     without --recording: rms_error [rad], fraction of the largest joint travel, travel,
     samples, shifts_s, joints {joint: {params, rms_error, travel, fraction}}), joints {joint:
     {start, gains, bump, load, stages [{stage, gains, response, chosen, note}]}}, verification
-    (as execute --json), ringing (the joints the verification names), error (null).
+    (as execute --json), ringing (the joints the verification names), error (null); last plot,
+    the figure drawn, if `plot` is given.
     """
     fit = None
     if result.fit is not None:
@@ -247,4 +248,6 @@ def tuning_document(result: TuneResult) -> dict[str, Any]:
         "interface": result.interface, "plant": result.plant_params, "fit": fit, "joints": joints,
         "verification": execution_document(result.verification), "ringing": result.ringing, "error": None,
     }
+    if plot is not None:
+        document["plot"] = str(plot)
     return cast("dict[str, Any]", finite_numbers(document))
