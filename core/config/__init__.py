@@ -30,12 +30,12 @@ if TYPE_CHECKING:
     from .goals import SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
     from .joint_units import check_joint_units
     from .limits import DEFAULT_ACCELERATION, JointLimit
-    from .motion import MotionSettings, Resolved, layered, resolved
+    from .motion import MIN_SCALING, MotionSettings, Resolved, is_planning_time, is_scaling, layered, resolved
     from .planners import PLANNERS
     from .robot_config import RobotConfig, load_robot_config
     from .sources import CONFIG_FILE
     from .srdf import Group
-    from .tasks import MAX_SEED, MIN_SCALING, StepSpec, TaskFile, load_task
+    from .tasks import MAX_SEED, StepSpec, TaskFile, load_task
     from .xacro import PackagePath, parse_xacro_args
 
 __all__ = [
@@ -70,6 +70,8 @@ __all__ = [
     "coordinate",
     "default_controller",
     "expression",
+    "is_planning_time",
+    "is_scaling",
     "layered",
     "load_robot_config",
     "load_task",
@@ -98,7 +100,7 @@ __getattr__ = lazy_exports(__name__, {
     "JointLimit": "limits",
     "MAX_MAGNITUDE": "fields",
     "MAX_SEED": "tasks",
-    "MIN_SCALING": "tasks",
+    "MIN_SCALING": "motion",
     "MotionSettings": "motion",
     "NamedGoal": "goals",
     "PLANNERS": "planners",
@@ -119,6 +121,8 @@ __getattr__ = lazy_exports(__name__, {
     "coordinate": "fields",
     "default_controller": "controllers",
     "expression": "fields",
+    "is_planning_time": "motion",
+    "is_scaling": "motion",
     "layered": "motion",
     "load_robot_config": "robot_config",
     "load_task": "tasks",
