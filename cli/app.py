@@ -366,7 +366,7 @@ def benchmark(
         found = find_problems(problems, count)
         source = robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits)
         config = source.load()
-        planners = [p.strip() for text in planner or [config.planning["planner"]] for p in text.split(",")]
+        planners = [p.strip() for text in planner or [config.motion.planner] for p in text.split(",")]
         with render.benchmark_progress(len(found) * len(planners) * len(seed_list), quiet) as advance:
             runs = run_benchmark(source, found, planners, seed_list, time_s, jobs, advance, timeout_s)
         with all_or_none() as written:

@@ -12,7 +12,7 @@ import reprlib
 from dataclasses import replace
 from typing import Any
 
-from ..core.config import MIN_SCALING, PLANNERS, MotionSettings
+from ..core.config import MIN_SCALING, PLANNERS, MotionSettings, Resolved, is_scaling, layered, resolved
 from ..core.errors import UsageError, known
 from ..core.pipeline import check_planning_time
 from ._world import World
@@ -21,6 +21,9 @@ __all__ = ["PLANNING_TIME_S", "PlanningSettings", "real_number"]
 
 PLANNING_TIME_S = 5.0
 """MoveGroupCommander's default planning time in [s], MoveIt's."""
+
+# MoveIt's move_group plans with 5 s unless told; the rest is the robot config's.
+_MOVEIT_DEFAULTS = MotionSettings(planning_time=PLANNING_TIME_S)
 
 _TOLERANCES = {"joint": 1e-4, "position": 1e-4, "orientation": 1e-3}  # MoveIt's goal tolerance defaults
 
@@ -31,8 +34,7 @@ class PlanningSettings:
     _world: World
 
     def __init__(self) -> None:
-        # What the setters set; the rest is the robot config's, as MoveIt's move_group gives it.
-        self._motion = MotionSettings(planning_time=PLANNING_TIME_S)
+        self._motion = MotionSettings()  # what the setters set
         self._tolerances = dict(_TOLERANCES)
 
     def get_goal_tolerance(self) -> tuple[float, float, float]:
@@ -69,7 +71,7 @@ class PlanningSettings:
 
     def get_planning_time(self) -> float:
         """Return the time a plan may search, in [s] (default 5, MoveIt's)."""
-        return float(self._motion.planning_time or PLANNING_TIME_S)
+        return self._resolved().planning_time
 
     def set_planning_time(self, seconds: float) -> None:
         """Set the time a plan may search, in [s]; return None."""
@@ -78,7 +80,7 @@ class PlanningSettings:
 
     def get_planner_id(self) -> str:
         """Return the planner set, or the robot config's when none was."""
-        return self._motion.planner or str(self._world.config.planning["planner"])
+        return self._resolved().planner
 
     def set_planner_id(self, planner_id: str) -> None:
         """Plan with an OMPL geometric planner ("RRTConnect"; MoveIt's "RRTConnectkConfigDefault" too); return None.
@@ -109,13 +111,17 @@ class PlanningSettings:
                                acceleration_scaling=_scaling(value, "set_max_acceleration_scaling_factor"))
 
     def _settings(self) -> MotionSettings:
-        """Return the settings a motion is planned with now (None: the robot config's)."""
-        return self._motion
+        """Return the settings a motion is planned with now: the setters' over MoveIt's (None: the robot config's)."""
+        return layered(self._motion, _MOVEIT_DEFAULTS)
+
+    def _resolved(self) -> Resolved:
+        """Return the settings a motion is planned with now, each one decided."""
+        return resolved(self._settings(), defaults=self._world.config.motion)
 
 
 def _scaling(value: Any, where: str) -> float:
     """Return a scaling factor checked to lie in [MIN_SCALING, 1], else raise UsageError naming `where`."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not MIN_SCALING <= float(value) <= 1.0:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not is_scaling(float(value)):
         raise UsageError(f"{where}: expected a value in the range from {MIN_SCALING:g} to 1 for scaling factor, "
                          f"got {value!r}")
     return float(value)

@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from .joint_units import check_joint_units
     from .limits import DEFAULT_ACCELERATION, JointLimit
     from .meshes import mesh_file
-    from .motion import MotionSettings, Resolved, layered, resolved
+    from .motion import MIN_SCALING, MotionSettings, Resolved, is_planning_time, is_scaling, layered, resolved
     from .moveit_request import MotionPlanRequest, PositionGoal, load_motion_plan_request
     from .planners import PLANNERS
     from .planning_scene_yaml import PLANNING_SCENE_KEYS, FixedTransform, PlanningSceneFile, parse_planning_scene
@@ -41,7 +41,7 @@ if TYPE_CHECKING:
     from .scene_yaml import SceneFile, check_shape_count, first_repeated, parse_scene
     from .sources import CONFIG_FILE
     from .srdf import Group
-    from .tasks import MAX_SEED, MIN_SCALING, StepSpec, TaskFile, load_task
+    from .tasks import MAX_SEED, StepSpec, TaskFile, load_task
     from .xacro import PackagePath, parse_xacro_args
 
 __all__ = [
@@ -87,6 +87,8 @@ __all__ = [
     "default_controller",
     "expression",
     "first_repeated",
+    "is_planning_time",
+    "is_scaling",
     "layered",
     "load_motion_plan_request",
     "load_robot_config",
@@ -122,7 +124,7 @@ __getattr__ = lazy_exports(__name__, {
     "JointLimit": "limits",
     "MAX_MAGNITUDE": "fields",
     "MAX_SEED": "tasks",
-    "MIN_SCALING": "tasks",
+    "MIN_SCALING": "motion",
     "MotionPlanRequest": "moveit_request",
     "MotionSettings": "motion",
     "NamedGoal": "goals",
@@ -152,6 +154,8 @@ __getattr__ = lazy_exports(__name__, {
     "default_controller": "controllers",
     "expression": "fields",
     "first_repeated": "scene_yaml",
+    "is_planning_time": "motion",
+    "is_scaling": "motion",
     "layered": "motion",
     "load_motion_plan_request": "moveit_request",
     "load_robot_config": "robot_config",

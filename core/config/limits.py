@@ -11,7 +11,7 @@ from typing import Any
 from ..errors import ConfigError
 from ._urdf import MOVABLE_JOINT_TYPES, UrdfJoint
 from .fields import MAX_MAGNITUDE, boolean, check_keys, load_yaml, mapping, number
-from .tasks import MIN_SCALING
+from .motion import MIN_SCALING, is_scaling
 
 __all__ = ["DEFAULT_ACCELERATION", "DEFAULT_SOURCE", "JointLimit", "merge_limits", "parse_joint_limits"]
 
@@ -68,7 +68,7 @@ def parse_joint_limits(path: Path | None) -> tuple[dict[str, dict[str, Any]], fl
     scales = []
     for key in ("default_velocity_scaling_factor", "default_acceleration_scaling_factor"):
         value = number(top.get(key, _DEFAULT_SCALING), f"{path}: {key}", positive=True)
-        if not MIN_SCALING <= value <= 1.0:
+        if not is_scaling(value):
             raise ConfigError(f"{path}: {key}: expected a number in [{MIN_SCALING:g}, 1], got {value:g} "
                               "(the bounds of --velocity-scaling and --acceleration-scaling)")
         scales.append(value)

@@ -42,11 +42,11 @@ from ..errors import ConfigError, known
 from .collision_objects import attached_object
 from .fields import MAX_MAGNITUDE, check_keys, coordinate, load_yaml, mapping, number, read_input
 from .goals import JointGoal, PoseGoal
-from .motion import MotionSettings
+from .motion import MIN_SCALING, MotionSettings
 from .planners import PLANNERS
 from .poses import pose_matrix
 from .ros_messages import header_frame, point, pose, quaternion, robot_state, yaml_list
-from .tasks import MIN_SCALING, StepSpec
+from .tasks import StepSpec
 
 __all__ = ["MAX_ATTEMPTS", "MotionPlanRequest", "PositionGoal", "load_motion_plan_request", "planner_name"]
 

@@ -58,14 +58,16 @@ class RobotConfig:
         srdf: Parsed SRDF; `srdf_path` its file.
         limits: Merged limits of every movable URDF joint; an acceleration limit the config
             does not give is limits.DEFAULT_ACCELERATION, its source limits.DEFAULT_SOURCE.
-        default_velocity_scaling, default_acceleration_scaling: From joint_limits.yaml (MoveIt: 0.1).
+        motion: What a motion is planned with where nothing else says: `planning`'s planner and
+            planning time, joint_limits.yaml's default scalings (MoveIt: 0.1).
         controllers: JointTrajectoryControllers from ros2_controllers.yaml.
         execution: MoveIt's trajectory_execution settings.
         initial_positions: Where every movable joint starts when no start is given (joint ->
             value): the URDF's <ros2_control> initial values (where mock hardware starts), else
             initial_positions.yaml, else MoveIt's default state (initial_state.py).
         planning: moveplan.yaml `planning` defaults: group, planner, planning_time, and
-            collision (`exact`: the URDF's meshes; `convex`: their convex hulls).
+            collision (`exact`: the URDF's meshes; `convex`: their convex hulls), as a
+            generated moveplan.yaml writes them; a motion's settings are read from `motion`.
         files: File name -> bytes of every config file, to embed in plan files; laid out in
             one folder they load again as this config (expanded URDF, generated moveplan.yaml).
         package_paths: Folders searched for `$(find pkg)` and `package://` URIs, in order.
@@ -86,8 +88,7 @@ class RobotConfig:
     srdf_path: Path
     srdf: Srdf
     limits: dict[str, JointLimit]
-    default_velocity_scaling: float
-    default_acceleration_scaling: float
+    motion: Resolved
     controllers: dict[str, ControllerConfig]
     execution: ExecutionConfig
     initial_positions: dict[str, float]
@@ -99,12 +100,6 @@ class RobotConfig:
     kinematics: dict[str, dict[str, Any]] = field(default_factory=dict)
     xacro_args: dict[str, str] = field(default_factory=dict)
     initial_sources: dict[str, str] = field(default_factory=dict)
-
-    @property
-    def motion_defaults(self) -> Resolved:
-        """Return what a motion is planned with where nothing else says: moveplan.yaml's planner and time, scalings."""
-        return Resolved(self.planning["planner"], self.planning["planning_time"], self.default_velocity_scaling,
-                        self.default_acceleration_scaling)
 
     def group(self, name: str | None = None) -> Group:
         """Return the named planning group, or the config's default one."""
@@ -222,8 +217,7 @@ def load_robot_config(
         srdf_path=paths["srdf"],
         srdf=model.srdf,
         limits=limits,
-        default_velocity_scaling=v_scale,
-        default_acceleration_scaling=a_scale,
+        motion=Resolved(planning["planner"], planning["planning_time"], v_scale, a_scale),
         controllers=controllers,
         execution=execution,
         initial_positions=initial.positions,

@@ -7,7 +7,7 @@ relative to the task file; its robot may also be a shipped config's bare name.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
@@ -24,11 +24,11 @@ from .fields import (
     read_input,
 )
 from .goals import GOAL_KINDS, SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
-from .motion import MotionSettings
+from .motion import MIN_SCALING, MotionSettings, is_scaling
 from .sources import shipped_config
 
 __all__ = [
-    "GOAL_KINDS", "MIN_SCALING", "SHIFT_AXES", "StepSpec", "TaskFile", "load_task", "parse_goal", "parse_pose",
+    "GOAL_KINDS", "SHIFT_AXES", "StepSpec", "TaskFile", "load_task", "parse_goal", "parse_pose",
     "parse_scaling", "parse_shift",
 ]
 
@@ -36,7 +36,7 @@ MAX_SEED = 2**32 - 1
 """Largest seed: OMPL's random generator takes 32-bit seeds (cli/parsing.py has the same bound for --seed)."""
 
 _TASK_KEYS = {"robot", "scene", "group", "start", "defaults", "steps", "seed"}
-_DEFAULT_KEYS = {"velocity_scaling", "acceleration_scaling", "planner", "planning_time"}
+_DEFAULT_KEYS = {f.name for f in fields(MotionSettings)}
 _STEP_KEYS = {"name", "linear", "min_fraction", *GOAL_KINDS, *_DEFAULT_KEYS}
 _POSE_KEYS = {"frame", "xyz", "rpy", "quat", "link"}
 
@@ -71,15 +71,10 @@ class TaskFile:
     raw: bytes = field(default=b"", repr=False)
 
 
-# A motion slowed more than a thousandfold lasts hours for a radian, and the plan's /tf
-# samples and an execution's control cycles grow with it (1e-9 asked for terabytes): a typo.
-MIN_SCALING = 1e-3
-
-
 def parse_scaling(value: Any, where: str) -> float:
     """Return a velocity or acceleration scaling factor, checked to lie in [MIN_SCALING, 1]."""
     factor = number(value, where)
-    if not MIN_SCALING <= factor <= 1.0:
+    if not is_scaling(factor):
         raise ConfigError(f"{where}: expected a scaling factor in [{MIN_SCALING:g}, 1], got {value!r}")
     return factor
 

@@ -113,7 +113,7 @@ def plan_step(
 
 def _settings(spec: StepSpec, request: PlanRequest, robot: Robot) -> _Settings:
     """Return a step's planner, planning time, scaled limits and minimum fraction."""
-    motion = resolved(spec.motion, request.motion, defaults=robot.config.motion_defaults)
+    motion = resolved(spec.motion, request.motion, defaults=robot.config.motion)
     return _Settings(
         planner=motion.planner,
         planning_time=motion.planning_time,

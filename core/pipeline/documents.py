@@ -73,8 +73,8 @@ def robot_document(config: RobotConfig) -> dict[str, Any]:
             for group, states in config.srdf.group_states.items()
         },
         "frames": links,
-        "default_scaling": {"velocity": config.default_velocity_scaling,
-                            "acceleration": config.default_acceleration_scaling},
+        "default_scaling": {"velocity": config.motion.velocity_scaling,
+                            "acceleration": config.motion.acceleration_scaling},
         "controllers": {
             n: {"joints": list(c.joints), "update_rate": c.update_rate_hz,
                 "command_interfaces": list(c.command_interfaces), "state_interfaces": list(c.state_interfaces),

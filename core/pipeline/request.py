@@ -26,6 +26,8 @@ from ..config import (
     StartFrom,
     StepSpec,
     TaskFile,
+    is_planning_time,
+    is_scaling,
     layered,
     load_motion_plan_request,
     load_robot_config,
@@ -39,7 +41,7 @@ _T = TypeVar("_T")
 
 def check_planning_time(seconds: float, flag: str = "--planning-time") -> float:
     """Return `seconds` if it is a positive, finite planning time of at most MAX_MAGNITUDE, else raise UsageError."""
-    if not 0 < seconds <= MAX_MAGNITUDE:  # NaN too: it compares false
+    if not is_planning_time(seconds):
         raise UsageError(f"{flag}: expected a positive number of seconds up to {MAX_MAGNITUDE:g}, got {seconds:g}")
     return seconds
 
@@ -147,7 +149,7 @@ class PlanFlags:
             check_planning_time(self.timeout, "--timeout")
         for name in ("velocity_scaling", "acceleration_scaling"):
             factor = getattr(self.motion, name)
-            if factor is not None and not MIN_SCALING <= factor <= 1.0:
+            if factor is not None and not is_scaling(factor):
                 raise UsageError(f"{_flag(name)}: expected a factor in [{MIN_SCALING:g}, 1], got {factor:g}")
 
     @property

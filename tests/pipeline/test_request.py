@@ -8,7 +8,7 @@ import pytest
 from conftest import ROOT
 
 from moveplan.core.config.goals import JointGoal, NamedGoal, PoseGoal, ShiftGoal, StartFrom
-from moveplan.core.config.motion import MotionSettings, Resolved, layered, resolved
+from moveplan.core.config.motion import MotionSettings, Resolved, is_planning_time, is_scaling, layered, resolved
 from moveplan.core.config.tasks import StepSpec, load_task
 from moveplan.core.errors import UsageError
 from moveplan.core.pipeline.request import PlanFlags, check_planning_time, resolve_request
@@ -131,6 +131,11 @@ def test_one_rule_layers_the_motion_settings_each_from_the_first_place_that_sets
     defaults = Resolved("RRTConnect", 1.0, 0.2, 0.3)
     assert resolved(step, flags, task, defaults=defaults) == Resolved("PRM", 3.0, 0.1, 0.3)
     assert resolved(defaults=defaults) == defaults
+
+
+def test_one_rule_says_which_scalings_and_planning_times_a_motion_is_planned_with() -> None:
+    assert [is_scaling(f) for f in (1e-3, 1.0, 9e-4, 1.01, float("nan"))] == [True, True, False, False, False]
+    assert [is_planning_time(t) for t in (1e-9, 1e6, 0.0, 1.1e6, float("nan"))] == [True, True, False, False, False]
 
 
 def test_a_steps_own_scaling_wins_over_the_tasks_defaults(tmp_path: Path) -> None:
