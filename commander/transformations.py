@@ -17,6 +17,7 @@ import numpy.typing as npt
 from numpy.typing import NDArray
 
 from ..core.errors import UsageError
+from ..core.rotations import MIN_QUATERNION_NORM
 
 __all__ = [
     "euler_from_quaternion", "euler_matrix", "quaternion_from_euler", "quaternion_from_matrix", "quaternion_matrix",
@@ -68,7 +69,7 @@ def quaternion_matrix(quaternion: Sequence[float]) -> NDArray[np.float64]:
     """
     q = np.asarray(quaternion, dtype=float)
     norm = float(np.linalg.norm(q)) if q.shape == (4,) else 0.0
-    if not math.isfinite(norm) or norm < 1e-9:
+    if not math.isfinite(norm) or norm < MIN_QUATERNION_NORM:
         raise UsageError(f"quaternion {list(np.ravel(q))}: expected [x, y, z, w] of nonzero finite norm")
     x, y, z, w = q / norm
     matrix = np.eye(4)

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 __all__ = [
     "MIN_QUATERNION_NORM", "matrix_from_quaternion", "matrix_from_rpy", "matrix_from_rotation_vector",
-    "quaternion_from_matrix", "quaternions_xyzw", "rotation_vector", "rpy_from_matrix",
+    "quaternion_from_matrix", "quaternions_xyzw", "rotation_angle", "rotation_vector", "rpy_from_matrix",
 ]
 
 MIN_QUATERNION_NORM = 1e-9
@@ -75,6 +75,12 @@ def rotation_vector(rotation: NDArray[np.float64]) -> NDArray[np.float64]:
 
     vector: NDArray[np.float64] = pin.log3(rotation)
     return vector
+
+
+def rotation_angle(rotation: NDArray[np.float64]) -> float:
+    """Return the angle in [rad], in [0, pi], a rotation turns about its axis."""
+    # The trace's rounding can step outside [-1, 1] near 0 and pi.
+    return float(np.arccos(np.clip((np.trace(rotation) - 1.0) / 2.0, -1.0, 1.0)))
 
 
 def matrix_from_rotation_vector(vector: NDArray[np.float64]) -> NDArray[np.float64]:

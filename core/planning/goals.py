@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 from ..config import JointGoal, NamedGoal, PoseGoal, PositionGoal, ShiftGoal, pose_matrix
 from ..errors import ConfigError, GoalOutsideLimits, OutsideLimits, UnknownName, UsageError
 from ..model import Robot, Scene, solve_ik
-from ..rotations import matrix_from_rpy, rpy_from_matrix
+from ..rotations import matrix_from_rpy, rotation_angle, rpy_from_matrix
 
 __all__ = [
     "check_limits", "joint_target", "named_state", "orientation_tolerance", "pose_error", "tip_target",
@@ -144,6 +144,5 @@ def _shifted(robot: Robot, scene: Scene, shift: ShiftGoal, q: NDArray[np.float64
 
 def pose_error(reached: NDArray[np.float64], target: NDArray[np.float64]) -> tuple[float, float]:
     """Return the distance in [m] and rotation angle in [rad] between two poses."""
-    rotation = reached[:3, :3].T @ target[:3, :3]
-    angle = float(np.arccos(np.clip((np.trace(rotation) - 1.0) / 2.0, -1.0, 1.0)))
+    angle = rotation_angle(reached[:3, :3].T @ target[:3, :3])
     return float(np.linalg.norm(reached[:3, 3] - target[:3, 3])), angle

@@ -14,6 +14,7 @@ from moveplan.core.rotations import (
     matrix_from_rpy,
     quaternion_from_matrix,
     quaternions_xyzw,
+    rotation_angle,
     rotation_vector,
     rpy_from_matrix,
 )
@@ -27,6 +28,14 @@ def test_rpy_is_about_the_fixed_axes_yaw_last_as_urdf_and_tf() -> None:
     np.testing.assert_allclose(rotation @ [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], atol=1e-15)
     np.testing.assert_allclose(rotation, transformations.euler_matrix(math.pi / 2, 0.0, math.pi / 2)[:3, :3],
                                atol=1e-15)
+
+
+def test_a_known_rpy_gives_the_known_matrix_and_ros_quaternion() -> None:
+    # Roll then yaw a quarter turn each: x goes to y, y to z, z to x, a third of a turn about (1, 1, 1).
+    rotation = matrix_from_rpy(math.pi / 2, 0.0, math.pi / 2)
+    np.testing.assert_allclose(rotation, [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], atol=1e-15)
+    np.testing.assert_allclose(quaternion_from_matrix(rotation), (0.5, 0.5, 0.5, 0.5), atol=1e-15)
+    np.testing.assert_allclose(rotation_angle(rotation), 2 * math.pi / 3, atol=1e-15)
 
 
 def test_a_known_rotation_has_the_ros_quaternion_with_w_first_positive() -> None:
@@ -46,6 +55,7 @@ def test_round_trips_and_the_vectorised_path_agree() -> None:
         np.testing.assert_allclose(rpy_from_matrix(rotation), (roll, pitch, yaw), atol=1e-12)
         np.testing.assert_allclose(matrix_from_quaternion(quaternion_from_matrix(rotation)), rotation, atol=1e-12)
         np.testing.assert_allclose(matrix_from_rotation_vector(rotation_vector(rotation)), rotation, atol=1e-12)
+        assert rotation_angle(rotation) == pytest.approx(float(np.linalg.norm(rotation_vector(rotation))), abs=1e-7)
         transforms[k, :3, :3] = rotation
     one_by_one = np.array([quaternion_from_matrix(t[:3, :3]) for t in transforms])
     np.testing.assert_allclose(quaternions_xyzw(transforms), one_by_one, atol=1e-12)
