@@ -383,9 +383,9 @@ class RobotState:
         """Return the state `as_dict` gave (KeyError, TypeError or ValueError if it is not one)."""
         pose = document["pose"]
         position, quaternion, rpy = (tuple(float(v) for v in pose[key]) for key in ("position", "quaternion", "rpy"))
-        if (len(position), len(quaternion), len(rpy)) != (3, 4, 3):
+        if len(position) != 3 or len(quaternion) != 4 or len(rpy) != 3:
             raise ValueError("a pose has 3 position, 4 quaternion and 3 rpy values")
-        link_pose = LinkPose(str(pose["link"]), str(pose["frame"]), position, quaternion, rpy)  # type: ignore[arg-type]
+        link_pose = LinkPose(str(pose["link"]), str(pose["frame"]), position, quaternion, rpy)
         return cls({str(j): float(v) for j, v in document["joints"].items()}, link_pose, prismatic)
 
 

@@ -51,7 +51,8 @@ def _joint_kind(model: pin.Model, jid: int) -> tuple[int, tuple[float, float, fl
     joint = model.joints[jid]
     if name in ("RevoluteUnaligned", "RevoluteUnboundedUnaligned", "PrismaticUnaligned"):
         kind = {"RevoluteUnaligned": _REVOLUTE, "RevoluteUnboundedUnaligned": _UNBOUNDED}.get(name, _PRISMATIC)
-        return kind, tuple(float(v) for v in np.asarray(joint.extract().axis))  # type: ignore[return-value]
+        x, y, z = (float(v) for v in np.asarray(joint.extract().axis))
+        return kind, (x, y, z)
     raise UnsupportedJoint(f"joint '{model.names[jid]}' ({name}) is not handled by the sphere filter")
 
 

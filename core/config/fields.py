@@ -76,7 +76,7 @@ values, which costs ~50 times more: a 200,000-shape scene is refused in a second
 _ROS_FLOAT = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$")
 
 
-class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: ignore[misc]
+class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: ignore[misc]  # a base chosen at import
     """PyYAML's safe loader, reading numbers with an exponent as ROS does.
 
     libyaml's where PyYAML has it: it reads a MotionBenchMaker scene 10x faster.

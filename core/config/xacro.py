@@ -193,8 +193,8 @@ def _find_through(packages: PackagePath) -> Iterator[None]:
 
 def _cause(exc: BaseException) -> BaseException:
     """Return the innermost exception xacro wrapped (it wraps ours in XacroException.exc)."""
-    while isinstance(getattr(exc, "exc", None), BaseException):
-        exc = exc.exc  # type: ignore[attr-defined]
+    while isinstance(inner := getattr(exc, "exc", None), BaseException):
+        exc = inner
     return exc
 
 

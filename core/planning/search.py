@@ -280,7 +280,7 @@ def _checked_by(
     return info
 
 
-class _EdgeValidator(ob.MotionValidator):  # type: ignore[misc]
+class _EdgeValidator(ob.MotionValidator):  # type: ignore[misc]  # ompl ships no stubs
     """Checks a whole edge in one call of `edge_free`."""
 
     def __init__(self, info: ob.SpaceInformation, edge_free: Callable[[ob.State, ob.State], bool]) -> None:

@@ -153,6 +153,7 @@ def _records(path: Path, stream: IO[bytes]) -> Iterator[McapRecord]:
     size = stream.seek(0, os.SEEK_END)
     stream.seek(0)
     # No record is longer than the file: a length beyond it is damage, never a read of that size.
+    # mcap's annotation asks for IO[bytes]; it only reads, seeks and tells.
     records = StreamReader(ClampedReads(stream, size), validate_crcs=True,  # type: ignore[arg-type]
                            record_size_limit=size).records
     while True:

@@ -78,7 +78,7 @@ def verify_mcap(path: Path, stream: IO[bytes], size: int, skips: Skips) -> Verif
                     if len(raw) < total:
                         raw = bytearray(total)
                     stream.seek(record.position)
-                    stream.readinto(memoryview(raw)[:total])  # type: ignore[attr-defined]
+                    stream.readinto(memoryview(raw)[:total])  # type: ignore[attr-defined]  # IO omits it; files have it
                     # To size the buffer; chunk_records refuses a chunk too short to declare a size.
                     declared = struct.unpack_from("<Q", raw, RECORD_HEAD + 16)[0] if total >= RECORD_HEAD + 24 else 0
                     if len(out) < declared <= codecs.limit:

@@ -141,6 +141,7 @@ def _summary_from_index(stream: IO[bytes], lost: dict[int, int]) -> BagSummary |
     stream.seek(0)
     try:
         # Reads clamped to the file: a damaged record length is never a read (an allocation) of that size.
+        # mcap's annotation asks for IO[bytes]; it only reads, seeks and tells.
         reader = SeekingReader(ClampedReads(stream, size), record_size_limit=size)  # type: ignore[arg-type]
         header = reader.get_header()
         summary = reader.get_summary()
