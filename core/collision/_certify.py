@@ -37,9 +37,10 @@ MAX_STATES = 2_000_000
 
 
 def reach(robot: Robot, geometry: pin.GeometryModel) -> NDArray[np.float64]:
-    """Return per group joint the largest distance [m] from its axis origin to any robot collision point.
+    """Return per group joint the largest distance [m] any robot collision point moves per unit of the joint.
 
-    For a prismatic joint the answer is 1: a point moves as far as the joint.
+    For a prismatic joint the answer is 1: a point moves as far as the joint. A joint's mimic
+    joints add what they move.
     """
     model = robot.model
     extent = np.zeros(model.njoints)  # per joint: farthest point of the shapes it carries
@@ -59,10 +60,13 @@ def reach(robot: Robot, geometry: pin.GeometryModel) -> NDArray[np.float64]:
         if parent > 0:
             offset = np.linalg.norm(model.jointPlacements[jid].translation) + travel[jid]
             below[parent] = max(below[parent], offset + below[jid])
-    out = []
-    for name in robot.joint_names:
-        jid = model.getJointId(name)
-        out.append(1.0 if is_prismatic(model.joints[jid].shortname()) else below[jid])
+    def moves(jid: int) -> float:
+        return 1.0 if is_prismatic(model.joints[jid].shortname()) else float(below[jid])
+
+    out = [moves(model.getJointId(name)) for name in robot.joint_names]
+    # A leader moving by d moves its mimic joints by multiplier * d, and every point below them with it.
+    for mimic in robot.mimics:
+        out[mimic.leader] += abs(mimic.multiplier) * moves(model.getJointId(mimic.joint))
     worst = int(np.argmax(out))
     if not out[worst] <= MAX_REACH_M:
         raise ConfigError(f"{robot.config.urdf_path}: joint '{robot.joint_names[worst]}' carries collision geometry "

@@ -10,7 +10,7 @@ from typing import Any
 import numba
 import numpy as np
 
-from ._kernels import _inside, apart, forward, gap, place, place_owner, tabled, unpack
+from ._kernels import _inside, apart, forward, gap, place, place_owner, set_mimics, tabled, unpack
 from ._verdicts import CLEAR
 
 __all__ = ["certify", "clearance"]
@@ -36,7 +36,7 @@ def clearance(q: Any, model: Any, cap: float, scratch: Any) -> tuple[int, float]
     COLLIDES if an inner ball proves it, else MAYBE.
     """
     rot, pos, world, iworld, owc, local, placed = scratch
-    _, joints, spheres, owners, _, pairs, obstacles, check = model
+    _, joints, spheres, owners, _, pairs, obstacles, check, _ = model
     centres, radii, sjoint, start = spheres
     ojoint, ocentre, oradius = owners
     okind, opos, orot, osize, _, oball = obstacles
@@ -103,6 +103,7 @@ def certify(values: Any, travel: Any, cap: float, floats: Any, ints: Any, head: 
                 q[group[i] + 1] = np.sin(values[k, i])
             else:
                 q[group[i]] = values[k, i]
+        set_mimics(q, values[k], model[8])
         out[k] = tabled(q, tables)
         if out[k] != CLEAR or travel[k] < covered:
             continue

@@ -161,6 +161,14 @@ def balls_touch(world: Any, radii: Any, a: Any, b: Any, strict: bool) -> bool:
 
 
 @numba.njit(cache=True)
+def set_mimics(q: Any, values: Any, mimic: Any) -> None:
+    """Set each mimic joint of `q` from its leader's group value (core/model/robot.py's Mimic)."""
+    index, leader, scale, offset = mimic
+    for m in range(len(index)):
+        q[index[m]] = scale[m] * values[leader[m]] + offset[m]
+
+
+@numba.njit(cache=True)
 def judge(values: Any, stop: bool, base: Any, group: Any, continuous: Any, model: Any, qs: Any, out: Any) -> int:
     """Write per group state (rows of `values`) its configuration into `qs` and its verdict into `out`.
 
@@ -169,7 +177,7 @@ def judge(values: Any, stop: bool, base: Any, group: Any, continuous: Any, model
     the model each time, which costs more than the judging. Measured: moving its stages into
     @njit helpers, inlined by numba or not, makes classify and edge 9-29 % slower.
     """
-    tables, joints, spheres, owners, inner, pairs, obstacles, check = model
+    tables, joints, spheres, owners, inner, pairs, obstacles, check, mimic = model
     centres, radii, sjoint, start = spheres
     ojoint, ocentre, oradius = owners
     okind, opos, orot, osize, _, oball = obstacles
@@ -188,6 +196,7 @@ def judge(values: Any, stop: bool, base: Any, group: Any, continuous: Any, model
                 q[group[i] + 1] = np.sin(values[k, i])
             else:
                 q[group[i]] = values[k, i]
+        set_mimics(q, values[k], mimic)
         verdict = tabled(q, tables)
         if verdict != CLEAR:
             out[k] = verdict
@@ -245,7 +254,7 @@ def judge(values: Any, stop: bool, base: Any, group: Any, continuous: Any, model
 @numba.njit(cache=True, inline="always")
 def _inside(model: Any, rot: Any, pos: Any, iworld: Any, owc: Any) -> int:
     """Return COLLIDES if a ball inside a hull touches an obstacle or another owner's inner ball, else MAYBE."""
-    _, _, _, owners, inner, pairs, obstacles, check = model
+    _, _, _, owners, inner, pairs, obstacles, check, _ = model
     _, _, oradius = owners
     icentres, iradii, ijoint, istart = inner
     okind, opos, orot, osize, osolid, oball = obstacles
@@ -336,6 +345,7 @@ LAYOUT = (
     ("pairs", 2, True),
     ("okind", 1, True), ("opos", 2, False), ("orot", 3, False), ("osize", 2, False), ("osolid", 1, True),
     ("check", 2, True), ("oball", 1, False),
+    ("mimic_q", 1, True), ("mimic_leader", 1, True), ("mimic_scale", 1, False), ("mimic_offset", 1, False),
 )
 
 
@@ -382,5 +392,6 @@ def unpack(f: Any, i: Any, h: Any) -> Any:
     owners = (_1d(i, h[20]), _2d(f, h[21]), _1d(f, h[22]))
     inner = (_2d(f, h[23]), _1d(f, h[24]), _1d(i, h[25]), _1d(i, h[26]))
     obstacles = (_1d(i, h[28]), _2d(f, h[29]), _3d(f, h[30]), _2d(f, h[31]), _1d(i, h[32]), _1d(f, h[34]))
-    model = (tables, joints, spheres, owners, inner, _2d(i, h[27]), obstacles, _2d(i, h[33]))
+    mimic = (_1d(i, h[35]), _1d(i, h[36]), _1d(f, h[37]), _1d(f, h[38]))
+    model = (tables, joints, spheres, owners, inner, _2d(i, h[27]), obstacles, _2d(i, h[33]), mimic)
     return _1d(f, h[0]), _1d(i, h[1]), _1d(i, h[2]), model

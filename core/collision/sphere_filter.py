@@ -104,7 +104,8 @@ class SphereFilter:
             "base": base, "group": robot.q_index, "continuous": robot.continuous, **_table_arrays(tables), **joints,
             "centres": spheres.centre, "radii": spheres.radius, "sjoint": spheres.joint, "start": spheres.start,
             "ojoint": owner_joint, "ocentre": owner_centre, "oradius": owner_radius,
-            **_inner_arrays(inner, names), "pairs": np.reshape(pairs, (-1, 2)), **_obstacles(world), "check": check})
+            **_inner_arrays(inner, names), "pairs": np.reshape(pairs, (-1, 2)), **_obstacles(world), "check": check,
+            **_mimic_arrays(robot)})
         self._nq = model.nq
         # Reused by every `edge` call: returning fresh arrays from compiled code costs more than judging a state.
         self._verdicts, self._unclear = np.empty(64, dtype=np.int8), np.empty((64, model.nq))
@@ -349,3 +350,9 @@ def _obstacles(world: list[CollisionObject]) -> dict[str, NDArray[Any]]:
             "osize": np.array(sizes, dtype=float).reshape(count, 3), "osolid": np.array(solid, dtype=np.bool_),
             "oball": np.array(balls, dtype=float)}
 
+
+def _mimic_arrays(robot: Robot) -> dict[str, Any]:
+    """Return the kernels' arrays of the joints that follow a group joint (core/model/robot.py's Mimic)."""
+    mimics = robot.mimics
+    return {"mimic_q": [m.q_index for m in mimics], "mimic_leader": [m.leader for m in mimics],
+            "mimic_scale": [m.multiplier for m in mimics], "mimic_offset": [m.offset for m in mimics]}

@@ -7,7 +7,9 @@ Each movable joint takes the first of:
    ros2_control's mock_components/GenericSystem starts;
 2. initial_positions.yaml, which a MoveIt config's xacro normally feeds into those initial
    values: it speaks for a URDF without them;
-3. MoveIt's default state (RobotState::setToDefaultValues): 0 where the joint's limits allow
+3. a MoveIt 1 config's fake_controllers.yaml `initial:` list (group and SRDF named state, in
+   order), where MoveIt 1's fake controllers start the robot;
+4. MoveIt's default state (RobotState::setToDefaultValues): 0 where the joint's limits allow
    it, else the middle of its range.
 
 The URDF wins over initial_positions.yaml because it is what the hardware reads; where the two
@@ -29,8 +31,8 @@ from ._urdf import UrdfJoint, xml_root
 from .fields import MAX_MAGNITUDE, coordinate, load_yaml, mapping
 from .limits import JointLimit
 
-__all__ = ["DEFAULT_STATE", "InitialState", "default_position", "initial_state", "parse_initial_positions",
-           "ros2_control_initial_positions"]
+__all__ = ["DEFAULT_STATE", "InitialState", "default_position", "fake_controllers_initial", "initial_state",
+           "parse_initial_positions", "ros2_control_initial_positions"]
 
 logger = logging.getLogger(__name__)
 
@@ -62,8 +64,12 @@ def initial_state(
     joints: dict[str, UrdfJoint],
     limits: dict[str, JointLimit],
     positions_path: Path | None,
+    named: tuple[dict[str, float], Path] | None = None,
 ) -> InitialState:
-    """Return where every movable joint starts (see the module's precedence), with the source of each value."""
+    """Return where every movable joint starts (see the module's precedence), with the source of each value.
+
+    `named` is fake_controllers_initial's joint values and the file they come from.
+    """
     hardware = ros2_control_initial_positions(urdf_text, urdf_path)
     from_file = parse_initial_positions(positions_path, limits) if positions_path is not None else {}
     _warn_disagreements(hardware, from_file, urdf_path, positions_path)
@@ -74,6 +80,8 @@ def initial_state(
             positions[name], sources[name] = hardware[name], f"the <ros2_control> initial_value in {urdf_path}"
         elif name in from_file:
             positions[name], sources[name] = from_file[name], str(positions_path)
+        elif named is not None and name in named[0]:
+            positions[name], sources[name] = named[0][name], f"the initial poses of {named[1]}"
         else:
             positions[name], sources[name] = default_position(limit), DEFAULT_STATE
     for name in limits:
@@ -141,6 +149,29 @@ def parse_initial_positions(path: Path, limits: dict[str, JointLimit]) -> dict[s
             raise UnknownName("joint", joint, f"{path}: initial_positions", limits)
         result[joint] = coordinate(value, f"{path}: initial_positions.{joint}")
     return result
+
+
+def fake_controllers_initial(path: Path, group_states: dict[str, dict[str, dict[str, float]]],
+                             limits: dict[str, JointLimit]) -> dict[str, float]:
+    """Return joint -> value of a MoveIt 1 fake_controllers.yaml's `initial:` poses (SRDF named states, in order).
+
+    Raises:
+        ConfigError: An entry that is no {group, pose} mapping; UnknownName: a group or pose the SRDF lacks.
+    """
+    top = mapping(load_yaml(path), str(path))
+    entries = top.get("initial") or []
+    if not isinstance(entries, list):
+        raise ConfigError(f"{path}: initial: expected a list of {{group: ..., pose: ...}}, got {entries!r}")
+    values: dict[str, float] = {}
+    for k, entry in enumerate(entries):
+        item = mapping(entry, f"{path}: initial[{k}]")
+        group, pose = str(item.get("group", "")), str(item.get("pose", ""))
+        if group not in group_states:
+            raise UnknownName("group with named states", group, f"{path}: initial[{k}].group", group_states)
+        if pose not in group_states[group]:
+            raise UnknownName("named state", pose, f"{path}: initial[{k}].pose", group_states[group])
+        values.update({j: v for j, v in group_states[group][pose].items() if j in limits})
+    return values
 
 
 def _initial_position_text(joint: ET.Element) -> str:

@@ -20,7 +20,7 @@ from typing import Any
 
 from ..errors import ConfigError, UnknownName
 from ._descriptions import check_xacro_args, expand, file_xacro_args
-from ._initial_state import initial_state
+from ._initial_state import fake_controllers_initial, initial_state
 from ._settings import parse_kinematics, planning_defaults
 from ._substitutions import read_substituted
 from ._urdf import CollisionMesh, UrdfJoint, parse_urdf, resolve_collision_meshes
@@ -78,6 +78,7 @@ class RobotConfig:
         kinematics: kinematics.yaml's settings per group (reported; moveplan solves IK itself).
         xacro_args: The xacro args the URDF and SRDF were expanded with.
         initial_sources: Joint -> where its initial position comes from (initial_state.py).
+        srdf_text: The SRDF as read (xacro expanded): what MoveIt holds as robot_description_semantic.
     """
 
     name: str
@@ -100,6 +101,7 @@ class RobotConfig:
     kinematics: dict[str, dict[str, Any]] = field(default_factory=dict)
     xacro_args: dict[str, str] = field(default_factory=dict)
     initial_sources: dict[str, str] = field(default_factory=dict)
+    srdf_text: str = ""
 
     def group(self, name: str | None = None) -> Group:
         """Return the named planning group, or the config's default one."""
@@ -198,7 +200,10 @@ def load_robot_config(
     _check_controller_joints(controllers, model.urdf_joints, paths.get("controllers"))
     execution = (parse_execution(paths["moveit_controllers"], model.xacro_args, substitute=substitute)
                  if "moveit_controllers" in paths else ExecutionConfig())
-    initial = initial_state(model.urdf_text, paths["urdf"], model.urdf_joints, limits, paths.get("initial_positions"))
+    fake = paths.get("fake_controllers")
+    named = (fake_controllers_initial(fake, model.srdf.group_states, limits), fake) if fake else None
+    initial = initial_state(model.urdf_text, paths["urdf"], model.urdf_joints, limits, paths.get("initial_positions"),
+                            named)
     kinematics = parse_kinematics(paths["kinematics"], model.srdf) if "kinematics" in paths else {}
     planning, planning_source = planning_defaults(
         found.manifest, found.top, paths.get("ompl_planning"), model.srdf, paths["srdf"]
@@ -229,6 +234,7 @@ def load_robot_config(
         kinematics=kinematics,
         xacro_args=model.xacro_args,
         initial_sources=initial.sources,
+        srdf_text=model.srdf_text,
     )
     config.group()  # an unknown default group is a config error, found at load time
     return config

@@ -57,6 +57,7 @@ _PACKAGE_FILES = {
     "moveit_controllers": "moveit_controllers.yaml",
     "initial_positions": "initial_positions.yaml",
     "ompl_planning": "ompl_planning.yaml",
+    "fake_controllers": "fake_controllers.yaml",  # MoveIt 1: where its fake controllers start the robot
 }
 _SRDF_FOLDERS = ("config", "srdf", ".")
 _URDF_FOLDERS = ("config", "urdf", "robots", ".")

@@ -52,6 +52,8 @@ class Group:
             depth-first through the URDF tree.
         base_joints: Its floating and planar joints (joint -> type): a virtual joint that
             moves the whole robot, or URDF ones. moveplan does not plan them.
+        links: Its links, MoveIt's JointModelGroup link models: the child link of each of its
+            joints, fixed ones included, depth-first through the URDF tree.
     """
 
     name: str
@@ -59,6 +61,7 @@ class Group:
     base: str
     tip: str
     base_joints: dict[str, str] = field(default_factory=dict)
+    links: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -295,7 +298,8 @@ def _group(name: str, members: set[str], chain: tuple[str, str] | None, tree: _T
     base, tip = chain or ("", "")
     if not base and active:
         base, tip = tree.joints[active[0]].parent, tree.joints[active[-1]].child
-    return Group(name, active, base, tip, base_joints)
+    links = tuple(tree.joints[j].child for j in sorted(members & tree.joints.keys(), key=tree.order.__getitem__))
+    return Group(name, active, base, tip, base_joints, links)
 
 
 def _group_states(

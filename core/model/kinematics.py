@@ -238,6 +238,9 @@ class _Solver:
         self.v_index = np.array([model.idx_vs[i] for i in ids])
         self.q_index = np.array([model.idx_qs[i] for i in ids])
         self.any_continuous = bool(self.continuous.any())
+        # Joints that follow a group joint: set with it, and their Jacobian column added to its column.
+        self.mimics = [(m.leader, m.q_index, int(model.idx_vs[model.getJointId(m.joint)]), m.multiplier, m.offset)
+                       for m in robot.mimics]
         self.all_columns = model.nv == self.dof and bool(
             np.all(self.v_index == np.arange(self.dof)))
         revolute = np.array([model.joints[i].shortname().startswith("JointModelR") for i in ids])
@@ -251,7 +254,9 @@ class _Solver:
         self.cholesky = eigenpy.LLT(self.dof)
 
     def set_values(self, q: NDArray[np.float64], values: NDArray[np.float64]) -> None:
-        """Write group values into the full configuration `q` in place."""
+        """Write group values (and the mimic joints following them) into the full configuration `q` in place."""
+        for leader, index, _, multiplier, offset in self.mimics:
+            q[index] = multiplier * values[leader] + offset
         if not self.any_continuous:
             q[self.q_index] = values
             return
@@ -305,7 +310,9 @@ class _Solver:
             elif iteration - best_iteration >= _STALL_ITERATIONS:
                 break
             if not self.all_columns:
-                jacobian = jacobian[:, self.v_index]
+                full, jacobian = jacobian, jacobian[:, self.v_index]
+                for leader, _, column, multiplier, _ in self.mimics:
+                    jacobian[:, leader] += multiplier * full[:, column]
             np.dot(jacobian.T, jacobian, out=normal)
             diagonal += _DAMPING_SCALE * residual + _DAMPING_FLOOR
             cholesky.compute(normal)

@@ -2,7 +2,9 @@
 
 A robot state is a pinocchio configuration vector `q` (all joints); the planner
 works on the group's joint values (`values`, one per active joint, in [rad] or
-[m]). Joints outside the group keep their values from the start state.
+[m]). Joints outside the group keep their values from the start state. A mimic
+joint is not active: it follows its leader (value = multiplier * leader + offset)
+wherever the leader is set, as MoveIt's RobotState.updateMimicJoints does.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import os
 import sys
 import tempfile
 from collections.abc import Iterator
+from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
@@ -22,7 +25,18 @@ from ..config import Group, RobotConfig
 from ..errors import ConfigError, UnknownName
 from ..types import Frame, TfSamples
 
-__all__ = ["Robot"]
+__all__ = ["Mimic", "Robot"]
+
+
+@dataclass(frozen=True)
+class Mimic:
+    """A joint that follows one of the group's active joints: q[q_index] = multiplier * values[leader] + offset."""
+
+    joint: str
+    leader: int  # position of the leader in the group's values
+    q_index: int
+    multiplier: float
+    offset: float
 
 
 class Robot:
@@ -46,7 +60,10 @@ class Robot:
         if errors:
             raise ConfigError(f"{config.urdf_path}: urdfdom cannot read part of the URDF: {_joined(errors)}")
         self.data = self.model.createData()
-        self.joint_names: tuple[str, ...] = self.group.joints
+        joints = config.urdf_joints
+        # The group's variables (MoveIt's) include its mimic joints; its active joints, which are planned, do not.
+        self.variable_names: tuple[str, ...] = self.group.joints
+        self.joint_names: tuple[str, ...] = tuple(j for j in self.group.joints if not joints[j].mimic)
         if not self.joint_names:
             raise ConfigError(f"{config.srdf_path}: group '{self.group.name}' has no movable joints")
         _check_group(config, self.group)
@@ -59,6 +76,10 @@ class Robot:
         ids = [self.model.getJointId(j) for j in self.joint_names]
         self.q_index = np.array([self.model.idx_qs[i] for i in ids])
         self.link_names = tuple(f.name for f in self.model.frames if f.type == pin.FrameType.BODY)
+        self.mimics = tuple(
+            Mimic(j.name, self.joint_names.index(j.mimic), int(self.model.idx_qs[self.model.getJointId(j.name)]),
+                  j.mimic_multiplier, j.mimic_offset)
+            for j in joints.values() if j.mimic in self.joint_names and self.model.existJointName(j.name))
 
     @property
     def dof(self) -> int:
@@ -80,6 +101,8 @@ class Robot:
         # A continuous joint is stored by pinocchio as (cos, sin).
         q[self.q_index[self.continuous], :] = np.cos(values[:, self.continuous]).T
         q[self.q_index[self.continuous] + 1, :] = np.sin(values[:, self.continuous]).T
+        for mimic in self.mimics:
+            q[mimic.q_index, :] = mimic.multiplier * values[:, mimic.leader] + mimic.offset
         return q
 
     def values(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -150,24 +173,18 @@ class Robot:
 
 
 def _check_group(config: RobotConfig, group: Group) -> None:
-    """Raise ConfigError for a group joint moveplan cannot plan: a mimic or its leader, a joint that cannot move.
+    """Raise ConfigError for a group joint moveplan cannot plan: a continuous mimic pair, a joint that cannot move.
 
-    pinocchio ignores <mimic>: a planned motion would move a leader while its mimic stays put.
     A joint with lower == upper would divide by its zero range in the collision tables.
     """
     where = f"{config.urdf_path}: group '{group.name}'"
     for joint in config.urdf_joints.values():
-        if not joint.mimic:
-            continue
-        if joint.name in group.joints:
-            raise ConfigError(f"{where} has joint '{joint.name}', which mimics '{joint.mimic}'; "
-                              "mimic joints are not supported yet: plan with a group without them")
-        if joint.mimic in group.joints:
-            raise ConfigError(f"{where} moves joint '{joint.mimic}', which joint '{joint.name}' mimics; "
-                              "mimic joints are not supported yet: plan with a group without them")
+        if joint.mimic in group.joints and "continuous" in (joint.type, config.urdf_joints[joint.mimic].type):
+            raise ConfigError(f"{where}: joint '{joint.name}' mimics '{joint.mimic}' and one of them is "
+                              "continuous; moveplan follows a leader with revolute or prismatic joints only")
     for name in group.joints:
         limit = config.limits[name]
-        if not limit.continuous and limit.lower == limit.upper:
+        if not config.urdf_joints[name].mimic and not limit.continuous and limit.lower == limit.upper:
             raise ConfigError(f"{where}: joint '{name}' has lower limit = upper limit ({limit.lower:g}), so it "
                               "cannot move; make it a fixed joint in the URDF, or widen its limits")
 

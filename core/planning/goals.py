@@ -79,11 +79,23 @@ def check_limits(
 
 
 def _apply(robot: Robot, values: dict[str, float], start: NDArray[np.float64], source: str) -> NDArray[np.float64]:
+    """Return `start` with the group joints of `values` set; a mimic joint's value must be the one its leader gives."""
     target = start.copy()
+    mimics = {m.joint: m for m in robot.mimics}
     for joint, value in values.items():
-        if joint not in robot.joint_names:
+        if joint in robot.joint_names:
+            target[robot.joint_names.index(joint)] = value
+        elif joint not in mimics:
             raise UnknownName("joint", joint, f"group '{robot.group.name}' ({source})", robot.joint_names)
-        target[robot.joint_names.index(joint)] = value
+    for joint in values.keys() & mimics.keys():
+        mimic = mimics[joint]
+        follows = mimic.multiplier * target[mimic.leader] + mimic.offset
+        # A mimic joint follows its leader (MoveIt overwrites its value); a value it cannot take is a mistake.
+        if abs(values[joint] - follows) > _LIMIT_SLACK:
+            leader = robot.joint_names[mimic.leader]
+            error = UsageError if source.startswith("--") else ConfigError
+            raise error(f"{source}: joint '{joint}' mimics '{leader}', so it is at {follows:g} there, not "
+                        f"{values[joint]:g}: set '{leader}' only")
     return target
 
 

@@ -9,9 +9,11 @@ import shutil
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 from conftest import ROOT, UR10E, Cli
+from rosbags.highlevel import AnyReader
 
 from moveplan.cli.parsing import parse_disturbance, parse_number, parse_seeds
 from moveplan.core.config.controllers import parse_controllers
@@ -328,31 +330,37 @@ def test_scene_with_too_many_shapes_is_refused_quickly(cli: Cli, tmp_path: Path,
 # 7. mimic joints
 
 
-def test_group_with_a_mimic_joint_is_refused(cli: Cli, ur10e_copy: Path, tmp_path: Path) -> None:
+def test_a_goal_for_a_mimic_joint_that_disagrees_with_its_leader_is_a_usage_error(
+        cli: Cli, ur10e_copy: Path, tmp_path: Path) -> None:
+    # MoveIt overwrites a mimic joint's value with its leader's (RobotState::updateMimicJoints):
+    # a goal asking for another value cannot be met, and is said so rather than dropped.
     _replace_in_urdf(ur10e_copy, '<child link="forearm_link"/>',
                      '<child link="forearm_link"/><mimic joint="shoulder_pan_joint" multiplier="1"/>')
     output = tmp_path / "out.mcap"
     result = cli("plan", "--robot", ur10e_copy, "--joints", "elbow_joint=0.3", "-o", output)
-    assert result.exit_code == 3
+    assert result.exit_code == 2
     assert not output.exists()
-    assert one_line(result).endswith("group 'manipulator' has joint 'elbow_joint', which mimics "
-                                     "'shoulder_pan_joint'; mimic joints are not supported yet: "
-                                     "plan with a group without them")
+    assert one_line(result).endswith("joint 'elbow_joint' mimics 'shoulder_pan_joint', so it is at 0 there, "
+                                     "not 0.3: set 'shoulder_pan_joint' only")
 
 
-def test_group_moving_a_mimics_leader_is_refused(cli: Cli, ur10e_copy: Path, tmp_path: Path) -> None:
+def test_a_joint_mimicking_a_group_joint_follows_it_in_the_plan(cli: Cli, ur10e_copy: Path, tmp_path: Path) -> None:
     urdf = ur10e_copy / "ur10e.urdf"
     urdf.write_text(urdf.read_text().replace("</robot>", """
   <link name="follower_link"/>
   <joint name="follower_joint" type="revolute"><parent link="tool0"/><child link="follower_link"/>
-    <limit lower="-1" upper="1" velocity="2" effort="1"/><mimic joint="elbow_joint"/></joint>
+    <origin xyz="0 0 0.05"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" velocity="2" effort="1"/><mimic joint="elbow_joint" multiplier="0.5"/></joint>
 </robot>"""))
     output = tmp_path / "out.mcap"
-    result = cli("plan", "--robot", ur10e_copy, "--joints", "elbow_joint=0.3", "-o", output)
-    assert result.exit_code == 3
-    assert not output.exists()
-    assert one_line(result).endswith("group 'manipulator' moves joint 'elbow_joint', which joint 'follower_joint' "
-                                     "mimics; mimic joints are not supported yet: plan with a group without them")
+    result = cli("plan", "--robot", ur10e_copy, "--joints", "elbow_joint=-0.6", "-o", output, "--json")
+    assert result.exit_code == 0, result.stderr
+    with AnyReader([output]) as reader:
+        tf = [c for c in reader.connections if c.topic == "/tf"]
+        transforms = [t for c, _, raw in reader.messages(connections=tf) for t in reader.deserialize(raw, c.msgtype)
+                      .transforms if t.child_frame_id == "follower_link"]
+    z, w = transforms[-1].transform.rotation.z, transforms[-1].transform.rotation.w
+    assert 2 * np.arctan2(z, w) == pytest.approx(0.5 * -0.6, abs=1e-9)
 
 
 def test_a_scaling_below_a_thousandth_is_a_usage_error(cli: Cli, tmp_path: Path) -> None:
