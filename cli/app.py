@@ -108,7 +108,8 @@ def plan(
         help="Axes of --shift: tool (default), base, moveit (shift_pose_target) or any frame.")] = None,
     linear: Annotated[bool, typer.Option("--linear", help="Move the tip along a straight line.")] = False,
     min_fraction: Annotated[str | None, typer.Option(help="With --linear: fail below this fraction (1).")] = None,
-    planner: Annotated[str | None, typer.Option(help="OMPL geometric planner (default RRTConnect).")] = None,
+    planner: Annotated[str | None, typer.Option(
+        help="OMPL geometric planner (default RRTConnect); Pilz's PTP (joint-space line), LIN (tool line).")] = None,
     planning_time: Annotated[str | None, typer.Option(
         help="The search's budget per step, in seconds at 20,000 checked motions a second (not wall time).")] = None,
     timeout: TimeoutOpt = None,

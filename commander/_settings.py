@@ -12,18 +12,21 @@ import reprlib
 from dataclasses import replace
 from typing import Any
 
-from ..core.config import MIN_SCALING, PLANNERS, MotionSettings, Resolved, is_scaling, layered, resolved
+from ..core.config import MIN_SCALING, PILZ_PLANNERS, PLANNERS, MotionSettings, Resolved, is_scaling, layered, resolved
 from ..core.errors import UsageError, known
 from ..core.pipeline import check_planning_time
 from ._world import World
 
-__all__ = ["PLANNING_TIME_S", "PlanningSettings", "real_number"]
+__all__ = ["PLANNING_TIME_S", "PlanningSettings", "real_number", "scaling"]
 
 PLANNING_TIME_S = 5.0
 """MoveGroupCommander's default planning time in [s], MoveIt's."""
 
 # MoveIt's move_group plans with 5 s unless told; the rest is the robot config's.
 _MOVEIT_DEFAULTS = MotionSettings(planning_time=PLANNING_TIME_S)
+
+_PILZ = "pilz_industrial_motion_planner"
+_PIPELINES = ("", "ompl", _PILZ)  # MoveIt's pipeline ids moveplan plans with
 
 _TOLERANCES = {"joint": 1e-4, "position": 1e-4, "orientation": 1e-3}  # MoveIt's goal tolerance defaults
 
@@ -35,6 +38,8 @@ class PlanningSettings:
 
     def __init__(self) -> None:
         self._motion = MotionSettings()  # what the setters set
+        self._pipeline = "ompl"
+        self._planner_id = ""
         self._tolerances = dict(_TOLERANCES)
 
     def get_goal_tolerance(self) -> tuple[float, float, float]:
@@ -83,17 +88,39 @@ class PlanningSettings:
         return self._resolved().planner
 
     def set_planner_id(self, planner_id: str) -> None:
-        """Plan with an OMPL geometric planner ("RRTConnect"; MoveIt's "RRTConnectkConfigDefault" too); return None.
+        """Plan with an OMPL geometric planner ("RRTConnect", MoveIt's "RRTConnectkConfigDefault") or Pilz's PTP, LIN.
 
-        "" goes back to the robot config's planner.
+        "" goes back to the planning pipeline's default: the robot config's planner for OMPL,
+        PTP for Pilz's. Return None.
         """
         if not isinstance(planner_id, str):
             raise UsageError(f"set_planner_id: expected a planner's name, got {planner_id!r}")
         name = planner_id.removeprefix("geometric::").removesuffix("kConfigDefault")
-        if name and name not in PLANNERS:
+        if name == "CIRC":
+            raise UsageError("set_planner_id('CIRC'): Pilz's circular motion is not supported; give the arc's "
+                             "points to compute_cartesian_path")
+        if name and name not in (*PLANNERS, *PILZ_PLANNERS):
             raise UsageError(f"set_planner_id: unknown planner '{planner_id}'; OMPL geometric planners: "
-                             f"{known(PLANNERS)}")
-        self._motion = replace(self._motion, planner=name or None)
+                             f"{known(PLANNERS)}; Pilz's: {', '.join(PILZ_PLANNERS)}")
+        self._planner_id = name
+        self._motion = replace(self._motion, planner=name or self._pipeline_default())
+
+    def get_planning_pipeline_id(self) -> str:
+        """Return the planning pipeline: "ompl" (default) or "pilz_industrial_motion_planner"."""
+        return self._pipeline
+
+    def set_planning_pipeline_id(self, planning_pipeline: str) -> None:
+        """Plan with MoveIt's "ompl" or "pilz_industrial_motion_planner" pipeline ("" is "ompl"); return None."""
+        if planning_pipeline not in _PIPELINES:
+            raise UsageError(f"set_planning_pipeline_id: unknown planning pipeline {planning_pipeline!r}; moveplan "
+                             f"has {', '.join(p for p in _PIPELINES if p)}")
+        self._pipeline = planning_pipeline or "ompl"
+        if not self._planner_id:
+            self._motion = replace(self._motion, planner=self._pipeline_default())
+
+    def _pipeline_default(self) -> str | None:
+        """Return the planner a pipeline plans with when no planner is set (None: the robot config's)."""
+        return "PTP" if self._pipeline == _PILZ else None
 
     def set_num_planning_attempts(self, num_planning_attempts: int) -> None:
         """Accept MoveIt's number of attempts; a moveplan plan is one attempt, certified; return None."""
@@ -103,12 +130,12 @@ class PlanningSettings:
 
     def set_max_velocity_scaling_factor(self, value: float) -> None:
         """Scale the joints' velocity limits by `value` in (0, 1] (default: joint_limits.yaml's); return None."""
-        self._motion = replace(self._motion, velocity_scaling=_scaling(value, "set_max_velocity_scaling_factor"))
+        self._motion = replace(self._motion, velocity_scaling=scaling(value, "set_max_velocity_scaling_factor"))
 
     def set_max_acceleration_scaling_factor(self, value: float) -> None:
         """Scale the joints' acceleration limits by `value` in (0, 1] (default: joint_limits.yaml's); return None."""
         self._motion = replace(self._motion,
-                               acceleration_scaling=_scaling(value, "set_max_acceleration_scaling_factor"))
+                               acceleration_scaling=scaling(value, "set_max_acceleration_scaling_factor"))
 
     def _settings(self) -> MotionSettings:
         """Return the settings a motion is planned with now: the setters' over MoveIt's (None: the robot config's)."""
@@ -119,7 +146,7 @@ class PlanningSettings:
         return resolved(self._settings(), defaults=self._world.config.motion)
 
 
-def _scaling(value: Any, where: str) -> float:
+def scaling(value: Any, where: str) -> float:
     """Return a scaling factor checked to lie in [MIN_SCALING, 1], else raise UsageError naming `where`."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real) or not is_scaling(float(value)):
         raise UsageError(f"{where}: expected a value in the range from {MIN_SCALING:g} to 1 for scaling factor, "

@@ -80,9 +80,10 @@ def transform_to_matrix(transform: Transform, where: str = "transform") -> NDArr
 
 
 def matrix_to_pose(matrix: NDArray[np.float64]) -> Pose:
-    """Return the Pose of a 4x4 matrix."""
+    """Return the Pose of a 4x4 matrix, its quaternion's w >= 0."""
     x, y, z = (float(v) for v in matrix[:3, 3])
-    return Pose(Point(x, y, z), Quaternion(*(float(v) for v in quaternion_from_matrix(matrix))))
+    q = quaternion_from_matrix(matrix)
+    return Pose(Point(x, y, z), Quaternion(*(float(v) for v in (-q if q[3] < 0 else q))))
 
 
 def matrix_to_transform(matrix: NDArray[np.float64]) -> Transform:

@@ -10,34 +10,41 @@ from __future__ import annotations
 
 import numbers
 import os
+import re
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..core.config import MAX_SEED
-from ..core.errors import UsageError
+from ..core.config import MAX_SEED, Group
+from ..core.errors import UnknownName, UsageError
 from ..core.pipeline import ExecutionSettings, RobotSource, check_execution
+from ._messages import state_message
 from ._targets import finite_number
-from ._world import World, make_current
-from .msgs import JointState, RobotState
+from ._world import ROBOT_VARIABLE, World, make_current
+from .msgs import RobotState
 
 if TYPE_CHECKING:
     from .move_group import MoveGroupCommander
 
 __all__ = ["ROBOT_VARIABLE", "RobotCommander"]
 
-ROBOT_VARIABLE = "MOVEPLAN_ROBOT"
-"""Environment variable naming the robot when RobotCommander() is given none (what robot_description is to ROS)."""
+
+# A ROS parameter name ending in robot_description: MoveIt's way of naming the robot a launch file loaded.
+_PARAMETER = re.compile(r"[~/]?([A-Za-z_][A-Za-z0-9_]*/)*robot_description")
 
 class RobotCommander:
     """The robot: its groups, joints and links, its current state, and every motion it executed.
 
     Args:
-        robot: A shipped config's name (`ur10e`), a moveplan.yaml or its folder, a MoveIt config
-            package, a URDF or SRDF: what `moveplan --robot` takes. None: `$MOVEPLAN_ROBOT`.
+        robot_description: What `moveplan --robot` takes: a shipped config's name (`ur10e`), a
+            moveplan.yaml or its folder, a MoveIt config package, a URDF or SRDF. MoveIt's
+            default, a ROS parameter name ("robot_description", "/ns/robot_description"), or
+            None: the robot `$MOVEPLAN_ROBOT` names, as the parameter names the launched robot.
+        ns: MoveIt's namespace of the move_group; kept (`get_namespace`), there is one robot here.
         scene: A scene file (moveplan's or a MoveIt PlanningScene YAML): its frames, objects and
             robot state are the planning scene's to start with.
-        package_path: Folders searched for `package://` and `$(find)` (`--package-path`).
+        package_path: Folders searched for `package://` and `$(find)` (`--package-path`), before
+            `$ROS_PACKAGE_PATH`.
         urdf, srdf, xacro_args, strict_limits: As `--urdf`, `--srdf`, `--xacro-arg`, `--strict-limits`.
         plant, plant_params, controllers: The simulated hardware motions execute on, as
             `execute --fake --plant`, `--plant-param` and `--controllers` choose it.
@@ -46,10 +53,11 @@ class RobotCommander:
 
     def __init__(
         self,
-        robot: str | Path | None = None,
+        robot_description: str | Path | None = "robot_description",
+        ns: str = "",
+        *,
         scene: str | Path | None = None,
         package_path: str | Path | Sequence[str | Path] | None = None,
-        *,
         urdf: str | None = None,
         srdf: str | None = None,
         xacro_args: Mapping[str, str] | None = None,
@@ -59,11 +67,15 @@ class RobotCommander:
         controllers: str | Path | None = None,
         seed: int = 0,
     ) -> None:
-        if robot is None:
+        robot = robot_description
+        if robot is None or (isinstance(robot, str) and _PARAMETER.fullmatch(robot)):
             robot = os.environ.get(ROBOT_VARIABLE) or None
             if robot is None:
-                raise UsageError(f"RobotCommander(): no robot: give a config (RobotCommander('ur10e')) or set "
-                                 f"{ROBOT_VARIABLE}")
+                raise UsageError(f"RobotCommander({robot_description!r}): no robot: give a config "
+                                 f"(RobotCommander('ur10e')) or set {ROBOT_VARIABLE}, which names the robot the "
+                                 "robot_description parameter would hold")
+        if not isinstance(ns, str):
+            raise UsageError(f"RobotCommander: ns: expected a namespace, got {ns!r}")
         where = "RobotCommander"
         paths = [] if package_path is None else [package_path] if isinstance(package_path, str | Path) else package_path
         if not hasattr(paths, "__iter__"):
@@ -78,7 +90,13 @@ class RobotCommander:
         scene_path = _path(scene, f"{where}: scene") if scene is not None else None
         self.world = World(source, scene_path, execution, int(seed))
         check_execution(self.world.config, self.world.robot(None).joint_names, execution)
+        self._ns = ns
+        self._groups: dict[str, MoveGroupCommander] = {}
         make_current(self.world)
+
+    def get_namespace(self) -> str:
+        """Return the namespace given (MoveIt's `ns`)."""
+        return self._ns
 
     def get_planning_frame(self) -> str:
         """Return the frame all planning is done in: the URDF's root link."""
@@ -92,38 +110,59 @@ class RobotCommander:
         """Return the names of the SRDF's planning groups."""
         return list(self.world.config.srdf.groups)
 
+    def has_group(self, name: str) -> bool:
+        """Return True if the SRDF has a planning group `name`."""
+        return name in self.world.config.srdf.groups
+
     def get_joint_names(self, group: str | None = None) -> list[str]:
-        """Return the movable joints of `group`, or of the whole robot for None."""
+        """Return the joints of `group` (or of the robot for None), fixed and mimic joints included, as MoveIt does."""
+        joints = self.world.config.urdf_joints
         if group is None:
-            return self.world.joint_names()
-        return list(self.world.robot(group).joint_names)
+            return list(joints)
+        above = {joint.child: name for name, joint in joints.items()}
+        return [above[link] for link in self._group(group).links]
 
     def get_active_joint_names(self, group: str | None = None) -> list[str]:
-        """Return the active (movable) joints of `group`, or of the whole robot for None."""
-        return self.get_joint_names(group)
+        """Return the joints of `group` (or of the robot) that are planned: movable and not mimic joints."""
+        joints = self.world.config.urdf_joints
+        if group is None:
+            return [j for j in self.world.joint_names() if not joints[j].mimic]
+        return [j for j in self._group(group).joints if not joints[j].mimic]
 
     def get_link_names(self, group: str | None = None) -> list[str]:
-        """Return the links of the robot (for None), or the links `group`'s joints move."""
-        robot = self.world.robot(group)
+        """Return the robot's links (for None), or the group's: the child link of each of its joints, fixed ones too."""
         if group is None:
-            return list(robot.link_names)
-        children = {j.name: j.child for j in self.world.config.urdf_joints.values()}
-        return [children[j] for j in robot.joint_names if j in children]
+            return list(self.world.robot(None).link_names)
+        return list(self._group(group).links)
 
     def get_current_state(self) -> RobotState:
-        """Return the robot's current state: every movable joint's position."""
-        names = self.world.joint_names()
-        return RobotState(JointState(name=names, position=[self.world.joint_value(j) for j in names]))
+        """Return the robot's current state: every movable joint's position, in the planning frame."""
+        return state_message(self.world)
 
     def get_current_variable_values(self) -> dict[str, float]:
         """Return joint name -> current position in [rad] or [m], for every movable joint."""
         return {j: self.world.joint_value(j) for j in self.world.joint_names()}
 
     def get_group(self, name: str) -> MoveGroupCommander:
-        """Return a MoveGroupCommander for the group `name` of this robot."""
+        """Return the MoveGroupCommander of the group `name` of this robot (one per group, as MoveIt keeps it)."""
         from .move_group import MoveGroupCommander
 
-        return MoveGroupCommander(name, self)
+        self._group(name)
+        if name not in self._groups:
+            self._groups[name] = MoveGroupCommander(name, self)
+        return self._groups[name]
+
+    def get_default_owner_group(self, joint_name: str) -> str | None:
+        """Return the smallest group (fewest links) that has joint `joint_name`, None if none has it."""
+        owners = [g for g in self.get_group_names() if joint_name in self.get_joint_names(g)]
+        return min(owners, key=lambda g: len(self.get_link_names(g)), default=None)
+
+    def __getattr__(self, name: str) -> Any:
+        """Return the MoveGroupCommander of a group named `name` (MoveIt's `robot.right_arm`)."""
+        world = self.__dict__.get("world")
+        if world is not None and name in world.config.srdf.groups:
+            return self.get_group(name)
+        raise AttributeError(f"'RobotCommander' object has no attribute '{name}'")
 
     def save(self, path: str | Path, distro: str = "jazzy") -> None:
         """Write every motion executed so far, in order, as one plan file (`moveplan inspect`, `execute` read it).
@@ -138,6 +177,13 @@ class RobotCommander:
         """
         self.world.save(_path(path, "save"), distro)
 
+    def _group(self, name: str) -> Group:
+        """Return the SRDF group `name`, else raise UnknownName."""
+        groups = self.world.config.srdf.groups
+        if name not in groups:
+            raise UnknownName("group", str(name), f"{self.world.config.srdf_path}", groups)
+        return groups[name]
+
 
 def _path(value: Any, where: str) -> Path:
     """Return `value` as a Path if it is a name or a path, else raise UsageError naming `where`."""
@@ -148,7 +194,7 @@ def _path(value: Any, where: str) -> Path:
 
 def _check_arguments(robot: Any, descriptions: Mapping[str, Any], mappings: Mapping[str, Any], seed: Any) -> None:
     """Raise UsageError naming the RobotCommander argument that has the wrong type (or a seed out of range)."""
-    _path(robot, "RobotCommander: robot")  # kept as given by the caller: a shipped config's name is no path
+    _path(robot, "RobotCommander: robot_description")  # kept as given by the caller: a shipped config's name is no path
     for flag, value in descriptions.items():
         if value is not None and not isinstance(value, str):
             raise UsageError(f"RobotCommander: {flag}: expected a file name or package:// URI, got {value!r}")

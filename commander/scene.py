@@ -18,12 +18,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core.config import MAX_MAGNITUDE, mesh_file
-from ..core.errors import UnknownName, UsageError
+from ..core.errors import UsageError
 from ..core.types import CollisionObject, Shape
+from ._messages import apply_scene, attached_messages, object_message, scene_message
+from ._objects import apply_object, attach_existing, detach, on_link
 from ._targets import frame_name
 from ._world import World, current_world
-from .conversions import matrix_to_pose, pose_to_matrix
-from .msgs import AttachedCollisionObject, Header, Pose, PoseStamped
+from .conversions import list_to_pose, matrix_to_pose, pose_to_matrix
+from .msgs import AttachedCollisionObject, PlanningScene, Pose, PoseStamped
 from .msgs import CollisionObject as CollisionObjectMsg
 
 __all__ = ["PlanningSceneInterface", "attach_existing", "detach"]
@@ -35,12 +37,46 @@ class PlanningSceneInterface:
     """The planning scene's collision objects: add, attach, detach, remove, list.
 
     Args:
-        robot: The RobotCommander whose scene this is; None (or MoveIt's `ns` string): the one created last.
+        ns: MoveIt's namespace, a string: the robot created last (one is made from `$MOVEPLAN_ROBOT`
+            if there is none); or the RobotCommander whose scene this is.
         synchronous, service_timeout: MoveIt's; accepted and unused (every call applies at once).
     """
 
-    def __init__(self, robot: Any = None, synchronous: bool = True, service_timeout: float = 5.0) -> None:
-        self._world = current_world(robot, "PlanningSceneInterface")
+    def __init__(self, ns: Any = "", synchronous: bool = True, service_timeout: float = 5.0) -> None:
+        self._world = current_world(ns, "PlanningSceneInterface")
+
+    def add_object(self, collision_object: CollisionObjectMsg) -> None:
+        """Apply a moveit_msgs CollisionObject: ADD (or replace), APPEND shapes, MOVE or REMOVE it; return None.
+
+        Its shapes are placed as MoveIt places them: each primitive and mesh at its pose in the
+        object's frame, the object at `pose` in `header.frame_id` (the planning frame when empty),
+        the robot where it is now. Planes are refused: use a thin box.
+        """
+        apply_object(self._world, collision_object, "add_object")
+
+    def add_cone(self, name: str, pose: PoseStamped | Pose, height: float, radius: float) -> None:
+        """Add a cone of `height` and `radius` [m], checked as the cylinder that encloses it; return None."""
+        where = f"add_cone('{name}')"
+        height, radius = _lengths([height, radius], 2, f"{where}: height, radius")
+        logger.warning("%s: a cone is checked as the cylinder that encloses it", where)
+        self._add(name, Shape("cylinder", (radius, height)), pose, where)
+
+    def add_plane(self, name: str, pose: PoseStamped | Pose, normal: Sequence[float] = (0, 0, 1),
+                  offset: float = 0) -> None:
+        """Raise UsageError: an infinite plane is not supported; a thin box is."""
+        raise UsageError(f"add_plane('{name}'): planes are not supported; add a thin box instead "
+                         "(add_box(name, pose, (10, 10, 0.001)))")
+
+    def get_planning_scene(self, components: int) -> PlanningScene:
+        """Return the planning scene's parts that `components` (PlanningSceneComponents bits) ask for."""
+        if isinstance(components, bool) or not isinstance(components, int):
+            raise UsageError(f"get_planning_scene: expected PlanningSceneComponents bits, got {components!r}")
+        return scene_message(self._world, components)
+
+    def apply_planning_scene(self, planning_scene_message: PlanningScene) -> bool:
+        """Apply a PlanningScene (a diff, or the whole scene), as move_group's apply_planning_scene; return True."""
+        apply_scene(self._world, planning_scene_message)
+        return True
 
     def add_box(self, name: str, pose: PoseStamped | Pose, size: Sequence[float] = (1, 1, 1)) -> None:
         """Add a box of full edge lengths `size` [m], centred at `pose`; return None."""
@@ -65,10 +101,20 @@ class PlanningSceneInterface:
         self._add(name, _mesh(filename, size, where), pose, where)
 
     def attach_object(self, object: Any, link: str | None = None, touch_links: Sequence[str] | None = None) -> None:
-        """Attach the scene object `object` (a name, or a message with an `id`) to `link`; return None."""
+        """Attach an object to `link`: a scene object's name, a CollisionObject, or an AttachedCollisionObject.
+
+        A CollisionObject with shapes is added where it says, then attached; one without (or a
+        name) is the scene object of that id. `touch_links` default to the link (MoveIt's); return None.
+        """
+        if isinstance(object, AttachedCollisionObject):
+            link = link or object.link_name
+            touch_links = touch_links if touch_links is not None else (object.touch_links or None)
+            object = object.object
         name = object if isinstance(object, str) else str(getattr(object, "id", ""))
         if not link:
             raise UsageError(f"attach_object('{name}'): give the link to attach it to")
+        if isinstance(object, CollisionObjectMsg) and (object.primitives or object.meshes):
+            apply_object(self._world, object, f"attach_object('{name}')")
         attach_existing(self._world, name, link, touch_links, f"attach_object('{name}')")
 
     def attach_box(self, link: str, name: str, pose: PoseStamped | Pose | None = None,
@@ -121,27 +167,23 @@ class PlanningSceneInterface:
 
     def get_known_object_names(self, with_type: bool = False) -> list[str]:
         """Return the names of the world objects (attached objects are the robot's)."""
-        return [n for n, o in self._world.objects.items() if not o.link]
+        return self._world.object_ids(attached=False)
 
     def get_object_poses(self, object_ids: Iterable[str]) -> dict[str, Pose]:
         """Return name -> pose in the planning frame of the world objects among `object_ids`."""
-        objects = self._world.objects
+        known = self.get_known_object_names()
         wanted = _names(object_ids, "get_object_poses")
-        return {n: matrix_to_pose(objects[n].transform) for n in wanted if n in objects and not objects[n].link}
+        return {n: matrix_to_pose(self._world.object_pose(n)) for n in wanted if n in known}
 
     def get_objects(self, object_ids: Iterable[str] = ()) -> dict[str, CollisionObjectMsg]:
-        """Return name -> CollisionObject (pose in the planning frame) of the world objects asked (all for none)."""
-        frame = self._world.robot(None).root_link
+        """Return name -> CollisionObject (shapes, poses in the planning frame) of world objects asked (all: none)."""
         wanted = set(_names(object_ids, "get_objects"))
-        return {n: CollisionObjectMsg(Header(frame_id=frame), n, matrix_to_pose(o.transform))
-                for n, o in self._world.objects.items() if not o.link and (not wanted or n in wanted)}
+        known = self.get_known_object_names()
+        return {n: object_message(self._world, n) for n in known if not wanted or n in wanted}
 
     def get_attached_objects(self, object_ids: Iterable[str] = ()) -> dict[str, AttachedCollisionObject]:
-        """Return name -> AttachedCollisionObject (pose in its link's frame) of the objects asked (all for none)."""
-        wanted = set(_names(object_ids, "get_attached_objects"))
-        return {n: AttachedCollisionObject(o.link, CollisionObjectMsg(Header(frame_id=o.link), n,
-                                                                      matrix_to_pose(o.transform)), list(o.touch_links))
-                for n, o in self._world.objects.items() if o.link and (not wanted or n in wanted)}
+        """Return name -> AttachedCollisionObject (in its link's frame) of the objects asked (all for none)."""
+        return {m.object.id: m for m in attached_messages(self._world, _names(object_ids, "get_attached_objects"))}
 
     def _add(self, name: str, shape: Shape, pose: PoseStamped | Pose, where: str) -> None:
         """Add or replace the world object `name` at `pose`."""
@@ -157,58 +199,8 @@ class PlanningSceneInterface:
             return
         objects = self._world.objects
         placed = CollisionObject(_name(name, where), shape(), _placed(self._world, pose, where))
-        objects[name] = _on_link(self._world, placed, link, touch_links, where)
+        objects[name] = on_link(self._world, placed, link, touch_links, where)
         self._world.change(objects=objects)
-
-
-def attach_existing(world: World, name: str, link: str, touch_links: Sequence[str] | None, where: str) -> None:
-    """Attach the scene object `name` to `link` where it is now; `touch_links` default to [link]; return None.
-
-    `where` names the call in errors.
-    """
-    objects = world.objects
-    if name not in objects:
-        raise UnknownName("object", name, "the planning scene", objects)
-    objects[name] = _on_link(world, _in_world(world, objects[name]), link, touch_links, where)
-    world.change(objects=objects)
-
-
-def detach(world: World, name: str, link: str | None = None) -> bool:
-    """Return True if objects were detached: `name` (an object, else a link's objects; "" all), left where they are."""
-    objects = world.objects
-    attached = [n for n, o in objects.items() if o.link and (link is None or o.link == link)]
-    if name in objects:
-        chosen = [name] if name in attached else []
-    else:
-        chosen = [n for n in attached if not name or objects[n].link == name]
-    for n in chosen:
-        objects[n] = _in_world(world, objects[n])
-    world.change(objects=objects)
-    return bool(chosen)
-
-
-def _on_link(
-    world: World, placed: CollisionObject, link: str, touch_links: Sequence[str] | None, where: str
-) -> CollisionObject:
-    """Return a world object attached to `link`, kept where it is now."""
-    robot = world.robot(None)
-    if not isinstance(link, str) or link not in robot.link_names:
-        raise UnknownName("link", str(link), f"{where} (the robot's links)", robot.link_names)
-    if touch_links is not None and (isinstance(touch_links, str) or not hasattr(touch_links, "__iter__")):
-        raise UsageError(f"{where}: touch_links: expected a list of link names, got {touch_links!r}")
-    touch = tuple(touch_links) if touch_links is not None else (link,)
-    for other in touch:
-        if other not in robot.link_names:
-            raise UnknownName("link", other, f"touch_links of '{placed.name}'", robot.link_names)
-    link_T_object = np.linalg.inv(world.pose(link)) @ placed.transform
-    return CollisionObject(placed.name, placed.shape, link_T_object, link, touch)
-
-
-def _in_world(world: World, item: CollisionObject) -> CollisionObject:
-    """Return an object as a world object where it is now (an attached one where its link holds it)."""
-    if not item.link:
-        return item
-    return CollisionObject(item.name, item.shape, world.pose(item.link) @ item.transform)
 
 
 def _placed(world: World, pose: PoseStamped | Pose, where: str) -> NDArray[np.float64]:
@@ -218,7 +210,14 @@ def _placed(world: World, pose: PoseStamped | Pose, where: str) -> NDArray[np.fl
         return world.pose(frame) @ pose_to_matrix(pose.pose, f"{where}: pose")
     if isinstance(pose, Pose):
         return pose_to_matrix(pose, f"{where}: pose")
-    raise UsageError(f"{where}: expected a PoseStamped (or a Pose in the planning frame), got {type(pose).__name__}")
+    if isinstance(pose, list | tuple) and len(pose) in (3, 6, 7):  # a position, or MoveIt's pose lists
+        values = list(pose) + [0.0, 0.0, 0.0] * (len(pose) == 3)
+        try:
+            return pose_to_matrix(list_to_pose(values), f"{where}: pose")
+        except UsageError as exc:
+            raise UsageError(f"{where}: pose: {exc}") from None
+    raise UsageError(f"{where}: expected a PoseStamped, a Pose or a list [x, y, z(, orientation)] in the planning "
+                     f"frame, got {type(pose).__name__}")
 
 
 def _name(name: Any, where: str) -> str:

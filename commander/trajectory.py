@@ -21,6 +21,7 @@ from ..core.errors import (
     NoPlan,
     PlanningFailed,
     PlanningTimeExceeded,
+    SolutionsCollide,
     StartInCollision,
     StartOutsideLimits,
     UsageError,
@@ -46,10 +47,16 @@ _CODES: tuple[tuple[type[NoPlan], int], ...] = (
 )
 
 
-def error_code(error: NoPlan | None) -> MoveItErrorCodes:
-    """Return MoveIt's error code for why a plan failed (SUCCESS for None), its message the error's."""
+def error_code(error: NoPlan | None, pilz: bool = False) -> MoveItErrorCodes:
+    """Return MoveIt's error code for why a plan failed (SUCCESS for None), its message the error's.
+
+    With `pilz`, a collision is INVALID_MOTION_PLAN: Pilz plans without checking, and move_group
+    refuses the motion it planned (pilz_industrial_motion_planner's python_move_group_planning.py).
+    """
     if error is None:
         return MoveItErrorCodes(MoveItErrorCodes.SUCCESS, "", "moveplan")
+    if pilz and isinstance(error, StartInCollision | GoalInCollision | SolutionsCollide | PlanningFailed):
+        return MoveItErrorCodes(MoveItErrorCodes.INVALID_MOTION_PLAN, str(error), "moveplan")
     value = next((code for kind, code in _CODES if isinstance(error, kind)), MoveItErrorCodes.FAILURE)
     return MoveItErrorCodes(value, str(error), "moveplan")
 

@@ -19,6 +19,7 @@ __all__ = [
     "OutsideLimits",
     "StartOutsideLimits",
     "GoalUnreachable",
+    "SolutionsCollide",
     "InCollision",
     "InputError",
     "MoveplanError",
@@ -176,6 +177,10 @@ class StartOutsideLimits(OutsideLimits):
 
 class GoalUnreachable(NoPlan):
     """No inverse-kinematics solution reaches the requested pose."""
+
+
+class SolutionsCollide(GoalUnreachable):
+    """Inverse kinematics reaches the requested pose, but every solution found is in collision."""
 
 
 class PlanningFailed(NoPlan):

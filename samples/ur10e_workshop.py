@@ -14,10 +14,9 @@ import sys
 from math import pi
 
 from moveplan import commander as moveit_commander
-from moveplan.commander import rospy
-from moveplan.commander import tf as tf2_ros
-from moveplan.commander.msgs import Pose, PoseStamped, TransformStamped
-from moveplan.commander.transformations import quaternion_from_euler
+from moveplan.commander.ros import rospy, tf2_ros
+from moveplan.commander.ros.geometry_msgs.msg import Pose, PoseStamped, TransformStamped
+from moveplan.commander.ros.tf.transformations import quaternion_from_euler
 
 
 def stamped_pose(frame, x=0.0, y=0.0, z=0.0, roll=0.0, pitch=0.0, yaw=0.0):

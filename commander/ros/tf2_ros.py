@@ -14,12 +14,12 @@ from typing import Any
 
 import numpy as np
 
-from ..core.errors import FrameNotFound, MoveplanError, UsageError
-from ..core.types import Frame
-from ._targets import frame_name
-from ._world import current_world
-from .conversions import matrix_to_pose, matrix_to_transform, pose_to_matrix, transform_to_matrix
-from .msgs import Header, PoseStamped, TransformStamped
+from ...core.errors import FrameNotFound, MoveplanError, UsageError
+from ...core.types import Frame
+from .._targets import frame_name
+from .._world import current_world
+from ..conversions import matrix_to_pose, matrix_to_transform, pose_to_matrix, transform_to_matrix
+from ..msgs import Header, PoseStamped, TransformStamped
 
 __all__ = [
     "Buffer", "ConnectivityException", "ExtrapolationException", "LookupException", "StaticTransformBroadcaster",

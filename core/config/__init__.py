@@ -9,7 +9,8 @@ from typing import TYPE_CHECKING
 from .._faces import lazy_exports
 
 if TYPE_CHECKING:
-    from .collision_objects import AttachedMessage, ObjectMessage, attached_collision_object
+    from ._initial_state import default_position
+    from .collision_objects import AttachedMessage, ObjectMessage, attached_collision_object, collision_object
     from .controllers import ControllerConfig, ExecutionConfig, default_controller, parse_controllers
     from .controllers_write import tuned_controllers_text
     from .embed import check_carried
@@ -34,8 +35,14 @@ if TYPE_CHECKING:
     from .meshes import mesh_file
     from .motion import MIN_SCALING, MotionSettings, Resolved, is_planning_time, is_scaling, layered, resolved
     from .moveit_request import MotionPlanRequest, PositionGoal, load_motion_plan_request
-    from .planners import PLANNERS
-    from .planning_scene_yaml import PLANNING_SCENE_KEYS, FixedTransform, PlanningSceneFile, parse_planning_scene
+    from .planners import PILZ_PLANNERS, PLANNERS
+    from .planning_scene_yaml import (
+        PLANNING_SCENE_KEYS,
+        AllowedCollisions,
+        FixedTransform,
+        PlanningSceneFile,
+        parse_planning_scene,
+    )
     from .poses import pose_matrix
     from .robot_config import RobotConfig, load_robot_config
     from .scene_yaml import SceneFile, check_shape_count, first_repeated, parse_scene
@@ -45,6 +52,7 @@ if TYPE_CHECKING:
     from .xacro import PackagePath, parse_xacro_args
 
 __all__ = [
+    "AllowedCollisions",
     "AttachedMessage",
     "CONFIG_FILE",
     "ControllerConfig",
@@ -62,6 +70,7 @@ __all__ = [
     "MotionSettings",
     "NamedGoal",
     "ObjectMessage",
+    "PILZ_PLANNERS",
     "PLANNERS",
     "PLANNING_SCENE_KEYS",
     "PackagePath",
@@ -79,8 +88,10 @@ __all__ = [
     "TaskFile",
     "angle",
     "attached_collision_object",
+    "collision_object",
     "check_carried",
     "check_joint_units",
+    "default_position",
     "check_keys",
     "check_shape_count",
     "coordinate",
@@ -112,6 +123,7 @@ __all__ = [
 ]
 
 __getattr__ = lazy_exports(__name__, {
+    "AllowedCollisions": "planning_scene_yaml",
     "AttachedMessage": "collision_objects",
     "CONFIG_FILE": "sources",
     "ControllerConfig": "controllers",
@@ -129,6 +141,7 @@ __getattr__ = lazy_exports(__name__, {
     "MotionSettings": "motion",
     "NamedGoal": "goals",
     "ObjectMessage": "collision_objects",
+    "PILZ_PLANNERS": "planners",
     "PLANNERS": "planners",
     "PLANNING_SCENE_KEYS": "planning_scene_yaml",
     "PackagePath": "xacro",
@@ -146,8 +159,10 @@ __getattr__ = lazy_exports(__name__, {
     "TaskFile": "tasks",
     "angle": "fields",
     "attached_collision_object": "collision_objects",
+    "collision_object": "collision_objects",
     "check_carried": "embed",
     "check_joint_units": "joint_units",
+    "default_position": "_initial_state",
     "check_keys": "fields",
     "check_shape_count": "scene_yaml",
     "coordinate": "fields",

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -42,6 +42,9 @@ _JTC_KEYS = frozenset({
 # async_parameters (ControllerInterfaceBase), the spawner's `type`, rclcpp's use_sim_time.
 MAX_UPDATE_RATE_HZ = 10_000.0
 _NODE_KEYS = frozenset({"update_rate", "is_async", "async_parameters", "type", "use_sim_time"})
+# gripper_controllers' and parallel_gripper_controller's GripperActionController parameters.
+_GRIPPER_KEYS = frozenset({"joint", "action_monitor_rate", "goal_tolerance", "max_effort", "max_velocity",
+                           "allow_stalling", "stall_velocity_threshold", "stall_timeout", "state_interfaces"})
 # ur_controllers' ScaledJointTrajectoryController adds scaled_joint_trajectory_controller_parameters.yaml.
 _SCALED_JTC_KEYS = frozenset({
     "speed_scaling_interface_name", "use_speed_scaling_topic_instead", "speed_scaling_topic_name",
@@ -92,7 +95,10 @@ class ExecutionConfig:
 def parse_controllers(
     path: Path, launch_args: Mapping[str, str] | None = None, substitute: bool = True
 ) -> dict[str, ControllerConfig]:
-    """Return the JointTrajectoryControllers configured in a ros2_controllers.yaml, by name.
+    """Return the JointTrajectoryControllers (and GripperActionControllers) of a ros2_controllers.yaml, by name.
+
+    A GripperActionController is kept as a JointTrajectoryController of its one joint with
+    nothing checked on the way: MoveIt's GripperCommand sends the last point, the gripper goes there.
 
     Args:
         path: The file.
@@ -123,6 +129,14 @@ def parse_controllers(
             params = _ros_parameters(top, name, path, declared)
             where = f"{path}: {name}.ros__parameters"
             controllers[name] = _joint_trajectory_controller(name, kind, params, rate, where)
+        elif "GripperActionController" in kind:
+            params = _ros_parameters(top, name, path, _GRIPPER_KEYS | _NODE_KEYS)
+            joint = params.get("joint")
+            if not isinstance(joint, str) or not joint:
+                raise ConfigError(f"{path}: {name}.ros__parameters.joint: expected the gripper's joint, got {joint!r}")
+            # MoveIt's GripperCommand sends the trajectory's last position; the gripper goes there. Executed as
+            # a trajectory of that joint with nothing checked on the way (the action has no path tolerance).
+            controllers[name] = replace(default_controller((joint,)), name=name, update_rate_hz=rate)
     return controllers
 
 

@@ -89,6 +89,8 @@ class PoseGoal:
         quat: Orientation as a quaternion [x, y, z, w], or None (neither: the frame's).
         frame: A scene frame or robot link; None for the planning frame.
         link: The link to move; None for the group's tip.
+        also: Poses of other links, reached at the same time (MoveIt's pose targets for several
+            end-effectors of one group, a dual arm's two hands).
     """
 
     kind: ClassVar[str] = "pose"
@@ -97,17 +99,21 @@ class PoseGoal:
     quat: tuple[float, float, float, float] | None = None
     frame: str | None = None
     link: str | None = None
+    also: tuple[PoseGoal, ...] = ()
 
     def __post_init__(self) -> None:
-        for name in ("xyz", "rpy", "quat"):
+        for name in ("xyz", "rpy", "quat", "also"):
             value = getattr(self, name)
             if value is not None:
                 object.__setattr__(self, name, tuple(value))
 
     def describe(self) -> dict[str, Any]:
-        """Return the goal as the plan JSON reports it: {"pose": {frame, link, xyz, rpy, quat}}."""
-        return {"pose": {"frame": self.frame, "link": self.link, "xyz": list(self.xyz),
-                         "rpy": _listed(self.rpy), "quat": _listed(self.quat)}}
+        """Return the goal as the plan JSON reports it: {"pose": {frame, link, xyz, rpy, quat[, also]}}."""
+        pose: dict[str, Any] = {"frame": self.frame, "link": self.link, "xyz": list(self.xyz),
+                                "rpy": _listed(self.rpy), "quat": _listed(self.quat)}
+        if self.also:
+            pose["also"] = [other.describe()["pose"] for other in self.also]
+        return {"pose": pose}
 
 
 @dataclass(frozen=True)

@@ -43,7 +43,7 @@ from .collision_objects import attached_object
 from .fields import MAX_MAGNITUDE, check_keys, coordinate, load_yaml, mapping, number, read_input
 from .goals import JointGoal, PoseGoal
 from .motion import MIN_SCALING, MotionSettings
-from .planners import PLANNERS
+from .planners import PILZ_PLANNERS, PLANNERS
 from .poses import pose_matrix
 from .ros_messages import header_frame, point, pose, quaternion, robot_state, yaml_list
 from .tasks import StepSpec
@@ -172,17 +172,19 @@ def load_motion_plan_request(path: Path) -> MotionPlanRequest:
 
 
 def planner_name(planner_id: str, where: str) -> str | None:
-    """Return the OMPL planner a MoveIt planner_id names, or None for an empty one (the default)."""
+    """Return the OMPL or Pilz planner a MoveIt planner_id names, or None for an empty one (the default)."""
     name = planner_id.removeprefix("geometric::")
     if not name:
         return None
+    if name in PILZ_PLANNERS:
+        return name
     candidates = {p: p for p in _UNAVAILABLE} | {p: p for p in PLANNERS}
     candidates |= {alias: full for alias, full in _ALIASES.items() if full in PLANNERS}
     matches = [c for c in candidates if name.startswith(c)]
     planner = candidates[max(matches, key=len)] if matches else ""
     if planner not in PLANNERS:
-        raise ConfigError(f"{where}: '{planner_id}' names no available OMPL geometric planner; "
-                          f"known: {known(PLANNERS)}")
+        raise ConfigError(f"{where}: '{planner_id}' names no available OMPL geometric planner nor Pilz's "
+                          f"{', '.join(PILZ_PLANNERS)}; known: {known(PLANNERS)}")
     return planner
 
 

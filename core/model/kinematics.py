@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 import weakref
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import eigenpy
@@ -22,7 +22,7 @@ import numpy.typing as npt
 import pinocchio as pin
 from numpy.typing import NDArray
 
-from ..errors import GoalUnreachable, InputError, UnknownName
+from ..errors import GoalUnreachable, InputError, SolutionsCollide, UnknownName
 from ..types import frozen_array
 from .robot import Robot
 
@@ -74,6 +74,7 @@ def solve_ik(
     orientation_tolerance: float = 1e-3,
     colliding_pair: Callable[[NDArray[np.float64]], tuple[str, str] | None] | None = None,
     exhaustive: bool = False,
+    also: Sequence[tuple[str, npt.ArrayLike]] = (),
 ) -> IkSolution:
     """Return the valid group values nearest to `start` that put `link` at `target` (root_T_link).
 
@@ -95,6 +96,9 @@ def solve_ik(
         exhaustive: Run all `max_attempts` and return the nearest valid solution of them all
             (slower). By default a valid local solution from `start` is returned at once, and
             restarts stop after a few valid solutions.
+        also: Further (link, target) pairs to place at the same time, each within the
+            tolerances (MoveIt's pose targets for several end-effectors); the errors
+            reported are the worst of all.
 
     Raises:
         GoalUnreachable: No valid solution was found; the message gives the closest pose
@@ -102,11 +106,13 @@ def solve_ik(
     """
     solver = _solver(robot)
     frame, root_T_target, reference, base = _checked_inputs(robot, solver, target, link, start, base)
+    goals = [(frame, root_T_target)]
+    for other, other_target in also:
+        goals.append(_checked_inputs(robot, solver, other_target, other, start, base)[:2])
     # Converging to half the tolerance leaves margin for callers that re-measure the pose
     # with other arithmetic (arccos of the trace loses digits near zero).
     tolerances = (0.5 * position_tolerance, 0.5 * orientation_tolerance)
-    outcome = _search(solver, reference, base, frame, root_T_target, tolerances, is_free, seed, max_attempts,
-                     exhaustive)
+    outcome = _search(solver, reference, base, tuple(goals), tolerances, is_free, seed, max_attempts, exhaustive)
     if outcome.best is not None:
         best = outcome.best
         return IkSolution(best.values, best.position_m, best.angle_rad, outcome.attempts)
@@ -144,7 +150,7 @@ class _Outcome:
 
 
 def _search(
-    solver: _Solver, reference: NDArray[np.float64], base: NDArray[np.float64], frame: int, root_T_target: pin.SE3,
+    solver: _Solver, reference: NDArray[np.float64], base: NDArray[np.float64], goals: tuple[tuple[int, pin.SE3], ...],
     tolerances: tuple[float, float], is_free: Callable[[NDArray[np.float64]], bool] | None, seed: int,
     max_attempts: int, exhaustive: bool,
 ) -> _Outcome:
@@ -159,7 +165,7 @@ def _search(
             rng = rng or np.random.default_rng(seed)
             guess = solver.random_guess(rng, reference)
         attempts += 1
-        attempt = solver.descend(guess, base, frame, root_T_target, tolerances)
+        attempt = solver.descend(guess, base, goals, tolerances)
         if not attempt.converged:
             if found.closest is None or attempt.residual < found.closest.residual:
                 found.closest = attempt
@@ -200,7 +206,7 @@ def _unreachable(
             nearest = min(colliding, key=lambda values: solver.distance(values, reference))
             pair = colliding_pair(robot.configuration(nearest, base))
             text += f" (nearest the start: {pair[0]} touches {pair[1]})" if pair else ""
-        return GoalUnreachable(f"{text} {tries}")
+        return SolutionsCollide(f"{text} {tries}")
     assert closest is not None  # no attempt converged, so every one was a candidate
     angle = "" if math.isinf(orientation_tolerance) else f", {closest.angle_rad:.3g} rad"
     return GoalUnreachable(f"{where}: closest reached {closest.position_m * 1e3:.1f} mm{angle} away {tries}")
@@ -269,14 +275,13 @@ class _Solver:
         self,
         guess: NDArray[np.float64],
         base: NDArray[np.float64],
-        frame: int,
-        target: pin.SE3,
+        goals: tuple[tuple[int, pin.SE3], ...],
         tolerances: tuple[float, float],
     ) -> _Attempt:
-        """Return where damped least squares on the local SE3 log error ends, from `guess`.
+        """Return where damped least squares on the SE3 log errors of `goals` (frame, target) ends, from `guess`.
 
-        With an infinite orientation tolerance, only the position error and the Jacobian's
-        linear rows count: the orientation is free.
+        With an infinite orientation tolerance, only the position errors and the Jacobians'
+        linear rows count: the orientation is free. Several goals stack their errors and Jacobians.
         """
         model, data = self.model, self.data
         position_tolerance2, angle_tolerance2 = tolerances[0] ** 2, tolerances[1] ** 2
@@ -290,20 +295,16 @@ class _Solver:
         for iteration in range(_MAX_ITERATIONS):
             self.set_values(q, values)
             # computeFrameJacobian would leave data.oMf stale; computeJointJacobians runs the
-            # forward kinematics too. LOCAL: the Jacobian maps joint velocities to the link's
-            # twist in its own frame, the frame of log6(root_T_link^-1 root_T_target).
+            # forward kinematics too.
             pin.computeJointJacobians(model, data, q)
-            jacobian = pin.getFrameJacobian(model, data, frame, pin.LOCAL)
-            link_T_target = pin.updateFramePlacement(model, data, frame).actInv(target)
-            error = pin.log6(link_T_target).vector
-            translation = link_T_target.translation
-            position2 = translation.dot(translation)
-            angle2 = error[3:].dot(error[3:])
+            if len(goals) == 1:
+                error, jacobian, position2, angle2 = self._frame_error(*goals[0], position_only)
+            else:
+                parts = [self._frame_error(frame, target, position_only) for frame, target in goals]
+                error, jacobian = np.concatenate([p[0] for p in parts]), np.vstack([p[1] for p in parts])
+                position2, angle2 = max(p[2] for p in parts), max(p[3] for p in parts)
             if position2 <= position_tolerance2 and angle2 <= angle_tolerance2:
                 break
-            if position_only:
-                # LOCAL: the linear rows move the origin in the link's frame, the frame of `translation`.
-                error, jacobian = translation, jacobian[:3]
             residual = error.dot(error)
             if residual < 0.98 * best_residual:
                 best_residual, best_iteration = residual, iteration
@@ -326,6 +327,24 @@ class _Solver:
         position, angle = math.sqrt(position2), math.sqrt(angle2)
         converged = position <= tolerances[0] and angle <= tolerances[1]
         return _Attempt(values, position, angle, math.sqrt(position2 + (0.0 if position_only else angle2)), converged)
+
+    def _frame_error(
+        self, frame: int, target: pin.SE3, position_only: bool,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], float, float]:
+        """Return (error, Jacobian, squared position error, squared angle) of one frame, after the kinematics.
+
+        LOCAL: the Jacobian maps joint velocities to the link's twist in its own frame, the frame
+        of log6(root_T_link^-1 root_T_target); position only, its linear rows and the translation.
+        """
+        model, data = self.model, self.data
+        jacobian = pin.getFrameJacobian(model, data, frame, pin.LOCAL)
+        link_T_target = pin.updateFramePlacement(model, data, frame).actInv(target)
+        error = pin.log6(link_T_target).vector
+        translation = link_T_target.translation
+        angle2 = error[3:].dot(error[3:])
+        if position_only:
+            return translation, jacobian[:3], translation.dot(translation), angle2
+        return error, jacobian, translation.dot(translation), angle2
 
     def random_guess(
         self, rng: np.random.Generator, start: NDArray[np.float64]

@@ -10,7 +10,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 
 import numpy as np
@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from ..collision import MotionChecker
 from ..config import JointGoal, NamedGoal, StepSpec, resolved
-from ..errors import GoalInCollision, PlanningFailed, PlanningTimeExceeded
+from ..errors import GoalInCollision, PlanningFailed, PlanningTimeExceeded, UsageError
 from ..model import Robot, Scene, solve_ik
 from ..planning import (
     PathResult,
@@ -80,6 +80,7 @@ class _Target:
     values: NDArray[np.float64] | None
     link: str
     pose: NDArray[np.float64] | None = None
+    also: tuple[tuple[str, NDArray[np.float64]], ...] = ()  # more links and their poses, reached with `link`
 
 
 def plan_step(
@@ -92,6 +93,8 @@ def plan_step(
     began = time.perf_counter()
     robot, checks = problem.robot, problem.checks
     settings = _settings(spec, request, robot)
+    if settings.planner == "LIN":  # Pilz's LIN is the tool's straight line: a linear step
+        spec = replace(spec, linear=True)
     target = _target(spec, request, robot, problem.scene, checks, start)
     search, fraction = _search(spec, settings, robot, checks, start, target)
     path, trajectory, stats = _certified(spec, settings, robot, checks, start, target, search)
@@ -135,16 +138,23 @@ def _target(
         pair = checks.colliding_pair(values)
         if pair:
             raise GoalInCollision(pair)
+        if spec.linear:  # Pilz's LIN to a joint goal: the tool's straight line to where the goal puts it
+            return _Target(None, robot.group.tip, robot.frame_pose(robot.configuration(values, checks.base),
+                                                                    robot.group.tip))
         return _Target(values, robot.group.tip)
     base = checks.base
-    link, pose = tip_target(robot, scene, goal, robot.configuration(start, base), source)
+    q = robot.configuration(start, base)
+    link, pose = tip_target(robot, scene, goal, q, source)
+    also = tuple(tip_target(robot, scene, other, q, source) for other in getattr(goal, "also", ()))
     if spec.linear:
+        if also:
+            raise UsageError(f"{source}: a straight line moves one link; this goal places {len(also) + 1}")
         return _Target(None, link, pose)
     # Exhaustive: the first valid solution from a far start is not always the nearest one.
     solution = solve_ik(robot, pose, link, start, base=base, seed=request.seed, exhaustive=True,
                         orientation_tolerance=orientation_tolerance(goal), is_free=checks.state_free,
-                        colliding_pair=checks.checker.colliding_pair)
-    return _Target(solution.values, link, pose)
+                        colliding_pair=checks.checker.colliding_pair, also=also)
+    return _Target(solution.values, link, pose, also)
 
 
 def _search(
@@ -158,6 +168,8 @@ def _search(
     if not spec.linear:
         goal = target.values
         assert goal is not None, "a step that is not linear has target values"
+        if settings.planner == "PTP":
+            return (lambda validity: _point_to_point(start, goal, validity)), 1.0
         return (lambda validity: plan_path(start, goal, robot.lower, robot.upper, validity, settings.planner,
                                            settings.planning_time, settings.timeout)), 1.0
     assert target.pose is not None, "a linear step has a target pose"
@@ -170,6 +182,15 @@ def _search(
                              f"in {robot.root_link}")
     line_path = PathResult(np.asarray(line.waypoints), "linear", 0.0, 0.0)
     return (lambda validity: line_path), line.fraction  # the line is already checked
+
+
+def _point_to_point(start: NDArray[np.float64], goal: NDArray[np.float64], validity: Validity) -> PathResult:
+    """Return Pilz's PTP path, the straight line in joint space, if it is free; else raise PlanningFailed."""
+    began = time.perf_counter()
+    if not validity.edge_free(start, goal):
+        raise PlanningFailed("PTP: the straight joint-space motion from start to goal collides; PTP does not plan "
+                             "around obstacles (plan with an OMPL planner, such as RRTConnect)")
+    return PathResult(np.array([start, goal]), "PTP", time.perf_counter() - began, 0.0)
 
 
 def _certified(
@@ -193,7 +214,7 @@ def _certified(
 
     path = search(checked(_COARSE_RAD))
     trajectory, hit = certifier.certified(path, _COARSE_STEP_RAD)
-    if hit is not None and not spec.linear:
+    if hit is not None and not spec.linear and settings.planner != "PTP":
         logger.debug("trajectory collides when certified; planning its colliding segments again, finer")
         try:
             path = repair_path(path.waypoints, robot.lower, robot.upper, checked(_FINE_RAD), settings.planner,
@@ -267,6 +288,6 @@ def _residual(
     """Return how far the trajectory's end is from the goal: in joint space, or as a tip pose error."""
     if target.pose is None:
         return {"joints_rad": float(np.max(np.abs(end - path_end)))}
-    reached = robot.frame_pose(robot.configuration(end, base), target.link)
-    position, angle = pose_error(reached, target.pose)
-    return {"position_m": position, "orientation_rad": angle}
+    q = robot.configuration(end, base)
+    errors = [pose_error(robot.frame_pose(q, link), pose) for link, pose in ((target.link, target.pose), *target.also)]
+    return {"position_m": max(e[0] for e in errors), "orientation_rad": max(e[1] for e in errors)}

@@ -30,7 +30,7 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from ..collision import setup_time_spent
-from ..config import PLANNERS
+from ..config import PILZ_PLANNERS, PLANNERS
 from ..errors import PlanningFailed, PlanningTimeExceeded, UsageError, known
 from ..types import frozen_array
 
@@ -151,7 +151,8 @@ def plan_path(
     when `timeout_s` seconds of wall time (default: `default_timeout(time_s)`) pass first.
     """
     if planner not in PLANNERS:
-        raise UsageError(f"unknown planner '{planner}'; OMPL geometric planners: {known(PLANNERS)}")
+        raise UsageError(f"unknown planner '{planner}'; OMPL geometric planners: {known(PLANNERS)}; Pilz's: "
+                         f"{', '.join(PILZ_PLANNERS)}")
     return _plan(start, goal, lower, upper, validity, planner, _Work(time_s, timeout_s))
 
 

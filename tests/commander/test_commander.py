@@ -14,11 +14,10 @@ from rosbags.highlevel import AnyReader
 from scipy.spatial.transform import Rotation
 
 from moveplan import commander as moveit_commander
-from moveplan.commander import rospy
-from moveplan.commander import tf as tf2_ros
 from moveplan.commander.conversions import pose_to_list
 from moveplan.commander.msgs import JointState, MoveItErrorCodes, Pose, PoseStamped, RobotState, TransformStamped
-from moveplan.commander.transformations import euler_from_quaternion, quaternion_from_euler
+from moveplan.commander.ros import rospy, tf2_ros
+from moveplan.commander.ros.tf.transformations import euler_from_quaternion, quaternion_from_euler
 from moveplan.core.bag import read_plan
 from moveplan.core.config import load_task
 from moveplan.core.errors import (
@@ -172,8 +171,19 @@ def test_bad_joint_targets_raise_the_clis_typed_errors(group: moveit_commander.M
         group.set_joint_value_target("elbow_joint", 7.0)
     with pytest.raises(UnknownName, match="named state 'nowhere' not found .* known: home, ready, up"):
         group.set_named_target("nowhere")
-    with pytest.raises(UsageError, match="plan: no target"):
-        group.plan()
+
+
+def test_a_partial_joint_target_keeps_the_previous_targets_values(group: moveit_commander.MoveGroupCommander) -> None:
+    # MoveIt's joint state target (moveit_commander test/python_moveit_commander.py, test_target_setting):
+    # it starts at the model's default values, and a partial target changes only the joints it names.
+    assert group.get_joint_value_target() == [0.0] * 6
+    group.set_joint_value_target([0.3] * 6)
+    group.set_joint_value_target("shoulder_pan_joint", 0.5)
+    assert group.get_joint_value_target() == [0.5] + [0.3] * 5
+    group.set_joint_value_target({"wrist_3_joint": 0.1})
+    assert group.get_joint_value_target() == [0.5] + [0.3] * 4 + [0.1]
+    group.set_pose_target(stamped("target_1"))
+    assert group.get_joint_value_target() == [0.5] + [0.3] * 4 + [0.1]  # a pose target leaves it as it is
 
 
 def test_remembered_values_are_named_targets(group: moveit_commander.MoveGroupCommander) -> None:

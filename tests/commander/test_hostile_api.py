@@ -13,8 +13,8 @@ import pytest
 from conftest import UR10E
 
 from moveplan import commander as moveit_commander
-from moveplan.commander import tf as tf2_ros
 from moveplan.commander.msgs import JointState, PoseStamped, RobotState, RobotTrajectory, TransformStamped
+from moveplan.commander.ros import tf2_ros
 from moveplan.core.errors import MoveplanError, UnknownName, UsageError
 
 Group = moveit_commander.MoveGroupCommander
@@ -153,9 +153,10 @@ def test_a_trajectory_edited_into_something_else_is_refused_naming_the_field(
 
 
 @pytest.mark.parametrize(("call", "message"), [
-    (lambda s: s.add_box("box", None), "add_box('box'): expected a PoseStamped (or a Pose in the planning frame), "
-                                       "got NoneType"),
-    (lambda s: s.add_box("box", [0.6, 0, 0]), "add_box('box'): expected a PoseStamped"),
+    (lambda s: s.add_box("box", None), "add_box('box'): expected a PoseStamped, a Pose or a list [x, y, z(, "
+                                       "orientation)] in the planning frame, got NoneType"),
+    (lambda s: s.add_box("box", [0.6, 0]), "add_box('box'): expected a PoseStamped"),
+    (lambda s: s.add_box("box", [0.6, 0, math.nan]), "add_box('box'): pose: pose list: expected finite numbers"),
     (lambda s: s.add_box("box", at(x=1e18)), "add_box('box'): pose: position [1e+18, 0.0, 0.0] is out of range; "
                                              "coordinates are limited to |value| <= 1,000,000 m"),
     (lambda s: s.add_box("box", at(), (1e18, 1, 1)), "add_box('box'): size: expected 3 positive lengths in [m] up "
@@ -206,7 +207,7 @@ def test_a_static_frame_beyond_the_coordinate_bound_is_refused(robot: Robot) -> 
 
 
 @pytest.mark.parametrize(("arguments", "message"), [
-    ({"robot": 3}, "RobotCommander: robot: expected a file or folder name, got 3"),
+    ({"robot_description": 3}, "RobotCommander: robot_description: expected a file or folder name, got 3"),
     ({"scene": 3}, "RobotCommander: scene: expected a file or folder name, got 3"),
     ({"package_path": 3}, "RobotCommander: package_path: expected a folder or a list of folders, got 3"),
     ({"urdf": 3}, "RobotCommander: urdf: expected a file name or package:// URI, got 3"),
@@ -218,7 +219,7 @@ def test_a_static_frame_beyond_the_coordinate_bound_is_refused(robot: Robot) -> 
     ({"seed": "a"}, "RobotCommander: seed: expected an integer in 0..4294967295, got 'a'"),
 ])
 def test_a_robot_commander_given_the_wrong_type_names_the_argument(arguments: dict[str, Any], message: str) -> None:
-    raises_naming(lambda: moveit_commander.RobotCommander(**{"robot": str(UR10E), **arguments}), message)
+    raises_naming(lambda: moveit_commander.RobotCommander(**{"robot_description": str(UR10E), **arguments}), message)
 
 
 def test_saving_to_no_path_names_the_call(robot: Robot) -> None:

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from moveplan.commander import transformations
+from moveplan.commander.ros.tf import transformations
 from moveplan.core.rotations import (
     matrix_from_quaternion,
     matrix_from_rotation_vector,
