@@ -36,6 +36,7 @@ from ..core.config import (
     ShiftGoal,
     StepSpec,
     default_position,
+    path_constraints,
     pose_matrix,
 )
 from ..core.control import ExecutionSummary
@@ -60,6 +61,7 @@ from .msgs import (
     PoseStamped,
     RobotState,
     RobotTrajectory,
+    plain,
 )
 from .trajectory import error_code, from_message, to_message
 from .transformations import euler_from_quaternion
@@ -394,7 +396,12 @@ class MoveGroupCommander(PlanningSettings):
         self._remembered.pop(name, None)
 
     def set_path_constraints(self, value: Any) -> None:
-        """Plan every motion within `value`, a moveit_msgs Constraints (None clears them); return None."""
+        """Plan every motion within `value`, a moveit_msgs Constraints (None clears them); return None.
+
+        Joint constraints narrow the joints' ranges; orientation and position constraints are
+        checked on every state the search and the certification check (MoveIt's rejection
+        sampling: a tight orientation tolerance makes a hard search). Checked when planning.
+        """
         if value is None:
             self.clear_path_constraints()
             return
@@ -641,10 +648,11 @@ class MoveGroupCommander(PlanningSettings):
     def _plan_step(self) -> tuple[StepResult | None, NoPlan | None, float]:
         """Return the step planned to the target, or the reason there is none, and the time spent [s]."""
         goal = self._goal()
-        if self._constraints is not None and _constraining(self._constraints):
-            raise UsageError("plan: path constraints are not supported yet")
+        constraints = None
+        if self._constraints is not None:
+            constraints = path_constraints(plain(self._constraints), "set_path_constraints")
         q = self._start_q()
-        spec = StepSpec(_step_name(goal), goal)
+        spec = StepSpec(_step_name(goal), goal, constraints=constraints)
         began = time.perf_counter()
         try:
             step = plan_motion(self._world.problem(self._robot, q), spec, q, self._settings(), self._world.seed)

@@ -18,12 +18,14 @@ from ..core.errors import (
     GoalInCollision,
     GoalOutsideLimits,
     GoalUnreachable,
+    GoalViolatesConstraints,
     NoPlan,
     PlanningFailed,
     PlanningTimeExceeded,
     SolutionsCollide,
     StartInCollision,
     StartOutsideLimits,
+    StartViolatesConstraints,
     UsageError,
 )
 from ..core.types import JointTrajectory, StepResult
@@ -37,6 +39,8 @@ _TIME_MATCH_S = 1e-8  # time_from_start holds whole nanoseconds: a planned time 
 
 # Most specific first: StartInCollision and GoalInCollision are both InCollision.
 _CODES: tuple[tuple[type[NoPlan], int], ...] = (
+    (StartViolatesConstraints, MoveItErrorCodes.START_STATE_VIOLATES_PATH_CONSTRAINTS),
+    (GoalViolatesConstraints, MoveItErrorCodes.GOAL_VIOLATES_PATH_CONSTRAINTS),
     (StartInCollision, MoveItErrorCodes.START_STATE_IN_COLLISION),
     (GoalInCollision, MoveItErrorCodes.GOAL_IN_COLLISION),
     (StartOutsideLimits, MoveItErrorCodes.START_STATE_INVALID),

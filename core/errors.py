@@ -19,6 +19,8 @@ __all__ = [
     "OutsideLimits",
     "StartOutsideLimits",
     "GoalUnreachable",
+    "GoalViolatesConstraints",
+    "StartViolatesConstraints",
     "SolutionsCollide",
     "InCollision",
     "InputError",
@@ -147,6 +149,14 @@ class GoalInCollision(InCollision):
 
     def __init__(self, pair: tuple[str, str]) -> None:
         super().__init__(pair, "goal state")
+
+
+class StartViolatesConstraints(NoPlan):
+    """The start state violates the motion's path constraints (MoveIt: START_STATE_VIOLATES_PATH_CONSTRAINTS)."""
+
+
+class GoalViolatesConstraints(NoPlan):
+    """The goal state violates the motion's path constraints (MoveIt: GOAL_VIOLATES_PATH_CONSTRAINTS)."""
 
 
 class OutsideLimits(NoPlan):

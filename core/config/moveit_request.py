@@ -22,8 +22,9 @@ Read as move_group reads one, with these choices:
   `attach_request_objects`), their mesh files found through the robot config's packages.
 - Ignored: `num_planning_attempts` (one search per step), `workspace_parameters` (the
   joint limits bound the search), `pipeline_id`, `reference_trajectories` and Cartesian
-  speed limits (warnings where set). Path and trajectory constraints and visibility
-  constraints are errors.
+  speed limits (warnings where set). Trajectory constraints and visibility constraints are
+  errors.
+- `path_constraints` hold every state of the motion (config/constraints.py).
 - Every number is finite and within MAX_MAGNITUDE, as on the command line; attempts are an
   int32 at least 0, planning time at least 0.
 """
@@ -40,6 +41,7 @@ from numpy.typing import NDArray
 
 from ..errors import ConfigError, known
 from .collision_objects import attached_object
+from .constraints import path_constraints
 from .fields import MAX_MAGNITUDE, check_keys, coordinate, load_yaml, mapping, number, read_input
 from .goals import JointGoal, PoseGoal
 from .motion import MIN_SCALING, MotionSettings
@@ -139,8 +141,9 @@ def load_motion_plan_request(path: Path) -> MotionPlanRequest:
         logger.warning("%s: goal_constraints has %d alternatives; moveplan plans to the first",
                        source, len(alternatives))
     goal = None
+    constraints = path_constraints(top.get("path_constraints") or {}, f"{source}: path_constraints")
     if alternatives:
-        goal = StepSpec(path.stem, _goal(alternatives[0], f"{source}: goal_constraints[0]"))
+        goal = StepSpec(path.stem, _goal(alternatives[0], f"{source}: goal_constraints[0]"), constraints=constraints)
 
     group = top.get("group_name", "")
     if not isinstance(group, str):
@@ -190,10 +193,6 @@ def planner_name(planner_id: str, where: str) -> str | None:
 
 def _check_unsupported(top: dict[str, Any], source: str) -> None:
     """Raise ConfigError for request fields that would change the motion but that moveplan cannot honour."""
-    path = mapping(top.get("path_constraints"), f"{source}: path_constraints")
-    check_keys(path, _CONSTRAINTS_KEYS, f"{source}: path_constraints")
-    if any(yaml_list(path.get(k), f"{source}: path_constraints.{k}") for k in _CONSTRAINTS_KEYS - {"name"}):
-        raise ConfigError(f"{source}: path_constraints: not supported; moveplan plans without path constraints")
     trajectory = mapping(top.get("trajectory_constraints"), f"{source}: trajectory_constraints")
     check_keys(trajectory, {"constraints"}, f"{source}: trajectory_constraints")
     if yaml_list(trajectory.get("constraints"), f"{source}: trajectory_constraints.constraints"):

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
+from .constraints import PathConstraints, path_constraints
 from .fields import (
     MAX_MAGNITUDE,
     angle,
@@ -37,7 +38,7 @@ MAX_SEED = 2**32 - 1
 
 _TASK_KEYS = {"robot", "scene", "group", "start", "defaults", "steps", "seed"}
 _DEFAULT_KEYS = {f.name for f in fields(MotionSettings)}
-_STEP_KEYS = {"name", "linear", "min_fraction", *GOAL_KINDS, *_DEFAULT_KEYS}
+_STEP_KEYS = {"name", "linear", "min_fraction", "path_constraints", *GOAL_KINDS, *_DEFAULT_KEYS}
 _POSE_KEYS = {"frame", "xyz", "rpy", "quat", "link"}
 
 
@@ -46,7 +47,7 @@ class StepSpec:
     """One requested motion: a goal plus per-step overrides (None = use the plan's default).
 
     A `linear` step moves the tip along a straight line (pose and shift goals); below
-    `min_fraction` of it, it fails.
+    `min_fraction` of it, it fails. Every state of the motion satisfies `constraints`.
     """
 
     name: str
@@ -54,6 +55,7 @@ class StepSpec:
     linear: bool = False
     min_fraction: float | None = None
     motion: MotionSettings = MotionSettings()
+    constraints: PathConstraints | None = None
 
 
 @dataclass(frozen=True)
@@ -218,8 +220,10 @@ def load_task(path: Path) -> TaskFile:
         goal = parse_goal(entry, where)
         if linear and isinstance(goal, JointGoal | NamedGoal):
             raise ConfigError(f"{where}: linear applies to pose and shift goals, not {goal.kind}")
+        constraints = (path_constraints(entry["path_constraints"], f"{where}.path_constraints")
+                       if "path_constraints" in entry else None)
         steps.append(StepSpec(name=name, goal=goal, linear=linear, min_fraction=min_fraction,
-                              motion=_motion(entry, where)))
+                              motion=_motion(entry, where), constraints=constraints))
     names = [s.name for s in steps]
     for name in names:
         if names.count(name) > 1:

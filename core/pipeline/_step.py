@@ -18,9 +18,17 @@ from numpy.typing import NDArray
 
 from ..collision import MotionChecker
 from ..config import JointGoal, NamedGoal, StepSpec, resolved
-from ..errors import GoalInCollision, PlanningFailed, PlanningTimeExceeded, UsageError
+from ..errors import (
+    GoalInCollision,
+    GoalViolatesConstraints,
+    PlanningFailed,
+    PlanningTimeExceeded,
+    StartViolatesConstraints,
+    UsageError,
+)
 from ..model import Robot, Scene, solve_ik
 from ..planning import (
+    PathCheck,
     PathResult,
     Validity,
     check_limits,
@@ -95,9 +103,10 @@ def plan_step(
     settings = _settings(spec, request, robot)
     if settings.planner == "LIN":  # Pilz's LIN is the tool's straight line: a linear step
         spec = replace(spec, linear=True)
-    target = _target(spec, request, robot, problem.scene, checks, start)
-    search, fraction = _search(spec, settings, robot, checks, start, target)
-    path, trajectory, stats = _certified(spec, settings, robot, checks, start, target, search)
+    constraints = _path_check(spec, robot, problem.scene, checks, start)
+    target = _target(spec, request, robot, problem.scene, checks, start, constraints)
+    search, fraction = _search(spec, settings, robot, checks, start, target, constraints)
+    path, trajectory, stats = _certified(spec, settings, robot, checks, start, target, search, constraints)
     stats["path_length"] = float(np.sum(np.linalg.norm(np.diff(path.waypoints, axis=0), axis=1)))
     check_limits(robot, trajectory.positions.max(axis=0))
     check_limits(robot, trajectory.positions.min(axis=0))
@@ -127,8 +136,23 @@ def _settings(spec: StepSpec, request: PlanRequest, robot: Robot) -> _Settings:
     )
 
 
+def _path_check(
+    spec: StepSpec, robot: Robot, scene: Scene, checks: MotionChecker, start: NDArray[np.float64]
+) -> PathCheck | None:
+    """Return the step's path constraints, checked to hold at the start; None for a step without any."""
+    if spec.constraints is None:
+        return None
+    constraints = PathCheck(robot, scene, spec.constraints, robot.configuration(start, checks.base))
+    why = constraints.violation(start)
+    if why is not None:
+        raise StartViolatesConstraints(f"start state violates the path constraints of {spec.constraints.source}: "
+                                       f"{why}")
+    return constraints
+
+
 def _target(
-    spec: StepSpec, request: PlanRequest, robot: Robot, scene: Scene, checks: MotionChecker, start: NDArray[np.float64]
+    spec: StepSpec, request: PlanRequest, robot: Robot, scene: Scene, checks: MotionChecker, start: NDArray[np.float64],
+    constraints: PathCheck | None,
 ) -> _Target:
     """Return the group values a step goes to (checked free), or the pose of a link it moves to."""
     source = str(request.task.source) if request.task else "flags"
@@ -138,6 +162,9 @@ def _target(
         pair = checks.colliding_pair(values)
         if pair:
             raise GoalInCollision(pair)
+        why = constraints.violation(values) if constraints is not None else None
+        if why is not None:
+            raise GoalViolatesConstraints(f"goal state violates the path constraints: {why}")
         if spec.linear:  # Pilz's LIN to a joint goal: the tool's straight line to where the goal puts it
             return _Target(None, robot.group.tip, robot.frame_pose(robot.configuration(values, checks.base),
                                                                     robot.group.tip))
@@ -151,29 +178,35 @@ def _target(
             raise UsageError(f"{source}: a straight line moves one link; this goal places {len(also) + 1}")
         return _Target(None, link, pose)
     # Exhaustive: the first valid solution from a far start is not always the nearest one.
+    is_free = checks.state_free if constraints is None else (
+        lambda values: checks.state_free(values) and constraints.satisfied(values))
     solution = solve_ik(robot, pose, link, start, base=base, seed=request.seed, exhaustive=True,
-                        orientation_tolerance=orientation_tolerance(goal), is_free=checks.state_free,
+                        orientation_tolerance=orientation_tolerance(goal), is_free=is_free,
                         colliding_pair=checks.checker.colliding_pair, also=also)
     return _Target(solution.values, link, pose, also)
 
 
 def _search(
     spec: StepSpec, settings: _Settings, robot: Robot, checks: MotionChecker, start: NDArray[np.float64],
-    target: _Target,
+    target: _Target, constraints: PathCheck | None,
 ) -> tuple[_Search, float]:
     """Return the step's search under given collision checks, and the fraction of the way it covers.
 
-    A linear step's line is planned (and checked) here, once; the search then returns it.
+    A linear step's line is planned (and checked) here, once; the search then returns it. Joint
+    constraints narrow the bounds the search samples within.
     """
+    lower, upper = (robot.lower, robot.upper) if constraints is None else (constraints.lower, constraints.upper)
     if not spec.linear:
         goal = target.values
         assert goal is not None, "a step that is not linear has target values"
         if settings.planner == "PTP":
             return (lambda validity: _point_to_point(start, goal, validity)), 1.0
-        return (lambda validity: plan_path(start, goal, robot.lower, robot.upper, validity, settings.planner,
+        return (lambda validity: plan_path(start, goal, lower, upper, validity, settings.planner,
                                            settings.planning_time, settings.timeout)), 1.0
     assert target.pose is not None, "a linear step has a target pose"
-    line = straight_line(robot, target.link, start, target.pose, checks.base, checks.free,
+    free = checks.free if constraints is None else (
+        lambda states: checks.free(states) & np.array([constraints.satisfied(v) for v in states], dtype=bool))
+    line = straight_line(robot, target.link, start, target.pose, checks.base, free,
                          checks.checker.colliding_pair)
     if line.fraction < settings.min_fraction:
         x, y, z = line.stopped_at
@@ -195,7 +228,7 @@ def _point_to_point(start: NDArray[np.float64], goal: NDArray[np.float64], valid
 
 def _certified(
     spec: StepSpec, settings: _Settings, robot: Robot, checks: MotionChecker, start: NDArray[np.float64],
-    target: _Target, search: _Search,
+    target: _Target, search: _Search, constraints: PathCheck | None,
 ) -> tuple[PathResult, JointTrajectory, dict[str, float]]:
     """Return a path, its timed trajectory certified collision-free, and the step's statistics.
 
@@ -209,15 +242,18 @@ def _certified(
     certifier = _Certifier(robot, checks, settings)
 
     def checked(resolution: float) -> Validity:
-        return Validity(partial(checks.state_free, conservative=conservative),
-                        partial(checks.edge_free, resolution=resolution, conservative=conservative))
+        return _within(Validity(partial(checks.state_free, conservative=conservative),
+                                partial(checks.edge_free, resolution=resolution, conservative=conservative)),
+                       constraints, resolution)
 
     path = search(checked(_COARSE_RAD))
     trajectory, hit = certifier.certified(path, _COARSE_STEP_RAD)
     if hit is not None and not spec.linear and settings.planner != "PTP":
         logger.debug("trajectory collides when certified; planning its colliding segments again, finer")
         try:
-            path = repair_path(path.waypoints, robot.lower, robot.upper, checked(_FINE_RAD), settings.planner,
+            lower, upper = (robot.lower, robot.upper) if constraints is None else (constraints.lower,
+                                                                                   constraints.upper)
+            path = repair_path(path.waypoints, lower, upper, checked(_FINE_RAD), settings.planner,
                                settings.planning_time, settings.timeout)
             trajectory, hit = certifier.certified(path, _FINE_STEP_RAD)
         except PlanningTimeExceeded:
@@ -229,9 +265,24 @@ def _certified(
         path = search(checked(_FINE_RAD))
         trajectory, hit = certifier.certified(path, _FINE_STEP_RAD)
     if hit is not None:
-        path = search(Validity(checks.state_free, checks.edge_free_certified))
+        path = search(_within(Validity(checks.state_free, checks.edge_free_certified), constraints, _FINE_RAD))
         trajectory = certifier.rest_to_rest(path)
+    if constraints is not None and not all(constraints.satisfied(p) for p in trajectory.positions):
+        # Timing rounds the path's corners; stopping at each waypoint keeps to the checked edges.
+        trajectory = certifier.rest_to_rest(path)
+        why = next((w for p in trajectory.positions if (w := constraints.violation(p)) is not None), None)
+        if why is not None:
+            raise PlanningFailed(f"the path's states satisfy the path constraints, but a state between them does "
+                                 f"not: {why}")
     return path, trajectory, certifier.stats
+
+
+def _within(validity: Validity, constraints: PathCheck | None, resolution: float) -> Validity:
+    """Return `validity` that also requires every state (on an edge: every `resolution`) to satisfy `constraints`."""
+    if constraints is None:
+        return validity
+    return Validity(lambda values: validity.state_free(values) and constraints.satisfied(values),
+                    lambda a, b: validity.edge_free(a, b) and constraints.edge(a, b, resolution))
 
 
 @dataclass

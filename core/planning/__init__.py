@@ -6,11 +6,13 @@ from .._faces import lazy_exports
 
 if TYPE_CHECKING:
     from .cartesian import LinearPath, straight_line
+    from .constraints import PathCheck
     from .goals import check_limits, joint_target, orientation_tolerance, pose_error, tip_target
     from .search import PathResult, Validity, plan_path, repair_path, seed_planner
 
 __all__ = [
     "LinearPath",
+    "PathCheck",
     "PathResult",
     "Validity",
     "check_limits",
@@ -26,6 +28,7 @@ __all__ = [
 
 __getattr__ = lazy_exports(__name__, {
     "LinearPath": "cartesian",
+    "PathCheck": "constraints",
     "PathResult": "search",
     "Validity": "search",
     "check_limits": "goals",
