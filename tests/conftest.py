@@ -27,16 +27,20 @@ SAMPLES = ROOT / "samples"
 TABLE_SCENE = SAMPLES / "ur10e_table_scene.yaml"
 # Real MoveIt 2 config packages as a colcon workspace's src/ (tools/get_realworld.sh builds one).
 REALWORLD = Path(os.environ.get("MOVEPLAN_REALWORLD") or ROOT.parent / "shared" / "realworld" / "src").resolve()
+# MoveIt 1's moveit_resources (fanuc, panda, dual panda), where MoveIt's Python tests run; part of that tier.
+NOETIC = Path(os.environ.get("MOVEPLAN_NOETIC")
+              or ROOT.parent / "shared" / "peers" / "moveit_resources_noetic").resolve()
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Leave out the real-world tier where its workspace is missing; under CI=true, fail the run instead."""
     tier = [item for item in items if item.get_closest_marker("realworld")]
-    if not tier or REALWORLD.is_dir():
+    missing = [folder for folder in (REALWORLD, NOETIC) if not folder.is_dir()]
+    if not tier or not missing:
         return
     if os.environ.get("CI", "").lower() == "true":
-        raise pytest.UsageError(f"{REALWORLD}: the real-world MoveIt workspace is missing, and CI=true requires "
-                                f"its {len(tier)} tests; {_HOW_TO_GET_REALWORLD}")
+        raise pytest.UsageError(f"{', '.join(map(str, missing))}: the real-world MoveIt workspace is missing, and "
+                                f"CI=true requires its {len(tier)} tests; {_HOW_TO_GET_REALWORLD}")
     config.hook.pytest_deselected(items=tier)
     items[:] = [item for item in items if not item.get_closest_marker("realworld")]
     config.stash[_LEFT_OUT] = len(tier)
@@ -44,7 +48,8 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 
 _LEFT_OUT = pytest.StashKey[int]()
 _HOW_TO_GET_REALWORLD = ("`bash tools/get_realworld.sh DIR` builds it from the public repositories "
-                         "(network needed), then set MOVEPLAN_REALWORLD=DIR/src")
+                         "(network needed), then set MOVEPLAN_REALWORLD=DIR/src and "
+                         "MOVEPLAN_NOETIC=DIR/peers/moveit_resources_noetic")
 
 
 def pytest_terminal_summary(terminalreporter: Any, exitstatus: int, config: pytest.Config) -> None:
@@ -52,7 +57,7 @@ def pytest_terminal_summary(terminalreporter: Any, exitstatus: int, config: pyte
     left_out = config.stash.get(_LEFT_OUT, 0)
     if left_out:
         terminalreporter.write_line(f"real-world tier not run ({left_out} tests): no MoveIt workspace at "
-                                    f"{REALWORLD}; {_HOW_TO_GET_REALWORLD}")
+                                    f"{REALWORLD} or {NOETIC}; {_HOW_TO_GET_REALWORLD}")
 
 
 @pytest.fixture(scope="session")

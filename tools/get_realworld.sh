@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Build the real-world test tier's workspace: eleven public MoveIt 2 config packages and the
 # description packages they name, at the commits the tier was written against, laid out as an
-# unbuilt colcon workspace's src/ (as their users have them).
+# unbuilt colcon workspace's src/ (as their users have them); and, beside it in DIR/peers, MoveIt 1's
+# moveit_resources (fanuc, panda, dual panda: the robots MoveIt's own Python tests run on).
 #
-#   bash tools/get_realworld.sh DIR          # then: MOVEPLAN_REALWORLD=DIR/src bash .ci/run
+#   bash tools/get_realworld.sh DIR
+#   MOVEPLAN_REALWORLD=DIR/src MOVEPLAN_NOETIC=DIR/peers/moveit_resources_noetic bash .ci/run
 #
 # Needs git and a network. Each repository is cloned once into DIR/repos, checked out at its
 # pinned commit, and only the listed folders are copied into DIR/src/<folder>.
@@ -37,19 +39,24 @@ packages=(
     "pal_robotiq_gripper|pal-robotics/pal_robotiq_gripper|f23e1101|LICENSE pal_robotiq_description"
 )
 
-mkdir -p "$dir/repos" "$dir/src"
-for entry in "${packages[@]}"; do
-    IFS="|" read -r folder repository commit paths <<<"$entry"
+# Outside src/: their package names are the ROS 2 moveit_resources' too, and a workspace holds one of each.
+peers=(
+    "moveit_resources_noetic|moveit/moveit_resources|b771644|fanuc_description fanuc_moveit_config panda_description panda_moveit_config dual_panda_moveit_config"
+)
+
+mkdir -p "$dir/repos" "$dir/src" "$dir/peers"
+for entry in "${packages[@]/#/src|}" "${peers[@]/#/peers|}"; do
+    IFS="|" read -r place folder repository commit paths <<<"$entry"
     clone="$dir/repos/${repository//\//+}"
     if [[ ! -d "$clone/.git" ]]; then
         git clone --quiet "$base/$repository.git" "$clone"
     fi
     git -C "$clone" -c advice.detachedHead=false checkout --quiet "$commit"
-    rm -rf "${dir:?}/src/$folder"
+    rm -rf "${dir:?}/$place/$folder"
     for path in $paths; do
-        mkdir -p "$(dirname "$dir/src/$folder/$path")"
-        cp -R "$clone/$path" "$dir/src/$folder/$path"
+        mkdir -p "$(dirname "$dir/$place/$folder/$path")"
+        cp -R "$clone/$path" "$dir/$place/$folder/$path"
     done
-    echo "$folder: $repository @ $commit"
+    echo "$place/$folder: $repository @ $commit"
 done
-echo "workspace ready: MOVEPLAN_REALWORLD=$dir/src bash .ci/run"
+echo "workspace ready: MOVEPLAN_REALWORLD=$dir/src MOVEPLAN_NOETIC=$dir/peers/moveit_resources_noetic bash .ci/run"
