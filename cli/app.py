@@ -109,7 +109,7 @@ def plan(
     linear: Annotated[bool, typer.Option("--linear", help="Move the tip along a straight line.")] = False,
     min_fraction: Annotated[str | None, typer.Option(help="With --linear: fail below this fraction (1).")] = None,
     planner: Annotated[str | None, typer.Option(
-        help="OMPL geometric planner (default RRTConnect); Pilz's PTP (joint-space line), LIN (tool line).")] = None,
+        help="OMPL geometric planner (default RRTConnect); Pilz's PTP (joint line), LIN (tool line), CIRC.")] = None,
     planning_time: Annotated[str | None, typer.Option(
         help="The search's budget per step, in seconds at 20,000 checked motions a second (not wall time).")] = None,
     timeout: TimeoutOpt = None,

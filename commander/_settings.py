@@ -88,17 +88,15 @@ class PlanningSettings:
         return self._resolved().planner
 
     def set_planner_id(self, planner_id: str) -> None:
-        """Plan with an OMPL geometric planner ("RRTConnect", MoveIt's "RRTConnectkConfigDefault") or Pilz's PTP, LIN.
+        """Plan with an OMPL geometric planner ("RRTConnect", "RRTConnectkConfigDefault") or Pilz's PTP, LIN, CIRC.
 
         "" goes back to the planning pipeline's default: the robot config's planner for OMPL,
-        PTP for Pilz's. Return None.
+        PTP for Pilz's. CIRC takes its interim or center point from the path constraints, as
+        Pilz does. Return None.
         """
         if not isinstance(planner_id, str):
             raise UsageError(f"set_planner_id: expected a planner's name, got {planner_id!r}")
         name = planner_id.removeprefix("geometric::").removesuffix("kConfigDefault")
-        if name == "CIRC":
-            raise UsageError("set_planner_id('CIRC'): Pilz's circular motion is not supported; give the arc's "
-                             "points to compute_cartesian_path")
         if name and name not in (*PLANNERS, *PILZ_PLANNERS):
             raise UsageError(f"set_planner_id: unknown planner '{planner_id}'; OMPL geometric planners: "
                              f"{known(PLANNERS)}; Pilz's: {', '.join(PILZ_PLANNERS)}")

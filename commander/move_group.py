@@ -27,6 +27,8 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from ..core.config import (
+    ARC_POINTS,
+    PILZ_PLANNERS,
     SHIFT_AXES,
     Goal,
     JointGoal,
@@ -35,6 +37,7 @@ from ..core.config import (
     PositionGoal,
     ShiftGoal,
     StepSpec,
+    arc_point,
     default_position,
     path_constraints,
     pose_matrix,
@@ -435,7 +438,7 @@ class MoveGroupCommander(PlanningSettings):
         self._set_target(joints)
         step, error, seconds = self._plan_step()
         return error is None, to_message(step, self.get_planning_frame()), seconds, \
-            error_code(error, pilz=self._resolved().planner in ("PTP", "LIN"))
+            error_code(error, pilz=self._resolved().planner in PILZ_PLANNERS)
 
     def go(self, joints: Any = None, wait: bool = True) -> bool:
         """Return True if planning to the target (or `joints`, set first) and executing the plan both succeeded."""
@@ -648,11 +651,14 @@ class MoveGroupCommander(PlanningSettings):
     def _plan_step(self) -> tuple[StepResult | None, NoPlan | None, float]:
         """Return the step planned to the target, or the reason there is none, and the time spent [s]."""
         goal = self._goal()
-        constraints = None
-        if self._constraints is not None:
+        constraints, arc = None, None
+        if self._constraints is not None and self._constraints.name in ARC_POINTS and \
+                self._resolved().planner == "CIRC":  # Pilz's CIRC reads its point from the path constraints
+            arc = arc_point(plain(self._constraints), "set_path_constraints")
+        elif self._constraints is not None:
             constraints = path_constraints(plain(self._constraints), "set_path_constraints")
         q = self._start_q()
-        spec = StepSpec(_step_name(goal), goal, constraints=constraints)
+        spec = StepSpec(_step_name(goal), goal, constraints=constraints, arc=arc)
         began = time.perf_counter()
         try:
             step = plan_motion(self._world.problem(self._robot, q), spec, q, self._settings(), self._world.seed)

@@ -11,7 +11,16 @@ from .._faces import lazy_exports
 if TYPE_CHECKING:
     from ._initial_state import default_position
     from .collision_objects import AttachedMessage, ObjectMessage, attached_collision_object, collision_object
-    from .constraints import JointBound, OrientationBound, PathConstraints, PositionBound, path_constraints
+    from .constraints import (
+        ARC_POINTS,
+        ArcPoint,
+        JointBound,
+        OrientationBound,
+        PathConstraints,
+        PositionBound,
+        arc_point,
+        path_constraints,
+    )
     from .controllers import ControllerConfig, ExecutionConfig, default_controller, parse_controllers
     from .controllers_write import tuned_controllers_text
     from .embed import check_carried
@@ -53,6 +62,7 @@ if TYPE_CHECKING:
     from .xacro import PackagePath, parse_xacro_args
 
 __all__ = [
+    "ARC_POINTS",
     "CONFIG_FILE",
     "DEFAULT_ACCELERATION",
     "MAX_MAGNITUDE",
@@ -63,6 +73,7 @@ __all__ = [
     "PLANNING_SCENE_KEYS",
     "SHIFT_AXES",
     "AllowedCollisions",
+    "ArcPoint",
     "AttachedMessage",
     "ControllerConfig",
     "ExecutionConfig",
@@ -92,6 +103,7 @@ __all__ = [
     "StepSpec",
     "TaskFile",
     "angle",
+    "arc_point",
     "attached_collision_object",
     "check_carried",
     "check_joint_units",
@@ -129,6 +141,7 @@ __all__ = [
 ]
 
 __getattr__ = lazy_exports(__name__, {
+    "ARC_POINTS": "constraints",
     "CONFIG_FILE": "sources",
     "DEFAULT_ACCELERATION": "limits",
     "MAX_MAGNITUDE": "fields",
@@ -139,6 +152,7 @@ __getattr__ = lazy_exports(__name__, {
     "PLANNING_SCENE_KEYS": "planning_scene_yaml",
     "SHIFT_AXES": "goals",
     "AllowedCollisions": "planning_scene_yaml",
+    "ArcPoint": "constraints",
     "AttachedMessage": "collision_objects",
     "ControllerConfig": "controllers",
     "ExecutionConfig": "controllers",
@@ -168,6 +182,7 @@ __getattr__ = lazy_exports(__name__, {
     "StepSpec": "tasks",
     "TaskFile": "tasks",
     "angle": "fields",
+    "arc_point": "constraints",
     "attached_collision_object": "collision_objects",
     "check_carried": "embed",
     "check_joint_units": "joint_units",

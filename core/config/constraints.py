@@ -28,7 +28,11 @@ from ..types import Shape, frozen_array
 from .fields import MAX_MAGNITUDE, check_keys, mapping, number
 from .ros_messages import header_frame, point, pose, quaternion, yaml_list
 
-__all__ = ["JointBound", "OrientationBound", "PathConstraints", "PositionBound", "path_constraints"]
+__all__ = ["ARC_POINTS", "ArcPoint", "JointBound", "OrientationBound", "PathConstraints", "PositionBound", "arc_point",
+           "path_constraints"]
+
+ARC_POINTS = ("interim", "center")
+"""Names of Constraints that give Pilz's CIRC its third point instead of constraining the path."""
 
 _KEYS = {"name", "joint_constraints", "position_constraints", "orientation_constraints", "visibility_constraints"}
 _JOINT_KEYS = {"joint_name", "position", "tolerance_above", "tolerance_below", "weight"}
@@ -89,6 +93,45 @@ class PathConstraints:
                                   "tolerance": list(b.tolerance)} for b in self.orientations],
                 "positions": [{"link": b.link, "frame": b.frame, "offset": list(b.offset),
                                "shapes": len(b.region)} for b in self.positions]}
+
+
+@dataclass(frozen=True)
+class ArcPoint:
+    """Pilz's CIRC point: the arc passes through it ("interim") or turns about it ("center"); in `frame` [m]."""
+
+    kind: str
+    xyz: tuple[float, float, float]
+    frame: str
+
+
+def arc_point(value: Any, where: str) -> ArcPoint:
+    """Return the point of a Constraints named "interim" or "center", as Pilz's CIRC reads it.
+
+    The point is the first primitive pose of the one position constraint's region, in its header frame.
+
+    Raises:
+        ConfigError: Another name, or not exactly one position constraint with a region pose.
+    """
+    entry = mapping(value, where)
+    check_keys(entry, _KEYS, where)
+    name = entry.get("name")
+    if name not in ARC_POINTS:
+        raise ConfigError(f"{where}.name: Pilz's CIRC takes its point from constraints named 'interim' or 'center', "
+                          f"got {name!r}")
+    items = yaml_list(entry.get("position_constraints"), f"{where}.position_constraints")
+    if len(items) != 1:
+        raise ConfigError(f"{where}.position_constraints: CIRC's {name} point is one position constraint, got "
+                          f"{len(items)}")
+    item = mapping(items[0], f"{where}.position_constraints[0]")
+    region = mapping(item.get("constraint_region"), f"{where}.position_constraints[0].constraint_region")
+    poses = yaml_list(region.get("primitive_poses"), f"{where}.position_constraints[0].constraint_region"
+                      ".primitive_poses")
+    if not poses:
+        raise ConfigError(f"{where}.position_constraints[0].constraint_region.primitive_poses: CIRC's {name} "
+                          "point is the first pose's position; there is none")
+    xyz = pose(poses[0], f"{where}.position_constraints[0].constraint_region.primitive_poses[0]")[:3, 3]
+    frame = header_frame(item, f"{where}.position_constraints[0]", "")
+    return ArcPoint(str(name), (float(xyz[0]), float(xyz[1]), float(xyz[2])), frame)
 
 
 def path_constraints(value: Any, where: str) -> PathConstraints | None:

@@ -41,7 +41,7 @@ from numpy.typing import NDArray
 
 from ..errors import ConfigError, known
 from .collision_objects import attached_object
-from .constraints import path_constraints
+from .constraints import ARC_POINTS, arc_point, path_constraints
 from .fields import MAX_MAGNITUDE, check_keys, coordinate, load_yaml, mapping, number, read_input
 from .goals import JointGoal, PoseGoal
 from .motion import MIN_SCALING, MotionSettings
@@ -141,9 +141,15 @@ def load_motion_plan_request(path: Path) -> MotionPlanRequest:
         logger.warning("%s: goal_constraints has %d alternatives; moveplan plans to the first",
                        source, len(alternatives))
     goal = None
-    constraints = path_constraints(top.get("path_constraints") or {}, f"{source}: path_constraints")
+    written = top.get("path_constraints") or {}
+    arc, constraints = None, None
+    if top.get("planner_id") == "CIRC" and isinstance(written, dict) and written.get("name") in ARC_POINTS:
+        arc = arc_point(written, f"{source}: path_constraints")  # Pilz's CIRC: its point, not a constraint
+    else:
+        constraints = path_constraints(written, f"{source}: path_constraints")
     if alternatives:
-        goal = StepSpec(path.stem, _goal(alternatives[0], f"{source}: goal_constraints[0]"), constraints=constraints)
+        goal = StepSpec(path.stem, _goal(alternatives[0], f"{source}: goal_constraints[0]"), constraints=constraints,
+                        arc=arc)
 
     group = top.get("group_name", "")
     if not isinstance(group, str):

@@ -13,7 +13,8 @@ PLANNERS = (
     "RRT", "RRTConnect", "RRTstar", "SORRTstar",
 )
 
-PILZ_PLANNERS = ("PTP", "LIN")
+PILZ_PLANNERS = ("PTP", "LIN", "CIRC")
 """MoveIt's pilz_industrial_motion_planner, as moveplan plans them: PTP the straight line in joint space
 (collision-checked, never planned around an obstacle), LIN the straight line of the tool to the goal pose
-(a joint goal's pose, for a joint goal), as `--linear` plans it. Each fails where its line collides."""
+(a joint goal's pose, for a joint goal), as `--linear` plans it, CIRC the tool's circular arc to the goal
+through an interim point or about a center. Each fails where its path collides."""

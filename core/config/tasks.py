@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from .constraints import PathConstraints, path_constraints
+from .constraints import ArcPoint, PathConstraints, path_constraints
 from .fields import (
     MAX_MAGNITUDE,
     angle,
@@ -26,6 +26,7 @@ from .fields import (
 )
 from .goals import GOAL_KINDS, SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
 from .motion import MIN_SCALING, MotionSettings, is_scaling
+from .poses import vector
 from .sources import shipped_config
 
 __all__ = [
@@ -38,7 +39,7 @@ MAX_SEED = 2**32 - 1
 
 _TASK_KEYS = {"robot", "scene", "group", "start", "defaults", "steps", "seed"}
 _DEFAULT_KEYS = {f.name for f in fields(MotionSettings)}
-_STEP_KEYS = {"name", "linear", "min_fraction", "path_constraints", *GOAL_KINDS, *_DEFAULT_KEYS}
+_STEP_KEYS = {"name", "linear", "min_fraction", "path_constraints", "arc", *GOAL_KINDS, *_DEFAULT_KEYS}
 _POSE_KEYS = {"frame", "xyz", "rpy", "quat", "link"}
 
 
@@ -56,6 +57,7 @@ class StepSpec:
     min_fraction: float | None = None
     motion: MotionSettings = MotionSettings()
     constraints: PathConstraints | None = None
+    arc: ArcPoint | None = None  # Pilz's CIRC: the point the arc passes through or turns about
 
 
 @dataclass(frozen=True)
@@ -71,6 +73,20 @@ class TaskFile:
     steps: tuple[StepSpec, ...]
     seed: int | None = None
     raw: bytes = field(default=b"", repr=False)
+
+
+def _arc(value: Any, where: str) -> ArcPoint:
+    """Return a step's `arc: {center | interim: [x, y, z], frame: ...}`, the point of planner CIRC."""
+    entry = mapping(value, where)
+    check_keys(entry, {"center", "interim", "frame"}, where)
+    kinds = [k for k in ("center", "interim") if k in entry]
+    if len(kinds) != 1:
+        raise ConfigError(f"{where}: give one of center and interim (the point the arc turns about or passes)")
+    xyz = vector(entry[kinds[0]], 3, f"{where}.{kinds[0]}")
+    frame = entry.get("frame", "")
+    if not isinstance(frame, str):
+        raise ConfigError(f"{where}.frame: expected a frame name, got {frame!r}")
+    return ArcPoint(kinds[0], (float(xyz[0]), float(xyz[1]), float(xyz[2])), frame)
 
 
 def parse_scaling(value: Any, where: str) -> float:
@@ -222,8 +238,9 @@ def load_task(path: Path) -> TaskFile:
             raise ConfigError(f"{where}: linear applies to pose and shift goals, not {goal.kind}")
         constraints = (path_constraints(entry["path_constraints"], f"{where}.path_constraints")
                        if "path_constraints" in entry else None)
+        arc = _arc(entry["arc"], f"{where}.arc") if "arc" in entry else None
         steps.append(StepSpec(name=name, goal=goal, linear=linear, min_fraction=min_fraction,
-                              motion=_motion(entry, where), constraints=constraints))
+                              motion=_motion(entry, where), constraints=constraints, arc=arc))
     names = [s.name for s in steps]
     for name in names:
         if names.count(name) > 1:

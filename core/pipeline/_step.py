@@ -101,11 +101,15 @@ def plan_step(
     began = time.perf_counter()
     robot, checks = problem.robot, problem.checks
     settings = _settings(spec, request, robot)
-    if settings.planner == "LIN":  # Pilz's LIN is the tool's straight line: a linear step
+    if settings.planner in ("LIN", "CIRC"):  # Pilz's: the tool's straight line, or its arc
         spec = replace(spec, linear=True)
+    if settings.planner == "CIRC" and spec.arc is None:
+        raise UsageError("CIRC needs the point its arc passes through or turns about: a task step's "
+                         "`arc: {center | interim: [x, y, z]}`, or path constraints named 'interim' or 'center' "
+                         "with one position constraint, as Pilz takes them")
     constraints = _path_check(spec, robot, problem.scene, checks, start)
     target = _target(spec, request, robot, problem.scene, checks, start, constraints)
-    search, fraction = _search(spec, settings, robot, checks, start, target, constraints)
+    search, fraction = _search(spec, settings, robot, problem.scene, checks, start, target, constraints)
     path, trajectory, stats = _certified(spec, settings, robot, checks, start, target, search, constraints)
     stats["path_length"] = float(np.sum(np.linalg.norm(np.diff(path.waypoints, axis=0), axis=1)))
     check_limits(robot, trajectory.positions.max(axis=0))
@@ -187,8 +191,8 @@ def _target(
 
 
 def _search(
-    spec: StepSpec, settings: _Settings, robot: Robot, checks: MotionChecker, start: NDArray[np.float64],
-    target: _Target, constraints: PathCheck | None,
+    spec: StepSpec, settings: _Settings, robot: Robot, scene: Scene, checks: MotionChecker,
+    start: NDArray[np.float64], target: _Target, constraints: PathCheck | None,
 ) -> tuple[_Search, float]:
     """Return the step's search under given collision checks, and the fraction of the way it covers.
 
@@ -206,14 +210,20 @@ def _search(
     assert target.pose is not None, "a linear step has a target pose"
     free = checks.free if constraints is None else (
         lambda states: checks.free(states) & np.array([constraints.satisfied(v) for v in states], dtype=bool))
+    arc = None
+    if settings.planner == "CIRC" and spec.arc is not None:
+        anchor, anchor_T_frame = scene.anchor(spec.arc.frame or robot.root_link, robot)
+        root_T_frame = robot.frame_pose(robot.configuration(start, checks.base), anchor) @ anchor_T_frame
+        arc = (spec.arc.kind, root_T_frame[:3, :3] @ np.array(spec.arc.xyz) + root_T_frame[:3, 3])
     line = straight_line(robot, target.link, start, target.pose, checks.base, free,
-                         checks.checker.colliding_pair)
+                         checks.checker.colliding_pair, arc)
     if line.fraction < settings.min_fraction:
         x, y, z = line.stopped_at
         raise PlanningFailed(f"straight line achieved {line.fraction:.1%} of the way (minimum "
                              f"{settings.min_fraction:.0%}): {line.reason}; stopped at [{x:.4f}, {y:.4f}, {z:.4f}] "
                              f"in {robot.root_link}")
-    line_path = PathResult(np.asarray(line.waypoints), "linear", 0.0, 0.0)
+    line_path = PathResult(np.asarray(line.waypoints), settings.planner if settings.planner in ("LIN", "CIRC")
+                           else "linear", 0.0, 0.0)
     return (lambda validity: line_path), line.fraction  # the line is already checked
 
 

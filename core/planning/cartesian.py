@@ -10,13 +10,14 @@ the path short; the fraction achieved is reported with the reason.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import GoalUnreachable
+from ..errors import GoalUnreachable, PlanningFailed
 from ..model import Robot, solve_ik
 from ..rotations import matrix_from_rotation_vector, rotation_vector
 from ..trajectory import interpolate
@@ -31,6 +32,7 @@ _PRECISION_M = 0.001
 _PRECISION_RAD = 0.01
 _MIN_INTERVAL = 1e-5
 _CHECK_RESOLUTION = 0.005
+_ARC_TOLERANCE_M = 1e-5  # start and goal this close to one circle about a CIRC center; points this far off a line
 
 
 @dataclass(frozen=True)
@@ -62,16 +64,23 @@ def straight_line(
     base: NDArray[np.float64],
     free_batch: Callable[[NDArray[np.float64]], NDArray[np.bool_]],
     colliding_pair: Callable[[NDArray[np.float64]], tuple[str, str] | None],
+    arc: tuple[str, NDArray[np.float64]] | None = None,
 ) -> LinearPath:
-    """Return the joint path moving `link` in a straight line from where it is to `target` (root frame)."""
+    """Return the joint path moving `link` in a straight line from where it is to `target` (root frame).
+
+    With `arc` ("interim" or "center", a point in the root frame), the link's origin moves on the
+    circle through the interim point, or about the center (the shorter way), as Pilz's CIRC;
+    the orientation turns as on a line. Raises PlanningFailed for a circle the points do not make.
+    """
     origin = robot.frame_pose(robot.configuration(start, base), link)
     rotation = rotation_vector(origin[:3, :3].T @ target[:3, :3])
-    distance = float(np.linalg.norm(target[:3, 3] - origin[:3, 3]))
+    position_at, distance = _line(origin[:3, 3], target[:3, 3]) if arc is None else _circle(
+        origin[:3, 3], target[:3, 3], *arc)
     count = max(1, int(np.ceil(max(distance / _STEP_M, float(np.linalg.norm(rotation)) / _STEP_RAD))))
 
     def pose_at(s: float) -> NDArray[np.float64]:
         pose = np.eye(4)
-        pose[:3, 3] = origin[:3, 3] + s * (target[:3, 3] - origin[:3, 3])
+        pose[:3, 3] = position_at(s)
         pose[:3, :3] = origin[:3, :3] @ matrix_from_rotation_vector(s * rotation)
         return pose
 
@@ -91,6 +100,61 @@ def straight_line(
             waypoints.append(values)
         reached = k / count
     return LinearPath(np.array(waypoints), 1.0, "", target[:3, 3])
+
+
+def _line(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[Callable[[float], NDArray[np.float64]], float]:
+    """Return the position at s in [0, 1] along the segment a-b, and its length [m]."""
+    return (lambda s: a + s * (b - a)), float(np.linalg.norm(b - a))
+
+
+def _circle(
+    a: NDArray[np.float64], b: NDArray[np.float64], kind: str, point: NDArray[np.float64]
+) -> tuple[Callable[[float], NDArray[np.float64]], float]:
+    """Return the position at s in [0, 1] along Pilz's CIRC arc from a to b, and the arc's length [m].
+
+    "center": about `point`, the shorter way (a and b the same distance from it, not opposite);
+    "interim": the circle through a, `point` and b, passing `point`.
+    """
+    if kind == "center":
+        center = point
+        ra, rb = a - center, b - center
+        if abs(np.linalg.norm(ra) - np.linalg.norm(rb)) > _ARC_TOLERANCE_M:
+            raise PlanningFailed(f"CIRC: start and goal are {np.linalg.norm(ra):.4f} m and {np.linalg.norm(rb):.4f} m "
+                                 "from the center; a circle needs them the same distance from it")
+        normal = np.cross(ra, rb)
+        if np.linalg.norm(normal) < _ARC_TOLERANCE_M * max(float(np.linalg.norm(ra)), 1e-9):
+            raise PlanningFailed("CIRC: start, center and goal lie on one line; the circle's plane is not defined "
+                                 "(give an interim point instead)")
+        angle = math.atan2(float(np.linalg.norm(normal)), float(ra @ rb))
+    else:
+        normal = np.cross(point - a, b - a)
+        if np.linalg.norm(normal) < _ARC_TOLERANCE_M * max(float(np.linalg.norm(b - a)), 1e-9):
+            raise PlanningFailed("CIRC: start, interim point and goal lie on one line; no circle passes through them")
+        center = _circumcenter(a, point, b)
+        ra = a - center
+        angle = _angle_about(ra, b - center, normal / np.linalg.norm(normal))
+    axis = normal / np.linalg.norm(normal)
+    radius = float(np.linalg.norm(ra))
+
+    def position_at(s: float) -> NDArray[np.float64]:
+        turn = s * angle
+        return center + ra * math.cos(turn) + np.cross(axis, ra) * math.sin(turn) + axis * (axis @ ra) * (
+            1.0 - math.cos(turn))
+
+    return position_at, radius * angle
+
+
+def _circumcenter(a: NDArray[np.float64], b: NDArray[np.float64], c: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Return the center of the circle through three points that are not on one line."""
+    ab, ac = b - a, c - a
+    n = np.cross(ab, ac)
+    return a + (np.cross(n, ab) * (ac @ ac) + np.cross(ac, n) * (ab @ ab)) / (2.0 * (n @ n))
+
+
+def _angle_about(u: NDArray[np.float64], v: NDArray[np.float64], axis: NDArray[np.float64]) -> float:
+    """Return the angle in (0, 2 pi) turning u to v counterclockwise about `axis`."""
+    angle = math.atan2(float(axis @ np.cross(u, v)), float(u @ v))
+    return angle if angle > 0 else angle + 2 * math.pi
 
 
 class _Stop(Exception):

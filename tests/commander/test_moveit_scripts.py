@@ -249,8 +249,6 @@ def test_pilz_ptp_moves_straight_in_joint_space_and_lin_the_tool_straight() -> N
     goal = group.get_current_pose().pose
     goal.position.x += 0.1
     assert group.go(goal)
-    with pytest.raises(UsageError, match="CIRC"):
-        group.set_planner_id("CIRC")
 
 
 def test_pilz_reports_a_colliding_goal_as_an_invalid_motion_plan() -> None:
@@ -410,3 +408,42 @@ def test_a_failed_go_says_why_on_stderr_without_any_logging_set_up(tmp_path: Pat
     run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, check=True)
     assert run.stdout.strip() == "False"
     assert "plan: " in run.stderr and "collision" in run.stderr
+
+
+def _circ_point(group: moveit_commander.MoveGroupCommander, kind: str, point: np.ndarray) -> Constraints:
+    """Return Pilz's CIRC point as MoveIt 2 users send it: constraints named "center" or "interim"."""
+    region = moveit_commander.msgs.BoundingVolume(primitive_poses=[Pose()])
+    position = region.primitive_poses[0].position
+    position.x, position.y, position.z = (float(v) for v in point)
+    constraint = moveit_commander.msgs.PositionConstraint(link_name=group.get_end_effector_link(),
+                                                          constraint_region=region)
+    constraint.header.frame_id = "base_link"
+    return Constraints(name=kind, position_constraints=[constraint])
+
+
+@pytest.mark.parametrize("kind", ["center", "interim"])
+def test_pilz_circ_moves_the_tool_on_a_circle(kind: str) -> None:
+    # pilz_industrial_motion_planner's CIRC: the point comes from path constraints named "center" or "interim".
+    group = moveit_commander.RobotCommander("ur10e").get_group("manipulator")
+    group.go("ready")
+    start = group.get_current_pose()
+    origin = np.array([start.pose.position.x, start.pose.position.y, start.pose.position.z])
+    center = origin + [0.0, 0.1, 0.0]
+    goal = group.get_current_pose()
+    goal.pose.position.y += 0.1
+    goal.pose.position.z += 0.1
+    point = center if kind == "center" else center + 0.1 * np.array([0.0, -np.sqrt(0.5), np.sqrt(0.5)])
+    group.set_path_constraints(_circ_point(group, kind, point))
+    group.set_planning_pipeline_id("pilz_industrial_motion_planner")
+    group.set_planner_id("CIRC")
+    success, plan, _, _ = group.plan(goal)
+    assert success
+    model = group._robot
+    radii = [np.linalg.norm(model.frame_pose(model.configuration(np.array(p.positions)), "tool0")[:3, 3] - center)
+             for p in plan.joint_trajectory.points]
+    assert min(radii) == pytest.approx(0.1, abs=1e-3) and max(radii) == pytest.approx(0.1, abs=1e-6)
+    across = group.get_current_pose()
+    across.pose.position.y += 0.2  # start, center and goal on one line: no plane for the circle
+    group.set_path_constraints(_circ_point(group, "center", center))
+    success, _, _, error = group.plan(across)
+    assert not success and "on one line" in error.message

@@ -8,6 +8,7 @@ inside a region. A start or goal outside them is refused with MoveIt's error.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -91,3 +92,28 @@ def test_a_start_outside_the_constraints_is_moveits_start_state_error() -> None:
     assert group.go([0.0, -1.2, 1.4, -1.6, -1.5, 0.1])
     with pytest.raises(moveit_commander.MoveItCommanderException, match="no constraints database|warehouse"):
         group.set_path_constraints("upright")
+
+
+def test_a_task_step_plans_pilz_circ_about_a_center(cli: Cli, tmp_path: Path) -> None:
+    # The ready pose's tool0 is at [0.6914, 0.17415, 0.67685]: a quarter circle up and across, 10 cm about a center.
+    center = np.array([0.6914, 0.27415, 0.67685])
+    path = tmp_path / "circ.yaml"
+    path.write_text(yaml.safe_dump({"robot": "ur10e", "start": {"named": "ready"}, "steps": [{
+        "name": "quarter", "pose": {"xyz": [0.6914, 0.27415, 0.77685], "rpy": ["pi", 0, "-pi/2"]},
+        "planner": "CIRC", "arc": {"center": center.tolist()}}]}))
+    out = tmp_path / "circ.mcap"
+    result = cli("plan", path, "-o", out, "--json")
+    assert result.exit_code == 0, result.stderr
+    assert json.loads(result.stdout)["steps"][0]["planner"] == "CIRC"
+    step = read_plan(out).steps[0]
+    robot = moveit_commander.RobotCommander("ur10e").manipulator._robot
+    radii = [np.linalg.norm(robot.frame_pose(robot.configuration(p), "tool0")[:3, 3] - center)
+             for p in step.trajectory.positions]
+    assert max(radii) == pytest.approx(0.1, abs=1e-6)
+
+
+def test_circ_without_its_point_is_a_usage_error(cli: Cli, tmp_path: Path) -> None:
+    path = tmp_path / "circ.yaml"
+    path.write_text(yaml.safe_dump({"robot": "ur10e", "steps": [{"name": "s", "named": "home", "planner": "CIRC"}]}))
+    result = cli("plan", path, "-o", tmp_path / "x.mcap")
+    assert result.exit_code == 2 and "CIRC needs the point its arc passes through" in result.stderr
