@@ -318,19 +318,11 @@ class MoveGroupCommander(PlanningSettings):
 
     def set_rpy_target(self, rpy: Sequence[float], end_effector_link: str = "") -> None:
         """Set a pose target: the current position, orientation [roll, pitch, yaw] (fixed axes); return None."""
-        if isinstance(rpy, str) or not hasattr(rpy, "__len__") or len(rpy) != 3:
-            raise UsageError(f"set_rpy_target: expected [roll, pitch, yaw], got {rpy!r}")
-        link = self._link(end_effector_link or self._eef, "set_rpy_target")
-        position = pose_to_list(self.get_current_pose(link).pose)[:3]
-        self._set_pose(link, pose_goal([*position, *rpy], link, self._robot.root_link, "set_rpy_target"))
+        self._set_orientation(rpy, 3, end_effector_link, "set_rpy_target: expected [roll, pitch, yaw]")
 
     def set_orientation_target(self, q: Sequence[float], end_effector_link: str = "") -> None:
         """Set a pose target: the current position, orientation the quaternion [x, y, z, w]; return None."""
-        if isinstance(q, str) or not hasattr(q, "__len__") or len(q) != 4:
-            raise UsageError(f"set_orientation_target: expected a quaternion [x, y, z, w], got {q!r}")
-        link = self._link(end_effector_link or self._eef, "set_orientation_target")
-        position = pose_to_list(self.get_current_pose(link).pose)[:3]
-        self._set_pose(link, pose_goal([*position, *q], link, self._robot.root_link, "set_orientation_target"))
+        self._set_orientation(q, 4, end_effector_link, "set_orientation_target: expected a quaternion [x, y, z, w]")
 
     def set_random_target(self) -> None:
         """Set the joint target to random values within the limits; return None."""
@@ -596,6 +588,15 @@ class MoveGroupCommander(PlanningSettings):
         self._joint_target = np.array(values, dtype=float)
         self._pose_targets.clear()
         self._named = None
+
+    def _set_orientation(self, orientation: Any, size: int, link: str, expected: str) -> None:
+        """Set a pose target at the link's current position with `orientation` (rpy or quaternion)."""
+        where = expected.split(":")[0]
+        if isinstance(orientation, str) or not hasattr(orientation, "__len__") or len(orientation) != size:
+            raise UsageError(f"{expected}, got {orientation!r}")
+        link = self._link(link or self._eef, where)
+        position = pose_to_list(self.get_current_pose(link).pose)[:3]
+        self._set_pose(link, pose_goal([*position, *orientation], link, self._robot.root_link, where))
 
     def _set_pose(self, link: str, goal: Goal) -> None:
         """Make `goal` the pose target of `link` (the others stay: one target per end-effector link)."""
