@@ -16,8 +16,8 @@ plan or execution is logged at WARNING, which Python shows on stderr unless the 
 configures logging otherwise. docs/python.md has the whole API.
 """
 
-from ..core.errors import MoveplanError
 from . import conversions, msgs, ros
+from .exception import MoveItCommanderException
 from .move_group import MoveGroupCommander
 from .robot import RobotCommander
 from .scene import PlanningSceneInterface
@@ -26,10 +26,6 @@ __all__ = [
     "MoveGroupCommander", "MoveItCommanderException", "PlanningSceneInterface", "RobotCommander", "conversions",
     "msgs", "ros", "roscpp_initialize", "roscpp_shutdown",
 ]
-
-MoveItCommanderException = MoveplanError
-"""moveit_commander's exception: every moveplan error is one, so `except MoveItCommanderException` catches them."""
-
 
 def roscpp_initialize(args: object = None) -> None:
     """Initialise nothing: there is no roscpp to start; return None."""

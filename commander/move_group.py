@@ -415,6 +415,21 @@ class MoveGroupCommander(PlanningSettings):
         """Plan without path constraints again; return None."""
         self._constraints = None
 
+    def allow_replanning(self, value: bool) -> None:
+        """Accept MoveIt's replanning switch: a moveplan motion is planned once and certified; return None."""
+
+    def allow_looking(self, value: bool) -> None:
+        """Accept MoveIt's sensor-looking switch: there is no sensor to turn; return None."""
+
+    def set_workspace(self, ws: Sequence[float]) -> None:
+        """Accept MoveIt's workspace bounds (for a mobile base; joint limits bound the search here); return None."""
+        if isinstance(ws, str) or not hasattr(ws, "__len__") or len(ws) not in (0, 4, 6):
+            raise UsageError(f"set_workspace: expected [minx, miny, maxx, maxy] or [minx, miny, minz, maxx, maxy, "
+                             f"maxz], got {ws!r}")
+
+    def set_support_surface_name(self, value: str) -> None:
+        """Accept the support surface name MoveIt's place pipeline uses (there is no place pipeline); return None."""
+
     def get_known_constraints(self) -> list[str]:
         """Return the names of stored constraints: none (MoveIt keeps them in a warehouse database)."""
         return []
