@@ -222,6 +222,10 @@ def _search(
         raise PlanningFailed(f"straight line achieved {line.fraction:.1%} of the way (minimum "
                              f"{settings.min_fraction:.0%}): {line.reason}; stopped at [{x:.4f}, {y:.4f}, {z:.4f}] "
                              f"in {robot.root_link}")
+    if line.fraction < 1.0:
+        x, y, z = line.stopped_at
+        logger.info("straight line stops at %.1f%% of the way: %s; at [%.4f, %.4f, %.4f] in %s", 100 * line.fraction,
+                    line.reason, x, y, z, robot.root_link)
     line_path = PathResult(np.asarray(line.waypoints), settings.planner if settings.planner in ("LIN", "CIRC")
                            else "linear", 0.0, 0.0)
     return (lambda validity: line_path), line.fraction  # the line is already checked

@@ -447,3 +447,18 @@ def test_pilz_circ_moves_the_tool_on_a_circle(kind: str) -> None:
     group.set_path_constraints(_circ_point(group, "center", center))
     success, _, _, error = group.plan(across)
     assert not success and "on one line" in error.message
+
+
+def test_a_cartesian_path_cut_short_says_what_it_ran_into(caplog: pytest.LogCaptureFixture) -> None:
+    robot = moveit_commander.RobotCommander("ur10e")
+    group, psi = robot.manipulator, moveit_commander.PlanningSceneInterface(robot)
+    group.go("ready")
+    below = group.get_current_pose()
+    below.pose.position.z -= 0.2
+    psi.add_box("block", below, (0.2, 0.2, 0.05))
+    goal = group.get_current_pose().pose
+    goal.position.z -= 0.3
+    with caplog.at_level("INFO", logger="moveplan"):
+        _, fraction = group.compute_cartesian_path([goal], 0.01)
+    assert 0.0 < fraction < 1.0
+    assert any("straight line stops" in r.message and "touches block" in r.message for r in caplog.records)
