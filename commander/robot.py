@@ -21,16 +21,76 @@ from ..core.pipeline import ExecutionSettings, RobotSource, check_execution
 from ._messages import state_message
 from ._targets import finite_number
 from ._world import ROBOT_VARIABLE, World, make_current
-from .msgs import RobotState
+from .conversions import matrix_to_pose
+from .msgs import PoseStamped, RobotState
 
 if TYPE_CHECKING:
     from .move_group import MoveGroupCommander
 
-__all__ = ["ROBOT_VARIABLE", "RobotCommander"]
+__all__ = ["Joint", "Link", "RobotCommander"]
 
 
 # A ROS parameter name ending in robot_description: MoveIt's way of naming the robot a launch file loaded.
 _PARAMETER = re.compile(r"[~/]?([A-Za-z_][A-Za-z0-9_]*/)*robot_description")
+
+class Joint:
+    """One joint of the robot, as moveit_commander's RobotCommander.Joint: its limits, its value, a move."""
+
+    def __init__(self, robot: RobotCommander, name: str) -> None:
+        self._robot, self._name = robot, name
+
+    def name(self) -> str:
+        """Return the joint's name."""
+        return self._name
+
+    def variable_count(self) -> int:
+        """Return how many values the joint has: 1 (moveplan's joints are revolute or prismatic)."""
+        return 1
+
+    def bounds(self) -> list[float]:
+        """Return [min, max] of the joint's position in [rad] or [m]."""
+        limit = self._robot.world.config.limits[self._name]
+        return [limit.lower, limit.upper]
+
+    def min_bound(self) -> float:
+        """Return the joint's lower limit."""
+        return self.bounds()[0]
+
+    def max_bound(self) -> float:
+        """Return the joint's upper limit."""
+        return self.bounds()[1]
+
+    def value(self) -> float:
+        """Return the joint's current position."""
+        return self._robot.world.joint_value(self._name)
+
+    def move(self, position: float, wait: bool = True) -> bool:
+        """Return True once the smallest group with this joint moved it to `position` (the others stay)."""
+        owner = self._robot.get_default_owner_group(self._name)
+        if owner is None:
+            raise UsageError(f"Joint('{self._name}').move: no group contains the joint; cannot move it")
+        group = self._robot.get_group(owner)
+        group.set_joint_value_target(group.get_current_joint_values())
+        group.set_joint_value_target(self._name, position)
+        return group.go(wait=wait)
+
+
+class Link:
+    """One link of the robot, as moveit_commander's RobotCommander.Link: its name and current pose."""
+
+    def __init__(self, robot: RobotCommander, name: str) -> None:
+        self._robot, self._name = robot, name
+
+    def name(self) -> str:
+        """Return the link's name."""
+        return self._name
+
+    def pose(self) -> PoseStamped:
+        """Return the link's current pose, stamped in the planning frame."""
+        stamped = PoseStamped(pose=matrix_to_pose(self._robot.world.pose(self._name)))
+        stamped.header.frame_id = self._robot.get_planning_frame()
+        return stamped
+
 
 class RobotCommander:
     """The robot: its groups, joints and links, its current state, and every motion it executed.
@@ -143,6 +203,20 @@ class RobotCommander:
         """Return joint name -> current position in [rad] or [m], for every movable joint."""
         return {j: self.world.joint_value(j) for j in self.world.joint_names()}
 
+    def get_joint(self, name: str) -> Joint:
+        """Return the movable joint `name` (its limits, value, a move), else raise UnknownName."""
+        movable = self.world.joint_names()
+        if name not in movable:
+            raise UnknownName("joint", str(name), "the robot's movable joints", movable)
+        return Joint(self, name)
+
+    def get_link(self, name: str) -> Link:
+        """Return the link `name` (its current pose), else raise UnknownName."""
+        links = self.world.robot(None).link_names
+        if name not in links:
+            raise UnknownName("link", str(name), "the robot's links", links)
+        return Link(self, name)
+
     def get_group(self, name: str) -> MoveGroupCommander:
         """Return the MoveGroupCommander of the group `name` of this robot (one per group, as MoveIt keeps it)."""
         from .move_group import MoveGroupCommander
@@ -158,10 +232,14 @@ class RobotCommander:
         return min(owners, key=lambda g: len(self.get_link_names(g)), default=None)
 
     def __getattr__(self, name: str) -> Any:
-        """Return the MoveGroupCommander of a group named `name` (MoveIt's `robot.right_arm`)."""
+        """Return the group, joint or link named `name` (MoveIt's `robot.right_arm`, `robot.elbow_joint`)."""
         world = self.__dict__.get("world")
         if world is not None and name in world.config.srdf.groups:
             return self.get_group(name)
+        if world is not None and name in world.joint_names():
+            return Joint(self, name)
+        if world is not None and name in world.robot(None).link_names:
+            return Link(self, name)
         raise AttributeError(f"'RobotCommander' object has no attribute '{name}'")
 
     def save(self, path: str | Path, distro: str = "jazzy") -> None:

@@ -462,3 +462,15 @@ def test_a_cartesian_path_cut_short_says_what_it_ran_into(caplog: pytest.LogCapt
         _, fraction = group.compute_cartesian_path([goal], 0.01)
     assert 0.0 < fraction < 1.0
     assert any("straight line stops" in r.message and "touches block" in r.message for r in caplog.records)
+
+
+def test_joints_and_links_are_robot_attributes_too() -> None:
+    # moveit_commander robot.py: robot.get_joint(name).move(...), robot.<link>.pose().
+    robot = moveit_commander.RobotCommander("ur10e")
+    elbow = robot.get_joint("elbow_joint")
+    assert elbow.bounds() == [elbow.min_bound(), elbow.max_bound()] and elbow.variable_count() == 1
+    assert elbow.move(1.0) and robot.elbow_joint.value() == pytest.approx(1.0, abs=1e-6)
+    assert robot.tool0.pose().header.frame_id == "base_link"
+    assert robot.get_link("tool0").pose() == robot.manipulator.get_current_pose()
+    with pytest.raises(UnknownName, match="joint 'elbow'"):
+        robot.get_joint("elbow")
