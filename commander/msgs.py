@@ -152,10 +152,52 @@ class Time(Message):
         """Return True for time zero."""
         return self.secs == 0 and self.nsecs == 0
 
+    # genpy's arithmetic: time - time is a duration, time +- duration a time, durations add and scale.
+    def __add__(self, other: Any) -> Any:
+        if not isinstance(other, Duration):
+            return NotImplemented
+        return type(self)(*_split_ns(self.to_nsec() + other.to_nsec()))
+
+    def __sub__(self, other: Any) -> Any:
+        if not isinstance(other, Time):
+            return NotImplemented
+        kind = Duration if type(other) is Time or isinstance(self, Duration) else type(self)
+        return kind(*_split_ns(self.to_nsec() - other.to_nsec()))
+
+    def __lt__(self, other: Any) -> bool:
+        return self.to_nsec() < _nsec(other)
+
+    def __le__(self, other: Any) -> bool:
+        return self.to_nsec() <= _nsec(other)
+
+    def __gt__(self, other: Any) -> bool:
+        return self.to_nsec() > _nsec(other)
+
+    def __ge__(self, other: Any) -> bool:
+        return self.to_nsec() >= _nsec(other)
+
 
 @dataclass
 class Duration(Time):
     """A length of time, as rospy.Duration: whole seconds and nanoseconds (`Duration(0.5)` takes seconds)."""
+
+    def __mul__(self, factor: float) -> Duration:
+        return Duration(*_split_ns(int(round(self.to_nsec() * float(factor)))))
+
+    __rmul__ = __mul__
+
+    def __neg__(self) -> Duration:
+        return Duration(*_split_ns(-self.to_nsec()))
+
+
+def _split_ns(total: int) -> tuple[int, int]:
+    """Return whole seconds and nanoseconds (0 <= nsecs < 1e9) of `total` [ns]."""
+    return total // 1_000_000_000, total % 1_000_000_000
+
+
+def _nsec(value: Any) -> int:
+    """Return a Time or Duration in [ns] for comparisons; a number of seconds too."""
+    return value.to_nsec() if isinstance(value, Time) else int(round(float(value) * 1e9))
 
 
 def _seconds(value: Any, where: str) -> float:

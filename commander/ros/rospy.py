@@ -20,7 +20,8 @@ from ...core.errors import MoveplanError, UsageError
 from ..msgs import Duration, JointState, Time, advance_clock, clock
 
 __all__ = [
-    "Duration", "Publisher", "ROSException", "ROSInterruptException", "Rate", "Subscriber", "Time", "get_name",
+    "Duration", "Publisher", "ROSException", "ROSInterruptException", "Rate", "ServiceProxy", "Subscriber", "Time",
+    "get_name",
     "get_namespace",
     "get_param", "get_rostime", "get_time", "has_param", "init_node", "is_shutdown", "logdebug", "logerr",
     "logfatal", "loginfo", "logwarn", "on_shutdown", "search_param", "set_param", "signal_shutdown", "sleep",
@@ -155,6 +156,24 @@ def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) 
     """Raise ROSException: no topic carries messages here (the robot's state: RobotCommander.get_current_state)."""
     raise ROSException(f"wait_for_message('{topic}'): there is no ROS graph; read the robot's state with "
                        "RobotCommander.get_current_state() instead")
+
+
+class ServiceProxy:
+    """rospy.ServiceProxy: there are no ROS services; calling one raises ROSException saying what serves instead."""
+
+    def __init__(self, name: str, service_class: Any = None, *args: Any, **kwargs: Any) -> None:
+        self.resolved_name = name
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        """Raise ROSException: nothing serves the call here."""
+        raise ROSException(f"ServiceProxy('{self.resolved_name}'): there is no ROS graph to call; the commander's "
+                           "methods do what move_group's services do (compute_ik: set_joint_value_target(pose), "
+                           "get_planning_scene: PlanningSceneInterface.get_planning_scene)")
+
+    call = __call__
+
+    def wait_for_service(self, timeout: float | None = None) -> None:
+        """Return at once."""
 
 
 def wait_for_service(service: str, timeout: float | None = None) -> None:

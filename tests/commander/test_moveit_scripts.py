@@ -474,3 +474,31 @@ def test_joints_and_links_are_robot_attributes_too() -> None:
     assert robot.get_link("tool0").pose() == robot.manipulator.get_current_pose()
     with pytest.raises(UnknownName, match="joint 'elbow'"):
         robot.get_joint("elbow")
+
+
+def test_times_subtract_to_durations_as_genpys_do() -> None:
+    # Scripts wait with `while (rospy.Time.now() - start).to_sec() < timeout:`.
+    start = rospy.Time.now()
+    rospy.sleep(1.5)
+    elapsed = rospy.Time.now() - start
+    assert isinstance(elapsed, rospy.Duration) and elapsed.to_sec() == pytest.approx(1.5)
+    assert start + elapsed == rospy.Time.now() and elapsed < rospy.Duration(2) and (elapsed * 2).to_sec() == 3.0
+
+
+def test_tf1_listener_and_broadcaster_work_on_the_robot_and_scene() -> None:
+    # MoveIt 1 scripts: listener.waitForTransform(...); (trans, rot) = listener.lookupTransform(...).
+    from moveplan.commander.ros import tf
+
+    robot = moveit_commander.RobotCommander("ur10e")
+    listener = tf.TransformListener()
+    listener.waitForTransform("/base_link", "/tool0", rospy.Time(0), rospy.Duration(4.0))
+    trans, rot = listener.lookupTransform("/base_link", "/tool0", rospy.Time(0))
+    tool = robot.manipulator.get_current_pose().pose
+    assert trans == pytest.approx([tool.position.x, tool.position.y, tool.position.z])
+    tf.TransformBroadcaster().sendTransform((0.5, 0.0, 0.3), (0.0, 0.0, 0.0, 1.0), rospy.Time.now(), "bin",
+                                            "base_link")
+    assert listener.lookupTransform("base_link", "bin", rospy.Time(0)) == ([0.5, 0.0, 0.3], [0.0, 0.0, 0.0, 1.0])
+    with pytest.raises(tf.LookupException, match="frame 'nowhere'"):
+        listener.lookupTransform("base_link", "nowhere", rospy.Time(0))
+    with pytest.raises(rospy.ROSException, match="no ROS graph"):
+        rospy.ServiceProxy("/compute_ik", None)()

@@ -1,5 +1,16 @@
-"""ROS 1's tf package, the part scripts use without a ROS graph: `tf.transformations`."""
+"""ROS 1's tf package, without a ROS graph: `tf.transformations`, TransformListener, TransformBroadcaster."""
 
 from . import transformations
+from ._tf1 import (
+    ConnectivityException,
+    Exception,
+    ExtrapolationException,
+    LookupException,
+    TransformBroadcaster,
+    TransformListener,
+)
 
-__all__ = ["transformations"]
+__all__ = [
+    "ConnectivityException", "Exception", "ExtrapolationException", "LookupException", "TransformBroadcaster",
+    "TransformListener", "transformations",
+]
