@@ -4,8 +4,11 @@
 only when the script sleeps (`sleep`, `Rate.sleep`), at once, so a loop waiting for the planning
 scene with a timeout ends as soon as the scene is as asked (it is at once: every call applies
 before it returns) or the timeout has passed, never on how busy the machine is. A Publisher keeps
-what it is given (`published`) and delivers it to nobody, except that a JointState published to
-the fake controllers' topic moves the robot, as MoveIt 1's fake controllers do. Parameters are
+what it is given (`published`) and delivers it to nobody, except to what move_group listens to:
+a JointState on the fake controllers' topic moves the robot, as MoveIt 1's fake controllers do,
+and a PlanningScene, CollisionObject or AttachedCollisionObject on `planning_scene`,
+`collision_object` or `attached_collision_object` changes the planning scene, as move_group's
+planning scene monitor applies them. Parameters are
 the robot's: `robot_description` and `robot_description_semantic` are its URDF and SRDF text.
 `loginfo`... go to the logging module (logger "moveplan.commander.ros.rospy").
 """
@@ -17,7 +20,18 @@ import math
 from typing import Any
 
 from ...core.errors import MoveplanError, UsageError
-from ..msgs import Duration, JointState, Time, advance_clock, clock
+from ..msgs import (
+    AttachedCollisionObject,
+    CollisionObject,
+    Duration,
+    JointState,
+    PlanningScene,
+    PlanningSceneWorld,
+    RobotState,
+    Time,
+    advance_clock,
+    clock,
+)
 
 __all__ = [
     "Duration", "Publisher", "ROSException", "ROSInterruptException", "Rate", "ServiceProxy", "Subscriber", "Time",
@@ -32,6 +46,8 @@ _LOG = logging.getLogger(__name__)
 _PARAMS: dict[str, Any] = {}
 _NODE = ["/unnamed"]
 _FAKE_CONTROLLER_TOPIC = "fake_controller_joint_states"  # MoveIt 1's fake controllers listen here
+# The topics move_group listens to that change what it plans with: the planning scene, the robot's state.
+_LISTENED = (_FAKE_CONTROLLER_TOPIC, "planning_scene", "collision_object", "attached_collision_object")
 
 
 class ROSException(MoveplanError):
@@ -111,10 +127,12 @@ def spin() -> None:
 
 
 class Publisher:
-    """rospy.Publisher: keeps every message published in `published`; a fake controller JointState moves the robot.
+    """rospy.Publisher: keeps every message published in `published`; what move_group listens to applies.
 
-    Publishing a JointState to `.../fake_controller_joint_states` sets those joints of the robot
-    created last, as MoveIt 1's fake controllers do with a state published there.
+    A JointState on `.../fake_controller_joint_states` sets those joints of the robot created
+    last, as MoveIt 1's fake controllers do; a PlanningScene on `planning_scene`, a
+    CollisionObject on `collision_object`, an AttachedCollisionObject on
+    `attached_collision_object` change its planning scene, as move_group's monitor applies them.
     """
 
     def __init__(self, name: str, data_class: Any = None, queue_size: int | None = None, latch: bool = False,
@@ -128,11 +146,22 @@ class Publisher:
         """Keep the message (built from the arguments as rospy builds it); return None."""
         message = args[0] if len(args) == 1 and not kwargs else self.data_class(*args, **kwargs)
         self.published.append(message)
-        if self.name.rstrip("/").endswith(_FAKE_CONTROLLER_TOPIC) and isinstance(message, JointState):
+        topic = self.name.rstrip("/").rsplit("/", 1)[-1]
+        if topic in _LISTENED:
+            from .._messages import apply_scene
             from .._world import current_world
 
             world = current_world(None, f"Publisher('{self.name}')")
-            world.set_joints(message, f"{self.name}: JointState")
+            where = f"Publisher('{self.name}').publish"
+            if topic == _FAKE_CONTROLLER_TOPIC and isinstance(message, JointState):
+                world.set_joints(message, where)
+            elif topic == "planning_scene" and isinstance(message, PlanningScene):
+                apply_scene(world, message)
+            elif topic == "collision_object" and isinstance(message, CollisionObject):
+                apply_scene(world, PlanningScene(world=PlanningSceneWorld([message]), is_diff=True))
+            elif topic == "attached_collision_object" and isinstance(message, AttachedCollisionObject):
+                apply_scene(world, PlanningScene(robot_state=RobotState(attached_collision_objects=[message]),
+                                                 is_diff=True))
 
     def get_num_connections(self) -> int:
         """Return 0: nothing subscribes."""

@@ -502,3 +502,19 @@ def test_tf1_listener_and_broadcaster_work_on_the_robot_and_scene() -> None:
         listener.lookupTransform("base_link", "nowhere", rospy.Time(0))
     with pytest.raises(rospy.ROSException, match="no ROS graph"):
         rospy.ServiceProxy("/compute_ik", None)()
+
+
+def test_scene_messages_published_to_move_groups_topics_change_the_scene() -> None:
+    # MoveIt 1 scripts publish CollisionObjects to /collision_object and PlanningScene diffs to /planning_scene.
+    robot = moveit_commander.RobotCommander("ur10e")
+    psi = moveit_commander.PlanningSceneInterface(robot)
+    box = CollisionObject(id="box", primitives=[SolidPrimitive(type=SolidPrimitive.BOX, dimensions=[0.1, 0.1, 0.1])],
+                          primitive_poses=[Pose()], operation=CollisionObject.ADD)
+    box.header.frame_id = "base_link"
+    box.primitive_poses[0].position.x = 0.8
+    rospy.Publisher("/collision_object", CollisionObject, queue_size=10).publish(box)
+    assert psi.get_known_object_names() == ["box"]
+    diff = PlanningScene(is_diff=True)
+    diff.world.collision_objects.append(CollisionObject(id="box", operation=CollisionObject.REMOVE))
+    rospy.Publisher("planning_scene", PlanningScene, queue_size=1).publish(diff)
+    assert psi.get_known_object_names() == []
