@@ -169,6 +169,15 @@ class PlanningSceneInterface:
         """Return the names of the world objects (attached objects are the robot's)."""
         return self._world.object_ids(attached=False)
 
+    def get_known_object_names_in_roi(self, minx: float, miny: float, minz: float, maxx: float, maxy: float,
+                                       maxz: float, with_type: bool = False) -> list[str]:
+        """Return the world objects whose every shape's origin lies in the box [min, max] of the planning frame."""
+        low, high = np.array([minx, miny, minz], dtype=float), np.array([maxx, maxy, maxz], dtype=float)
+        objects = self._world.objects
+        return [oid for oid in self.get_known_object_names()
+                if all(bool(np.all((low <= objects[n].transform[:3, 3]) & (objects[n].transform[:3, 3] <= high)))
+                       for n in self._world.parts(oid))]
+
     def get_object_poses(self, object_ids: Iterable[str]) -> dict[str, Pose]:
         """Return name -> pose in the planning frame of the world objects among `object_ids`."""
         known = self.get_known_object_names()

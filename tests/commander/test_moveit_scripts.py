@@ -351,6 +351,8 @@ def test_a_collision_object_of_two_shapes_is_added_moved_and_removed() -> None:
     table.pose.position.x, table.primitive_poses[1].position.z = 0.8, -0.25
     psi.add_object(table)
     assert psi.get_known_object_names() == ["table"]
+    assert psi.get_known_object_names_in_roi(0.5, -1, -1, 1.0, 1, 1) == ["table"]
+    assert psi.get_known_object_names_in_roi(-1, -1, -1, 0.5, 1, 1) == []
     shapes = psi.get_objects(["table"])["table"]
     assert [p.type for p in shapes.primitives] == [SolidPrimitive.BOX, SolidPrimitive.CYLINDER]
     assert shapes.primitives[1].dimensions == pytest.approx([0.5, 0.05])
