@@ -136,6 +136,10 @@ class RobotCommander:
                                  "robot_description parameter would hold")
         if not isinstance(ns, str):
             raise UsageError(f"RobotCommander: ns: expected a namespace, got {ns!r}")
+        if ns.endswith((".yaml", ".yml")) or (ns and os.path.isfile(ns)):
+            # MoveIt's second argument is the namespace; a scene file there would be silently unused.
+            raise UsageError(f"RobotCommander: ns: '{ns}' is a file, not a namespace; give a scene as "
+                             f"RobotCommander(..., scene='{ns}')")
         where = "RobotCommander"
         paths = [] if package_path is None else [package_path] if isinstance(package_path, str | Path) else package_path
         if not hasattr(paths, "__iter__"):
