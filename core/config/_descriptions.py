@@ -37,19 +37,22 @@ def expand(
 
 
 def check_xacro_args(
-    args: Mapping[str, str], flags: frozenset[str], declared: frozenset[str], urdf: Path, source: Path | None
+    args: Mapping[str, str], flags: frozenset[str], declared: frozenset[str], descriptions: tuple[Path, ...],
+    source: Path | None,
 ) -> None:
-    """Raise for a xacro arg no xacro file declares (a typo must not pass silently).
+    """Raise for a xacro arg no xacro file declares or substitutes (a typo must not pass silently).
 
-    An arg set by flag is a UsageError; one from a file (`source`: moveplan.yaml or
-    .setup_assistant) a ConfigError naming that file.
+    `descriptions` are the URDF and SRDF files. An arg set by flag is a UsageError; one from a
+    file (`source`: moveplan.yaml or .setup_assistant) a ConfigError naming that file.
     """
+    xacros = [str(p) for p in descriptions if p.name.endswith(".xacro")]
     for name in args:
         if name in declared:
             continue
-        what = f"xacro arg '{name}' is not declared by {urdf} or the files it includes; declared: {known(declared)}"
-        if not urdf.name.endswith(".xacro"):
-            what = f"xacro arg '{name}' given, but {urdf} is not a .xacro file"
+        what = (f"xacro arg '{name}' is not declared or used by {' or '.join(xacros)} (or their includes); "
+                f"declared or used: {known(declared)}")
+        if not xacros:
+            what = f"xacro arg '{name}' given, but {' and '.join(map(str, descriptions))} are not .xacro files"
         if name in flags:
             raise UsageError(f"--xacro-arg {name}: {what}")
         raise ConfigError(f"{source}: xacro_args: {what}")

@@ -278,7 +278,7 @@ def _read_model(found: _Located, flags: Mapping[str, str]) -> _Model:
     urdf_path, srdf_path = found.paths["urdf"], found.paths["srdf"]
     urdf_text, urdf_includes, declared = expand(urdf_path, found.root, args, found.packages)
     srdf_text, _, srdf_declared = expand(srdf_path, found.root, args, found.packages)
-    check_xacro_args(args, frozenset(flags), declared | srdf_declared, urdf_path, found.xacro_source)
+    check_xacro_args(args, frozenset(flags), declared | srdf_declared, (urdf_path, srdf_path), found.xacro_source)
     urdf_joints = parse_urdf(urdf_text, urdf_path)
     srdf = parse_srdf(srdf_text, srdf_path, urdf_joints)
     return _Model(urdf_text, urdf_includes, urdf_joints, srdf_text, srdf, dict(args))

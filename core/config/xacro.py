@@ -128,7 +128,9 @@ class XacroResult:
     Attributes:
         text: The XML document it expands to.
         includes: Every file it read (includes and YAML loaded with xacro.load_yaml), in order.
-        declared: Names of the xacro args it and its includes declare.
+        declared: Names of the xacro args it and its includes declare (`<xacro:arg>`) or
+            substitute (`$(arg name)`, which xacro takes from the args given, declared or not:
+            KUKA's SRDF uses `robot_name`, which CMake passes).
     """
 
     text: str
@@ -137,7 +139,7 @@ class XacroResult:
 
 
 class _RecordingArgs(dict[str, str]):
-    """xacro's arg table; records which names `<xacro:arg>` asks about, i.e. declares."""
+    """xacro's arg table; records which names `<xacro:arg>` asks about (declares) or `$(arg)` reads."""
 
     def __init__(self, values: Mapping[str, str]) -> None:
         super().__init__(values)
@@ -147,6 +149,11 @@ class _RecordingArgs(dict[str, str]):
         if isinstance(key, str):
             self.declared.add(key)
         return super().__contains__(key)
+
+    def __getitem__(self, key: str) -> str:
+        if isinstance(key, str) and super().__contains__(key):
+            self.declared.add(key)
+        return super().__getitem__(key)
 
 
 MAX_ARG_LENGTH = 4096

@@ -390,3 +390,15 @@ def test_usage_error_for_urdf_flag_names_the_flag(tmp_path: Path) -> None:
     write(tmp_path, {"arm.urdf": URDF, "arm.srdf": SRDF})
     with pytest.raises(UsageError, match=r"--srdf .*arm.urdf: a URDF file; pass it with --urdf"):
         load_robot_config(tmp_path, srdf=str(tmp_path / "arm.urdf"))
+
+
+def test_an_arg_only_the_srdf_substitutes_is_taken_and_a_typo_still_refused(tmp_path: Path) -> None:
+    # KUKA's kr_arm.srdf.xacro names its robot $(arg robot_name) without <xacro:arg>: CMake passes it, as xacro allows.
+    srdf = ('<?xml version="1.0"?>\n<robot name="$(arg robot_name)" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+            '<group name="arm"><joint name="j1"/></group></robot>\n')
+    folder = write(tmp_path / "arm", {"arm.urdf": URDF, "arm.srdf.xacro": srdf, "joint_limits.yaml": LIMITS})
+    with pytest.raises(ConfigError, match="pass --xacro-arg robot_name:=VALUE"):
+        load_robot_config(folder)
+    assert load_robot_config(folder, xacro_args={"robot_name": "kr6"}).srdf.name == "kr6"
+    with pytest.raises(UsageError, match="--xacro-arg robot_nam: .* not declared or used by .*srdf"):
+        load_robot_config(folder, xacro_args={"robot_name": "kr6", "robot_nam": "kr6"})

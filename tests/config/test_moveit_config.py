@@ -95,7 +95,7 @@ def test_xacro_args_reach_the_xacro_and_its_includes(tmp_path: Path) -> None:
 
 
 def test_an_undeclared_xacro_arg_lists_the_declared_ones() -> None:
-    with pytest.raises(UsageError, match=r"--xacro-arg mount_hieght: .*declared: initial_positions_file, mount_height"):
+    with pytest.raises(UsageError, match=r"--xacro-arg mount_hieght: .*used: initial_positions_file, mount_height"):
         load_robot_config(PACKAGE, (DATA,), {"mount_hieght": "0.5"})
 
 
