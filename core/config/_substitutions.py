@@ -39,18 +39,19 @@ MAX_NESTING = 32
 """Substitutions inside substitutions: launch files nest two or three (`$(var a $(env B))`)."""
 
 
-def load_substituted_yaml(path: Path, launch_args: Mapping[str, str] | None = None) -> Any:
+def load_substituted_yaml(path: Path, launch_args: Mapping[str, str] | None = None, merge: bool = False) -> Any:
     """Return a parameter file's content, parsed as YAML after its launch substitutions.
 
     The file as written is read by load_yaml first, with its limits and messages: the files that
     use substitutions are YAML before them too. Errors name `path`, the user's file, and the
-    line: the substituted text keeps the file's lines.
+    line: the substituted text keeps the file's lines. `merge`: repeated keys merge, as rcl
+    reads a parameter file's.
     """
-    content = load_yaml(path)
+    content = load_yaml(path, merge)
     text = _read(path)
     if "$(" not in text:
         return content
-    return parse_yaml(substitute(text, path, launch_args or {}), path, " once its launch substitutions are made")
+    return parse_yaml(substitute(text, path, launch_args or {}), path, " once its launch substitutions are made", merge)
 
 
 def read_substituted(path: Path, launch_args: Mapping[str, str] | None = None) -> str:

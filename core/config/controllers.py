@@ -13,6 +13,8 @@ Both files may use ROS 2 launch substitutions, as ur_robot_driver's ur_controlle
 
 from __future__ import annotations
 
+import difflib
+import logging
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
@@ -27,6 +29,8 @@ __all__ = [
     "MAX_UPDATE_RATE_HZ", "ControllerConfig", "ExecutionConfig", "default_controller", "parse_controllers",
     "parse_execution",
 ]
+
+logger = logging.getLogger(__name__)
 
 # What a JointTrajectoryController declares, in any release from Humble to master: ros2_controllers'
 # joint_trajectory_controller/src/joint_trajectory_controller_parameters.yaml (@9c53e68, Humble-era
@@ -111,7 +115,8 @@ def parse_controllers(
             parameters, `constraints` or `gains`; names the file and the key path. An
             unsupported or malformed substitution; names the file, line and substitution.
     """
-    top = mapping(load_substituted_yaml(path, launch_args) if substitute else load_yaml(path), str(path))
+    top = mapping(load_substituted_yaml(path, launch_args, merge=True) if substitute else load_yaml(path, merge=True),
+                  str(path))
     manager = _ros_parameters(top, "controller_manager", path)
     where = f"{path}: controller_manager.ros__parameters.update_rate"
     rate = number(manager.get("update_rate", 100), where, positive=True)
@@ -192,25 +197,55 @@ def _default_controllers(value: Any, path: Path) -> tuple[str, ...]:
                  and boolean(manager[name].get("default", False), f"{where}.{name}.default"))
 
 
+def _warn_unknown(params: Mapping[str, Any], allowed: frozenset[str], where: str) -> None:
+    """Warn about parameters the controller does not declare: ros2_control ignores them, and so does moveplan.
+
+    A node ignores an override it does not declare; the legacy `interface_name` (Foxy's) among them.
+    A typo inside `constraints` or `gains` changes what is checked, and stays an error there.
+    """
+    for key in params:
+        if key == "interface_name":
+            logger.warning("%s: interface_name is ignored, as today's JointTrajectoryController ignores it "
+                           "(command_interfaces name the interface)", where)
+        elif key not in allowed:
+            near = difflib.get_close_matches(str(key), sorted(allowed), n=1)
+            hint = f" (did you mean '{near[0]}'?)" if near else ""
+            logger.warning("%s: unknown parameter '%s' ignored, as the controller ignores parameters it does not "
+                           "declare%s", where, key, hint)
+
+
 def _ros_parameters(
     top: dict[str, Any], node: str, path: Path, declared: frozenset[str] | None = None
 ) -> dict[str, Any]:
     """Return the parameters a ROS 2 parameter file gives `node`, merged in file order as rclcpp does.
 
     A section applies to the node when its key names it in any namespace (`controller_manager`,
-    `/robot/controller_manager`) or matches it by wildcard (`/**`, `/**/controller_manager`, `*`).
-    A wildcard section serves every node: of its parameters, only those in `declared` are the
-    node's (a node ignores overrides it does not declare); a section naming the node is kept whole.
+    `/robot/controller_manager`, or nested: `/robot:` holding `controller_manager:`) or matches it
+    by wildcard (`/**`, `/**/controller_manager`, `*`). A section whose node name is a wildcard
+    serves every node: of its parameters, only those in `declared` are the node's (a node ignores
+    overrides it does not declare); a section naming the node is kept whole.
     """
     merged: dict[str, Any] = {}
-    for key, section in top.items():
-        if isinstance(key, str) and _names_node(key, node):
-            entry = mapping(section, f"{path}: {key}")
-            params = mapping(entry.get("ros__parameters"), f"{path}: {key}.ros__parameters")
-            if "*" in key and declared is not None:
+    for key, params in _sections(top, "", path):
+        if _names_node(key, node):
+            if "*" in key.rstrip("/").rsplit("/", 1)[-1] and declared is not None:
                 params = {k: v for k, v in params.items() if k in declared}
             merged.update(params)
     return merged
+
+
+def _sections(entries: dict[str, Any], prefix: str, path: Path) -> list[tuple[str, dict[str, Any]]]:
+    """Return (node key, parameters) of each `ros__parameters` block, in file order, namespaces joined."""
+    found: list[tuple[str, dict[str, Any]]] = []
+    for key, section in entries.items():
+        if not isinstance(key, str) or not isinstance(section, dict):
+            continue
+        name = f"{prefix}/{key.strip('/')}" if prefix else key
+        where = f"{path}: {name}"
+        if "ros__parameters" in section:
+            found.append((name, mapping(section.get("ros__parameters"), f"{where}.ros__parameters")))
+        found.extend(_sections({k: v for k, v in section.items() if k != "ros__parameters"}, name, path))
+    return found
 
 
 def _names_node(key: str, node: str) -> bool:
@@ -225,7 +260,7 @@ def _joint_trajectory_controller(
 ) -> ControllerConfig:
     """Return one JointTrajectoryController's settings from its checked `ros__parameters` (at `where`)."""
     scaled = _SCALED_JTC_KEYS if "ScaledJointTrajectoryController" in kind else frozenset()
-    check_keys(params, _JTC_KEYS | _NODE_KEYS | scaled, where)
+    _warn_unknown(params, _JTC_KEYS | _NODE_KEYS | scaled, where)
     check_keys(mapping(params.get("speed_scaling"), f"{where}.speed_scaling"), _SPEED_SCALING_KEYS,
                f"{where}.speed_scaling")
     joints = tuple(string_list(params.get("joints"), f"{where}.joints", "joint names"))

@@ -89,15 +89,43 @@ _Loader.add_implicit_resolver("tag:yaml.org,2002:float", _ROS_FLOAT, list("-+012
 _Loader.yaml_constructors = dict(yaml.constructor.SafeConstructor.yaml_constructors)
 
 
-def load_yaml(path: Path) -> Any:
+class _MergingLoader(_Loader):
+    """_Loader that merges a mapping's repeated keys as rcl merges a ROS 2 parameter file's.
+
+    Several `/**:` blocks in one file all apply: mappings merge key by key, a later scalar wins.
+    """
+
+    def construct_mapping(self, node: Any, deep: bool = False) -> dict[Any, Any]:
+        self.flatten_mapping(node)
+        merged: dict[Any, Any] = {}
+        for key_node, value_node in node.value:
+            key = self.construct_object(key_node, deep=True)
+            value = self.construct_object(value_node, deep=True)  # deep: a lazily built mapping would merge empty
+            merged[key] = _merged(merged[key], value) if key in merged else value
+        return merged
+
+
+_MergingLoader.add_constructor("tag:yaml.org,2002:map", _MergingLoader.construct_mapping)
+
+
+def _merged(old: Any, new: Any) -> Any:
+    """Return `new` over `old`: mappings key by key (recursively), anything else `new`."""
+    if isinstance(old, dict) and isinstance(new, dict):
+        return {**old, **{k: _merged(old[k], v) if k in old else v for k, v in new.items()}}
+    return new
+
+
+def load_yaml(path: Path, merge: bool = False) -> Any:
     """Return the parsed content of a YAML file; ConfigError names the file and line.
+
+    With `merge`, repeated keys of a mapping merge as rcl merges a ROS 2 parameter file's.
 
     A file larger than MAX_YAML_BYTES, or with more than MAX_YAML_EVENTS parse events, is refused
     before its values are built. Aliases may add at most MAX_ALIAS_EXPANSION values to the
     document (and may not contain themselves), so that no reader of the result walks a billion
     shared copies.
     """
-    return parse_yaml(read_input_text(path), path)
+    return parse_yaml(read_input_text(path), path, merge=merge)
 
 
 def read_input(path: Path, limit: int = MAX_YAML_BYTES) -> bytes:
@@ -137,14 +165,14 @@ def read_input_text(path: Path, limit: int = MAX_YAML_BYTES) -> str:
         raise ConfigError(f"{path}: cannot read: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
 
 
-def parse_yaml(text: str, path: Path, after: str = "") -> Any:
+def parse_yaml(text: str, path: Path, after: str = "", merge: bool = False) -> Any:
     """Return YAML `text` parsed under load_yaml's limits; ConfigError names `path`, the line and `after`."""
     try:
         events = _count_events(text)
         if events > MAX_YAML_EVENTS:
             raise ConfigError(f"{path}: more than {MAX_YAML_EVENTS:,} YAML values (lists and mappings count twice); "
                               "moveplan reads at most that many per file (a 10,000-shape scene has ~350,000)")
-        content = yaml.load(text, Loader=_Loader)  # noqa: S506 - a safe loader
+        content = yaml.load(text, Loader=_MergingLoader if merge else _Loader)  # noqa: S506 - safe loaders
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" line {mark.line + 1}" if mark is not None else ""

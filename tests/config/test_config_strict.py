@@ -94,11 +94,32 @@ def test_gains_for_a_joint_the_controller_does_not_have_are_an_error(tmp_path: P
         parse_controllers(path)
 
 
-def test_a_typo_in_the_controller_parameters_names_file_and_key(tmp_path: Path) -> None:
-    path = write_controllers(tmp_path, {"allow_partial_joint_goal": True})
-    with pytest.raises(ConfigError, match=r"ros2_controllers.yaml: arm_controller.ros__parameters: "
-                                          r"unknown key 'allow_partial_joint_goal'"):
-        parse_controllers(path)
+def test_a_parameter_the_controller_does_not_declare_is_ignored_with_a_warning_naming_the_nearest(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    # ros2_control ignores an override a controller does not declare (rclcpp's undeclared parameters);
+    # Interbotix's files still carry Foxy's interface_name.
+    path = write_controllers(tmp_path, {"allow_partial_joint_goal": True, "interface_name": "position"})
+    assert set(parse_controllers(path)) == {"arm_controller"}
+    messages = [r.getMessage() for r in caplog.records]
+    assert any("arm_controller.ros__parameters: unknown parameter 'allow_partial_joint_goal' ignored" in m
+               and "did you mean 'allow_partial_joints_goal'" in m for m in messages)
+    assert any("interface_name is ignored" in m for m in messages)
+
+
+def test_several_wildcard_blocks_and_a_namespace_merge_as_rcl_reads_them(tmp_path: Path) -> None:
+    # Franka's fr3_ros_controllers.yaml repeats `/**:`; Interbotix's wraps everything in `/wx250s:`.
+    path = tmp_path / "ros2_controllers.yaml"
+    path.write_text("/**:\n  controller_manager:\n    ros__parameters:\n      update_rate: 500\n"
+                    "      arm_controller: {type: joint_trajectory_controller/JointTrajectoryController}\n"
+                    "/**:\n  arm_controller:\n    ros__parameters:\n      joints: [j1, j2]\n"
+                    "      command_interfaces: [position]\n      state_interfaces: [position]\n")
+    controller = parse_controllers(path)["arm_controller"]
+    assert controller.joints == ("j1", "j2") and controller.update_rate_hz == 500.0
+    path.write_text("/robot:\n  controller_manager:\n    ros__parameters:\n"
+                    "      arm_controller: {type: joint_trajectory_controller/JointTrajectoryController}\n"
+                    "  arm_controller:\n    ros__parameters:\n      joints: [j1]\n"
+                    "      command_interfaces: [position]\n      state_interfaces: [position]\n")
+    assert parse_controllers(path)["arm_controller"].joints == ("j1",)
 
 
 def test_a_typo_under_speed_scaling_is_an_error(tmp_path: Path) -> None:
@@ -152,13 +173,15 @@ def test_a_gain_flag_must_be_a_yaml_boolean(tmp_path: Path) -> None:
         parse_controllers(path)
 
 
-def test_the_scaled_jtc_accepts_its_own_parameters_and_the_plain_one_does_not(tmp_path: Path) -> None:
+def test_the_scaled_jtc_accepts_its_own_parameters_and_the_plain_one_ignores_them(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
     params = {"speed_scaling_interface_name": "speed_scaling/speed_scaling_factor"}
     path = tmp_path / "ros2_controllers.yaml"
     path.write_text(controllers_yaml(params, kind="ur_controllers/ScaledJointTrajectoryController"))
     assert set(parse_controllers(path)) == {"arm_controller"}
-    with pytest.raises(ConfigError, match="unknown key 'speed_scaling_interface_name'"):
+    with caplog.at_level("WARNING"):
         parse_controllers(write_controllers(tmp_path, params))
+    assert "unknown parameter 'speed_scaling_interface_name' ignored" in caplog.text
 
 
 def test_other_controllers_keep_their_own_keys(tmp_path: Path) -> None:
