@@ -22,6 +22,7 @@ from .errors import (
 )
 from .options import (
     ROBOT_HELP,
+    JointLimitsOpt,
     JsonOpt,
     PackagePathOpt,
     QuietOpt,
@@ -120,6 +121,7 @@ def plan(
     xacro_arg: XacroArgOpt = None,
     urdf: UrdfOpt = None,
     srdf: SrdfOpt = None,
+    joint_limits: JointLimitsOpt = None,
     strict_limits: StrictLimitsOpt = False,
     ros_distro: Annotated[str, typer.Option(help="Message layout to write: jazzy or humble.")] = "jazzy",
     as_json: JsonOpt = False,
@@ -133,7 +135,7 @@ def plan(
 
     with exit_codes(as_json, plan_failure_document):
         check_outputs({"-o": output}, {"TASK": task, "--robot": robot, "--scene": scene, "--request": motion_request,
-                                       "--start-from": start_from, **description_inputs(urdf, srdf)})
+                                       "--start-from": start_from, **description_inputs(urdf, srdf, joint_limits)})
         flags = _plan_flags(locals())
         from ..core.pipeline import plan_to_file
 
@@ -162,7 +164,7 @@ def _plan_flags(args: dict[str, Any]) -> PlanFlags:
         timeout=number("timeout"), seed=args["seed"],
         package_paths=tuple(args["package_path"] or ()),
         xacro_args=parse_xacro_args(args["xacro_arg"] or ()), urdf=args["urdf"], srdf=args["srdf"],
-        strict_limits=args["strict_limits"],
+        strict_limits=args["strict_limits"], joint_limits=args["joint_limits"],
     )
 
 
@@ -275,6 +277,7 @@ def robot_info(
     xacro_arg: XacroArgOpt = None,
     urdf: UrdfOpt = None,
     srdf: SrdfOpt = None,
+    joint_limits: JointLimitsOpt = None,
     strict_limits: StrictLimitsOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
@@ -284,7 +287,7 @@ def robot_info(
     with exit_codes(as_json):
         from . import render
 
-        loaded = robot_source(config, package_path, xacro_arg, urdf, srdf, strict_limits).load()
+        loaded = robot_source(config, package_path, xacro_arg, urdf, srdf, strict_limits, joint_limits).load()
         loaded.collision_meshes()  # a missing mesh is reported here too, not only when planning
     render.robot_summary(loaded, as_json, quiet)
 
@@ -336,6 +339,7 @@ def benchmark(
     xacro_arg: XacroArgOpt = None,
     urdf: UrdfOpt = None,
     srdf: SrdfOpt = None,
+    joint_limits: JointLimitsOpt = None,
     strict_limits: StrictLimitsOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
@@ -354,7 +358,7 @@ def benchmark(
         from . import render
 
         check_outputs({"--csv": csv, "--plot": plot},
-                      {"PROBLEMS": problems, "--robot": robot, **description_inputs(urdf, srdf)})
+                      {"PROBLEMS": problems, "--robot": robot, **description_inputs(urdf, srdf, joint_limits)})
         if plot is not None:
             from ..core.pipeline import check_plot_path
 
@@ -365,7 +369,7 @@ def benchmark(
         if timeout_s is not None:
             check_planning_time(timeout_s, "--timeout")
         found = find_problems(problems, count)
-        source = robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits)
+        source = robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits, joint_limits)
         config = source.load()
         planners = [p.strip() for text in planner or [config.motion.planner] for p in text.split(",")]
         with render.benchmark_progress(len(found) * len(planners) * len(seed_list), quiet) as advance:

@@ -222,9 +222,9 @@ def all_or_none() -> Iterator[list[Path]]:
         raise
 
 
-def description_inputs(urdf: str | None, srdf: str | None) -> dict[str, Path]:
-    """Return --urdf and --srdf as inputs for check_outputs: those naming a file (a package:// URI names none yet)."""
-    return {flag: Path(value) for flag, value in (("--urdf", urdf), ("--srdf", srdf))
+def description_inputs(urdf: str | None, srdf: str | None, joint_limits: str | None = None) -> dict[str, Path]:
+    """Return --urdf, --srdf and --joint-limits as inputs for check_outputs: those naming a file (not a URI)."""
+    return {flag: Path(value) for flag, value in (("--urdf", urdf), ("--srdf", srdf), ("--joint-limits", joint_limits))
             if value is not None and "://" not in value}
 
 

@@ -26,6 +26,9 @@ UrdfOpt = Annotated[str | None, typer.Option(
     "--urdf", metavar="FILE|package://PKG/PATH", help="URDF (or .xacro) to load, whatever the config names.")]
 SrdfOpt = Annotated[str | None, typer.Option(
     "--srdf", metavar="FILE|package://PKG/PATH", help="SRDF (or .srdf.xacro) to load, whatever the config names.")]
+JointLimitsOpt = Annotated[str | None, typer.Option(
+    "--joint-limits", metavar="FILE|package://PKG/PATH",
+    help="MoveIt's joint_limits.yaml to load (where a vendor keeps it), whatever the config has.")]
 StrictLimitsOpt = Annotated[bool, typer.Option(
     "--strict-limits", help="An acceleration limit missing in the config is an error instead of the documented "
                             "default.")]
@@ -57,10 +60,11 @@ def setup_logging(verbose: bool, quiet: bool) -> None:
 
 def robot_source(
     robot: Path, package_path: list[Path] | None, xacro_arg: list[str] | None, urdf: str | None, srdf: str | None,
-    strict_limits: bool,
+    strict_limits: bool, joint_limits: str | None = None,
 ) -> RobotSource:
     """Return what loads the robot config: --robot and the flags that complete it, as core's typed value."""
     from ..core.config import parse_xacro_args
     from ..core.pipeline import RobotSource
 
-    return RobotSource(robot, tuple(package_path or ()), parse_xacro_args(xacro_arg or ()), urdf, srdf, strict_limits)
+    return RobotSource(robot, tuple(package_path or ()), parse_xacro_args(xacro_arg or ()), urdf, srdf, strict_limits,
+                       joint_limits)

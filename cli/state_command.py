@@ -10,6 +10,7 @@ import typer
 from .errors import exit_codes
 from .options import (
     ROBOT_HELP,
+    JointLimitsOpt,
     JsonOpt,
     PackagePathOpt,
     QuietOpt,
@@ -41,6 +42,7 @@ def state(
     xacro_arg: XacroArgOpt = None,
     urdf: UrdfOpt = None,
     srdf: SrdfOpt = None,
+    joint_limits: JointLimitsOpt = None,
     strict_limits: StrictLimitsOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
@@ -53,13 +55,14 @@ def state(
         from . import render
 
         given = {"--package-path": package_path, "--xacro-arg": xacro_arg, "--urdf": urdf, "--srdf": srdf,
-                 "--strict-limits": strict_limits}
+                 "--joint-limits": joint_limits, "--strict-limits": strict_limits}
         if robot is None and (flags := [name for name, value in given.items() if value]):
             from ..core.errors import UsageError
 
             raise UsageError(f"{flags[0]} completes --robot: give --robot too (with --from alone, the plan's "
                              "embedded config is used as it is)")
-        source = None if robot is None else robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits)
+        source = None if robot is None else robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits,
+                                                         joint_limits)
         result = robot_state(StateRequest(
             robot=source, group=group, joints=parse_optional(parse_joints, joints, "--joints"), named=named,
             plan=from_plan, step=step, at_s=parse_optional(parse_time, at, "--at"), link=link, frame=frame, scene=scene,

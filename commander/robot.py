@@ -105,7 +105,8 @@ class RobotCommander:
             robot state are the planning scene's to start with.
         package_path: Folders searched for `package://` and `$(find)` (`--package-path`), before
             `$ROS_PACKAGE_PATH`.
-        urdf, srdf, xacro_args, strict_limits: As `--urdf`, `--srdf`, `--xacro-arg`, `--strict-limits`.
+        urdf, srdf, joint_limits, xacro_args, strict_limits: As `--urdf`, `--srdf`, `--joint-limits`,
+            `--xacro-arg`, `--strict-limits`.
         plant, plant_params, controllers: The simulated hardware motions execute on, as
             `execute --fake --plant`, `--plant-param` and `--controllers` choose it.
         seed: Seeds every plan (each one anew, as one `moveplan plan` run) and the plant.
@@ -120,6 +121,7 @@ class RobotCommander:
         package_path: str | Path | Sequence[str | Path] | None = None,
         urdf: str | None = None,
         srdf: str | None = None,
+        joint_limits: str | None = None,
         xacro_args: Mapping[str, str] | None = None,
         strict_limits: bool = False,
         plant: str = "mirror",
@@ -144,11 +146,11 @@ class RobotCommander:
         paths = [] if package_path is None else [package_path] if isinstance(package_path, str | Path) else package_path
         if not hasattr(paths, "__iter__"):
             raise UsageError(f"{where}: package_path: expected a folder or a list of folders, got {package_path!r}")
-        _check_arguments(robot, {"urdf": urdf, "srdf": srdf}, {"xacro_args": xacro_args, "plant_params": plant_params},
-                         seed)
+        _check_arguments(robot, {"urdf": urdf, "srdf": srdf, "joint_limits": joint_limits},
+                         {"xacro_args": xacro_args, "plant_params": plant_params}, seed)
         params = {str(k): finite_number(v, f"{where}: plant_params['{k}']") for k, v in (plant_params or {}).items()}
         source = RobotSource(robot, tuple(_path(p, f"{where}: package_path") for p in paths), dict(xacro_args or {}),
-                             urdf, srdf, strict_limits)
+                             urdf, srdf, strict_limits, joint_limits)
         controllers_path = _path(controllers, f"{where}: controllers") if controllers else None
         execution = ExecutionSettings(plant, params, controllers_path, int(seed))
         scene_path = _path(scene, f"{where}: scene") if scene is not None else None

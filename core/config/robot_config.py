@@ -165,6 +165,7 @@ def load_robot_config(
     srdf: str | None = None,
     strict_limits: bool = False,
     embedded: bool = False,
+    joint_limits: str | None = None,
 ) -> RobotConfig:
     """Return the parsed robot config at `robot`.
 
@@ -177,6 +178,8 @@ def load_robot_config(
         xacro_args: --xacro-arg values; they override moveplan.yaml's or .setup_assistant's `xacro_args`.
         urdf: --urdf, a file or `package://pkg/path`: the URDF, whatever the config names.
         srdf: --srdf, likewise the SRDF.
+        joint_limits: --joint-limits, likewise MoveIt's joint_limits.yaml (a vendor keeps it
+            where a launch file names it).
         strict_limits: --strict-limits: a joint without an acceleration limit is an error
             instead of planning with the documented default.
         embedded: `robot` is the folder a plan file's attachments were written to: read as
@@ -188,7 +191,7 @@ def load_robot_config(
             names file and key, or the files and the flag that settles it.
         UsageError: A --xacro-arg the xacro files do not declare.
     """
-    found = _carried(Path(robot)) if embedded else _locate(robot, package_paths, urdf, srdf)
+    found = _carried(Path(robot)) if embedded else _locate(robot, package_paths, urdf, srdf, joint_limits)
     paths = found.paths
     model = _read_model(found, xacro_args or {})
     limit_overrides, v_scale, a_scale = parse_joint_limits(paths.get("joint_limits"))
@@ -240,7 +243,9 @@ def load_robot_config(
     return config
 
 
-def _locate(robot: str | Path, package_paths: Sequence[Path], urdf: str | None, srdf: str | None) -> _Located:
+def _locate(
+    robot: str | Path, package_paths: Sequence[Path], urdf: str | None, srdf: str | None, joint_limits: str | None,
+) -> _Located:
     """Return where the config's files are: named by its moveplan.yaml, or found in its folder or beside a file."""
     path = resolve_config_path(robot, srdf_given=srdf is not None)
     manifest = path if robot_file_kind(path) == "moveplan" else None
@@ -250,7 +255,8 @@ def _locate(robot: str | Path, package_paths: Sequence[Path], urdf: str | None, 
     if manifest is not None:
         top, extra = read_manifest(manifest)
     packages = PackagePath(search_path(root, tuple(package_paths), extra))
-    given = {key: flag_file(value, key, packages) for key, value in (("urdf", urdf), ("srdf", srdf)) if value}
+    given = {key: flag_file(value, key, packages)
+             for key, value in (("urdf", urdf), ("srdf", srdf), ("joint_limits", joint_limits)) if value}
     if manifest is not None:
         paths = manifest_files(manifest, top, packages, given)
         # A flag's file replaces moveplan.yaml's, named by URI: a plan then embeds the files as loaded.
@@ -260,7 +266,8 @@ def _locate(robot: str | Path, package_paths: Sequence[Path], urdf: str | None, 
     found = discover(root, packages, given) if path.is_dir() else discover_beside(path, given)
     if found.root != root:
         packages = PackagePath(search_path(found.root, tuple(package_paths)))
-    return _Located(None, found.root, top, packages, found.paths, found.xacro_args, found.xacro_source)
+    paths = {**found.paths, **{key: file for key, file in given.items() if key not in ("urdf", "srdf")}}
+    return _Located(None, found.root, top, packages, paths, found.xacro_args, found.xacro_source)
 
 
 def _carried(folder: Path) -> _Located:

@@ -65,7 +65,7 @@ _SRDF_SUFFIXES = (".srdf", ".srdf.xacro")
 _URDF_SUFFIXES = (".urdf", ".urdf.xacro")
 # Description packages keep top-level xacros as robot.xacro in these; elsewhere a bare .xacro is a fragment.
 _XACRO_URDF_FOLDERS = ("urdf", "robots")
-_FLAGS = {"urdf": "--urdf", "srdf": "--srdf"}
+_FLAGS = {"urdf": "--urdf", "srdf": "--srdf", "joint_limits": "--joint-limits"}
 _INCLUDE = re.compile(r"<xacro:include\s[^>]*?filename\s*=\s*[\"']([^\"']+)[\"']")
 _ACCEPTED = ("a moveplan.yaml or a folder holding one, a MoveIt config package folder, a URDF (.urdf, "
              ".urdf.xacro, .xacro) or SRDF (.srdf, .srdf.xacro) file")
@@ -193,10 +193,10 @@ def manifest_files(
 
 
 def flag_file(value: str, key: str, packages: PackagePath) -> Path:
-    """Return the file --urdf or --srdf (`key`) names: a path, or a `package://` or `file://` URI."""
+    """Return the file --urdf, --srdf or --joint-limits (`key`) names: a path, or a `package://` or `file://` URI."""
     flag = _FLAGS[key]
     other = "srdf" if key == "urdf" else "urdf"
-    if robot_file_kind(Path(value)) == other:
+    if key in ("urdf", "srdf") and robot_file_kind(Path(value)) == other:
         article = "an SRDF" if other == "srdf" else "a URDF"
         raise UsageError(f"{flag} {value}: {article} file; pass it with {_FLAGS[other]}")
     path = packages.resolve_uri(value, Path.cwd(), f"{flag} {value}")[0] if "://" in value else Path(value)

@@ -65,7 +65,8 @@ def plan_to_file(task: Path | None, flags: PlanFlags, output: Path, ros_distro: 
     """Plan what a task file (if any) and the flags ask for, write it to `output` for `ros_distro`, return it."""
     request = resolve_request(load_task(task) if task is not None else None, flags)
     config = load_robot_config(request.robot, request.package_paths, request.xacro_args, urdf=request.urdf,
-                               srdf=request.srdf, strict_limits=request.strict_limits)
+                               srdf=request.srdf, strict_limits=request.strict_limits,
+                               joint_limits=request.joint_limits)
     _refuse_replacing_inputs(output, request, config)
     if (request.group or config.planning["group"]) in config.srdf.groups:
         _warn_default_accelerations(config, request.group or config.planning["group"])
@@ -112,7 +113,8 @@ def plan(
     loaded_here = config is None
     if config is None:
         config = load_robot_config(request.robot, request.package_paths, request.xacro_args, urdf=request.urdf,
-                                   srdf=request.srdf, strict_limits=request.strict_limits)
+                                   srdf=request.srdf, strict_limits=request.strict_limits,
+                                   joint_limits=request.joint_limits)
     robot = _robot(request, config)
     if loaded_here:
         _warn_default_accelerations(config, robot.group.name)

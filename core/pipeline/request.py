@@ -58,6 +58,7 @@ class RobotSource:
         xacro_args: --xacro-arg values, name -> value.
         urdf, srdf: --urdf and --srdf: a file or `package://pkg/path`, replacing the config's.
         strict_limits: --strict-limits: a missing acceleration limit is an error.
+        joint_limits: --joint-limits: MoveIt's joint_limits.yaml, a file or `package://pkg/path`.
     """
 
     robot: str | Path
@@ -66,11 +67,12 @@ class RobotSource:
     urdf: str | None = None
     srdf: str | None = None
     strict_limits: bool = False
+    joint_limits: str | None = None
 
     def load(self) -> RobotConfig:
         """Return the robot config these arguments name."""
         return load_robot_config(self.robot, self.package_paths, self.xacro_args, urdf=self.urdf, srdf=self.srdf,
-                                 strict_limits=self.strict_limits)
+                                 strict_limits=self.strict_limits, joint_limits=self.joint_limits)
 
 
 @dataclass(frozen=True)
@@ -103,6 +105,7 @@ class PlanFlags:
         xacro_args: xacro arguments, name -> value.
         urdf, srdf: The URDF and SRDF (a file or `package://pkg/path`), replacing the config's.
         strict_limits: A missing acceleration limit is an error instead of the default.
+        joint_limits: MoveIt's joint_limits.yaml (a file or `package://pkg/path`), replacing the config's.
     """
 
     robot: Path | None = None
@@ -129,6 +132,7 @@ class PlanFlags:
     urdf: str | None = None
     srdf: str | None = None
     strict_limits: bool = False
+    joint_limits: str | None = None
 
     def __post_init__(self) -> None:
         starts = [k for k in ("start_joints", "start_named", "start_from") if getattr(self, k) is not None]
@@ -198,6 +202,7 @@ class PlanRequest:
     urdf: str | None = None
     srdf: str | None = None
     strict_limits: bool = False
+    joint_limits: str | None = None
 
 
 def resolve_request(task: TaskFile | None, flags: PlanFlags) -> PlanRequest:
@@ -224,7 +229,7 @@ def resolve_request(task: TaskFile | None, flags: PlanFlags) -> PlanRequest:
         seed=_first(flags.seed, task.seed if task else None) or 0,
         min_fraction=1.0 if flags.min_fraction is None else flags.min_fraction,
         package_paths=flags.package_paths, xacro_args=dict(flags.xacro_args), task=task, motion_request=motion,
-        urdf=flags.urdf, srdf=flags.srdf, strict_limits=flags.strict_limits,
+        urdf=flags.urdf, srdf=flags.srdf, strict_limits=flags.strict_limits, joint_limits=flags.joint_limits,
     )
 
 

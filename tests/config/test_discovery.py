@@ -402,3 +402,21 @@ def test_an_arg_only_the_srdf_substitutes_is_taken_and_a_typo_still_refused(tmp_
     assert load_robot_config(folder, xacro_args={"robot_name": "kr6"}).srdf.name == "kr6"
     with pytest.raises(UsageError, match="--xacro-arg robot_nam: .* not declared or used by .*srdf"):
         load_robot_config(folder, xacro_args={"robot_name": "kr6", "robot_nam": "kr6"})
+
+
+def test_joint_limits_a_vendor_keeps_elsewhere_come_by_flag_path_or_package_uri(cli: Cli, tmp_path: Path) -> None:
+    # Interbotix keeps config/joint_limits/<robot>_joint_limits.yaml, KUKA <support>/config/<robot>_joint_limits.yaml:
+    # launch files name them; --joint-limits does here.
+    folder = write(tmp_path / "arm", {"arm.urdf": URDF, "arm.srdf": SRDF, "joint_limits.yaml": LIMITS,
+                                      "package.xml": "<package><name>acme_arm</name></package>",
+                                      "config/joint_limits/arm_joint_limits.yaml":
+                                          LIMITS.replace("max_acceleration: 3.0", "max_acceleration: 7.5")})
+    assert load_robot_config(folder).limits["j1"].max_acceleration == 3.0
+    for given in (str(folder / "config/joint_limits/arm_joint_limits.yaml"),
+                  "package://acme_arm/config/joint_limits/arm_joint_limits.yaml"):
+        code, document = cli.json("robot", folder, "--joint-limits", given, "--package-path", tmp_path)
+        assert code == 0, document
+        assert document["joints"]["j1"]["max_acceleration"] == 7.5
+        assert document["joints"]["j1"]["source"]["acceleration"] == "arm_joint_limits.yaml"
+    result = cli("robot", folder, "--joint-limits", str(folder / "no_such.yaml"))
+    assert result.exit_code == 3 and "--joint-limits" in result.stderr and "file not found" in result.stderr
