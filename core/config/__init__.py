@@ -55,6 +55,7 @@ if TYPE_CHECKING:
     )
     from .poses import pose_matrix
     from .robot_config import RobotConfig, load_robot_config
+    from .scene_text import parse_scene_text
     from .scene_yaml import SceneFile, check_shape_count, first_repeated, parse_scene
     from .sources import CONFIG_FILE
     from .srdf import Group
@@ -128,6 +129,7 @@ __all__ = [
     "parse_controllers",
     "parse_planning_scene",
     "parse_scene",
+    "parse_scene_text",
     "parse_xacro_args",
     "parse_yaml",
     "path_constraints",
@@ -207,6 +209,7 @@ __getattr__ = lazy_exports(__name__, {
     "parse_controllers": "controllers",
     "parse_planning_scene": "planning_scene_yaml",
     "parse_scene": "scene_yaml",
+    "parse_scene_text": "scene_text",
     "parse_xacro_args": "xacro",
     "parse_yaml": "fields",
     "path_constraints": "constraints",

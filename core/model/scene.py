@@ -19,12 +19,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..config import parse_scene
+from ..config import SceneFile, parse_scene
 from ..errors import ConfigError, FrameNotFound
 from ..types import CollisionObject, Frame
 from .robot import Robot
 
-__all__ = ["MAX_SCENE_FRAMES", "Scene", "empty_scene", "moveplan_scene", "planning_frame_names", "resolve_frames"]
+__all__ = [
+    "MAX_SCENE_FRAMES", "Scene", "empty_scene", "moveplan_scene", "planning_frame_names", "resolve_frames",
+    "resolved_scene",
+]
 
 MAX_SCENE_FRAMES = 10_000
 """Frames a scene may define, subframes of PlanningScene objects included."""
@@ -89,7 +92,11 @@ def empty_scene() -> Scene:
 
 def moveplan_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
     """Return the scene of a moveplan scene file's parsed `top` mapping, resolved against `robot`'s links."""
-    file = parse_scene(top, path)
+    return resolved_scene(parse_scene(top, path), robot)
+
+
+def resolved_scene(file: SceneFile, robot: Robot) -> Scene:
+    """Return the scene of a read scene file (moveplan's, or MoveIt's text `.scene`), resolved against `robot`."""
     anchors = resolve_frames(list(file.frames), robot, file.source)
     root_q = robot.neutral()
     objects: list[CollisionObject] = []
