@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
+from ._launch_types import spawned_types
 from ._substitutions import load_substituted_yaml
 from .fields import boolean, check_keys, load_yaml, mapping, number, string_list
 
@@ -103,6 +104,8 @@ def parse_controllers(
 
     A GripperActionController is kept as a JointTrajectoryController of its one joint with
     nothing checked on the way: MoveIt's GripperCommand sends the last point, the gripper goes there.
+    A file without a controller_manager section (one controller a file, as PAL writes them) takes
+    each controller's type from the package's launch files that spawn it with this file.
 
     Args:
         path: The file.
@@ -127,8 +130,10 @@ def parse_controllers(
         raise ConfigError(f"{where}: {rate:g} Hz is beyond moveplan's limit of {MAX_UPDATE_RATE_HZ:g} Hz "
                           "(ros2_control loops run at up to a few kHz)")
     controllers: dict[str, ControllerConfig] = {}
-    for name, entry in manager.items():
-        kind = str(entry.get("type", "")) if isinstance(entry, dict) else ""
+    kinds = {name: str(entry.get("type", "")) for name, entry in manager.items() if isinstance(entry, dict)}
+    if not kinds and substitute:  # no controller_manager section: the launch file that spawns each gives its type
+        kinds = {name: kind for name, kind in spawned_types(path).items() if _ros_parameters(top, name, path)}
+    for name, kind in kinds.items():
         if "JointTrajectoryController" in kind:
             declared = _JTC_KEYS | _NODE_KEYS | (_SCALED_JTC_KEYS if "Scaled" in kind else frozenset())
             params = _ros_parameters(top, name, path, declared)

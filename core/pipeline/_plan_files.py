@@ -102,8 +102,11 @@ def pick_controller(
     """
     fitting = [c for c in controllers.values() if set(joints) <= set(c.joints)]
     if not fitting:
+        why = "" if controllers else (" (the file gives no controller a JointTrajectoryController type: under "
+                                      "controller_manager's ros__parameters, or in a launch file of its package "
+                                      "that spawns it)")
         raise ConfigError(f"{source}: no JointTrajectoryController drives all of {', '.join(joints)}; "
-                          f"controllers: {', '.join(controllers) or '(none)'}")
+                          f"controllers: {', '.join(controllers) or '(none)'}{why}")
     best = min((c.name not in preferred, len(c.joints)) for c in fitting)
     candidates = [c for c in fitting if (c.name not in preferred, len(c.joints)) == best]
     # The same joints listed in another order drive the robot the same way.

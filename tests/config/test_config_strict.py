@@ -310,3 +310,27 @@ def test_a_controller_joint_the_urdf_lacks_exits_3_naming_the_file_controller_an
     line = result.stderr.strip()
     assert "\n" not in line and "joint 'shoulder_pan_jiont' not found" in line and "ros2_controllers.yaml" in line
     assert not (tmp_path / "p.mcap").exists()
+
+
+def test_a_controller_file_without_a_manager_takes_its_types_from_the_launch_file_that_spawns_it(
+        tmp_path: Path) -> None:
+    # PAL's TIAGo: config/arm_controller.yaml holds one controller; launch/arm_controller.launch.py hands the
+    # spawner its type. The launch file is parsed, never run.
+    package = tmp_path / "robot_controller_configuration"
+    (package / "config").mkdir(parents=True)
+    (package / "launch").mkdir()
+    (package / "package.xml").write_text("<package><name>robot_controller_configuration</name></package>")
+    params = package / "config" / "arm_controller.yaml"
+    params.write_text("arm_controller:\n  ros__parameters:\n    joints: [j1, j2]\n    command_interfaces: [position]\n"
+                      "    state_interfaces: [position]\n    constraints: {goal_time: 0.6, j1: {goal: 0.02}}\n")
+    (package / "launch" / "arm_controller.launch.py").write_text(
+        "import os\nraise SystemExit('a launch file is parsed, never run')\n"
+        "def generate_launch_description():\n"
+        "    return generate_load_controller_launch_description(controller_name='arm_controller',\n"
+        "        controller_type='joint_trajectory_controller/JointTrajectoryController',\n"
+        "        controller_params_file=os.path.join(pkg, 'config', 'arm_controller.yaml'))\n")
+    controller = parse_controllers(params)["arm_controller"]
+    assert controller.joints == ("j1", "j2") and controller.goal_time_s == 0.6
+    assert controller.goal_tolerance["j1"] == 0.02
+    (package / "launch" / "arm_controller.launch.py").write_text("def broken(:\n")
+    assert parse_controllers(params) == {}
