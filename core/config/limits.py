@@ -13,7 +13,10 @@ from ._urdf import MOVABLE_JOINT_TYPES, UrdfJoint
 from .fields import MAX_MAGNITUDE, boolean, check_keys, load_yaml, mapping, number
 from .motion import MIN_SCALING, is_scaling
 
-__all__ = ["DEFAULT_ACCELERATION", "DEFAULT_SOURCE", "JointLimit", "merge_limits", "parse_joint_limits"]
+__all__ = [
+    "DEFAULT_ACCELERATION", "DEFAULT_SOURCE", "JointLimit", "is_moveit_joint_limits", "merge_limits",
+    "parse_joint_limits",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -56,14 +59,21 @@ class JointLimit:
     source: dict[str, str]
 
 
+def is_moveit_joint_limits(path: Path) -> bool:
+    """Return True if a joint_limits.yaml is MoveIt's (not, say, a description package's own URDF limits)."""
+    top = load_yaml(path)
+    return not isinstance(top, dict) or not top or bool(set(_unwrapped(top, path)) & _TOP_KEYS)
+
+
 def parse_joint_limits(path: Path | None) -> tuple[dict[str, dict[str, Any]], float, float]:
-    """Return joint_limits.yaml's entries by joint and its default velocity and acceleration scaling."""
+    """Return joint_limits.yaml's entries by joint and its default velocity and acceleration scaling.
+
+    The file may hold them as MoveIt's loader does, under `robot_description_planning`, or as
+    move_group's node parameters (`move_group: ros__parameters: robot_description_planning:`).
+    """
     if path is None:
         return {}, _DEFAULT_SCALING, _DEFAULT_SCALING
-    top = mapping(load_yaml(path), str(path))
-    # MoveIt loads this file under robot_description_planning; accept it written either way.
-    if "robot_description_planning" in top:
-        top = mapping(top["robot_description_planning"], f"{path}: robot_description_planning")
+    top = _unwrapped(mapping(load_yaml(path), str(path)), path)
     check_keys(top, _TOP_KEYS, str(path))
     scales = []
     for key in ("default_velocity_scaling_factor", "default_acceleration_scaling_factor"):
@@ -80,6 +90,19 @@ def parse_joint_limits(path: Path | None) -> tuple[dict[str, dict[str, Any]], fl
         check_keys(entry, _LIMIT_KEYS, where)
         overrides[joint] = entry
     return overrides, scales[0], scales[1]
+
+
+def _unwrapped(top: dict[str, Any], path: Path) -> dict[str, Any]:
+    """Return the limits mapping inside node-parameter and robot_description_planning wrappers."""
+    # A ROS 2 parameter file: one node (any name, `/**`), its ros__parameters.
+    if len(top) == 1:
+        (section,) = top.values()
+        if isinstance(section, dict) and "ros__parameters" in section:
+            top = mapping(section["ros__parameters"], f"{path}: ros__parameters")
+    # MoveIt loads this file under robot_description_planning; accept it written either way.
+    if "robot_description_planning" in top:
+        top = mapping(top["robot_description_planning"], f"{path}: robot_description_planning")
+    return top
 
 
 def merge_limits(

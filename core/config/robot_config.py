@@ -13,6 +13,7 @@ beside it, which are the plan's attachments.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,8 +27,8 @@ from ._substitutions import read_substituted
 from ._urdf import CollisionMesh, UrdfJoint, parse_urdf, resolve_collision_meshes
 from .controllers import ControllerConfig, ExecutionConfig, parse_controllers, parse_execution
 from .embed import carried_paths, embedded_files
-from .fields import read_input
-from .limits import DEFAULT_SOURCE, JointLimit, merge_limits, parse_joint_limits
+from .fields import load_yaml, read_input
+from .limits import DEFAULT_SOURCE, JointLimit, is_moveit_joint_limits, merge_limits, parse_joint_limits
 from .motion import Resolved
 from .sources import (
     CONFIG_FILE,
@@ -44,6 +45,8 @@ from .srdf import Group, Srdf, parse_srdf
 from .xacro import PackagePath
 
 __all__ = ["RobotConfig", "load_robot_config"]
+
+logger = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -207,7 +210,9 @@ def load_robot_config(
     named = (fake_controllers_initial(fake, model.srdf.group_states, limits), fake) if fake else None
     initial = initial_state(model.urdf_text, paths["urdf"], model.urdf_joints, limits, paths.get("initial_positions"),
                             named)
-    kinematics = parse_kinematics(paths["kinematics"], model.srdf) if "kinematics" in paths else {}
+    kinematics = _kinematics(paths.get("kinematics"), model.srdf, named=found.manifest is not None)
+    if "kinematics" in paths and kinematics is None:
+        del paths["kinematics"]
     planning, planning_source = planning_defaults(
         found.manifest, found.top, paths.get("ompl_planning"), model.srdf, paths["srdf"]
     )
@@ -234,7 +239,7 @@ def load_robot_config(
         package_paths=found.packages.folders,
         sources=_sources(found, planning_source),
         urdf_includes=model.urdf_includes,
-        kinematics=kinematics,
+        kinematics=kinematics or {},
         xacro_args=model.xacro_args,
         initial_sources=initial.sources,
         srdf_text=model.srdf_text,
@@ -267,6 +272,10 @@ def _locate(
     if found.root != root:
         packages = PackagePath(search_path(found.root, tuple(package_paths)))
     paths = {**found.paths, **{key: file for key, file in given.items() if key not in ("urdf", "srdf")}}
+    if "joint_limits" in paths and "joint_limits" not in given and not is_moveit_joint_limits(paths["joint_limits"]):
+        # Found by name only: a description package's own limits (Franka's) beside its URDF, not MoveIt's.
+        logger.warning("%s: not MoveIt's joint_limits.yaml (no joint_limits key); not read: pass --joint-limits "
+                       "FILE to name MoveIt's", paths.pop("joint_limits"))
     return _Located(None, found.root, top, packages, paths, found.xacro_args, found.xacro_source)
 
 
@@ -289,6 +298,21 @@ def _read_model(found: _Located, flags: Mapping[str, str]) -> _Model:
     urdf_joints = parse_urdf(urdf_text, urdf_path)
     srdf = parse_srdf(srdf_text, srdf_path, urdf_joints)
     return _Model(urdf_text, urdf_includes, urdf_joints, srdf_text, srdf, dict(args))
+
+
+def _kinematics(path: Path | None, srdf: Srdf, named: bool) -> dict[str, dict[str, Any]] | None:
+    """Return kinematics.yaml's settings ({} without one); None for a file found by name that is not MoveIt's."""
+    if path is None:
+        return {}
+    top = load_yaml(path)
+    moveit = any(key in ("/**", "robot_description_kinematics") or (isinstance(entry, dict) and any(
+        str(k).startswith("kinematics_solver") for k in entry)) for key, entry in top.items()) \
+        if isinstance(top, dict) else True
+    if not named and top and not moveit:
+        # A description package's own kinematics.yaml (Franka's DH parameters) lies where a lone URDF is.
+        logger.warning("%s: not MoveIt's kinematics.yaml (no group names a kinematics_solver); not read", path)
+        return None
+    return parse_kinematics(path, srdf)
 
 
 def _sources(found: _Located, planning_source: Path) -> dict[str, Path]:

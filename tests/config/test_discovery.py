@@ -420,3 +420,24 @@ def test_joint_limits_a_vendor_keeps_elsewhere_come_by_flag_path_or_package_uri(
         assert document["joints"]["j1"]["source"]["acceleration"] == "arm_joint_limits.yaml"
     result = cli("robot", folder, "--joint-limits", str(folder / "no_such.yaml"))
     assert result.exit_code == 3 and "--joint-limits" in result.stderr and "file not found" in result.stderr
+
+
+def test_a_description_packages_own_limits_and_kinematics_beside_a_lone_urdf_are_skipped_with_a_warning(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    # franka_description/robots/fr3 holds joint_limits.yaml and kinematics.yaml in Franka's own formats.
+    folder = write(tmp_path / "fr3", {"arm.urdf": URDF, "arm.srdf": SRDF,
+                                      "joint_limits.yaml": "j1:\n  limit: {lower: -1, upper: 1, velocity: 2}\n",
+                                      "kinematics.yaml": "j1: {a: 0.0, d: 0.333}\n"})
+    with caplog.at_level("WARNING"):
+        config = load_robot_config(folder / "arm.urdf")
+    assert config.limits["j1"].max_velocity == 2.0 and "joint_limits" not in config.sources
+    assert "not MoveIt's joint_limits.yaml" in caplog.text and "not MoveIt's kinematics.yaml" in caplog.text
+    with pytest.raises(ConfigError, match="joint_limits.yaml: unknown key 'j1'"):
+        load_robot_config(folder / "arm.urdf", joint_limits=str(folder / "joint_limits.yaml"))
+
+
+def test_joint_limits_written_as_move_group_node_parameters_are_read(tmp_path: Path) -> None:
+    limits = ("move_group:\n  ros__parameters:\n    robot_description_planning:\n      joint_limits:\n"
+              "        j1: {has_acceleration_limits: true, max_acceleration: 4.5}\n")
+    folder = write(tmp_path / "arm", {"arm.urdf": URDF, "arm.srdf": SRDF, "joint_limits.yaml": limits})
+    assert load_robot_config(folder).limits["j1"].max_acceleration == 4.5
