@@ -441,3 +441,16 @@ def test_joint_limits_written_as_move_group_node_parameters_are_read(tmp_path: P
               "        j1: {has_acceleration_limits: true, max_acceleration: 4.5}\n")
     folder = write(tmp_path / "arm", {"arm.urdf": URDF, "arm.srdf": SRDF, "joint_limits.yaml": limits})
     assert load_robot_config(folder).limits["j1"].max_acceleration == 4.5
+
+
+def test_a_switch_moveit_does_not_read_is_ignored_with_a_warning_but_an_unknown_number_refused(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    # KUKA's kr6_r700_sixx_joint_limits.yaml writes `has_jerk: false`, which MoveIt ignores.
+    limits = LIMITS.replace("max_acceleration: 3.0", "max_acceleration: 3.0, has_jerk: false")
+    folder = write(tmp_path / "arm", {"arm.urdf": URDF, "arm.srdf": SRDF, "joint_limits.yaml": limits})
+    with caplog.at_level("WARNING"):
+        assert load_robot_config(folder).limits["j1"].max_acceleration == 3.0
+    assert "unknown switch 'has_jerk' ignored" in caplog.text and "has_jerk_limits" in caplog.text
+    (folder / "joint_limits.yaml").write_text(limits.replace("has_jerk: false", "max_jerkk: 5"))
+    with pytest.raises(ConfigError, match="unknown key 'max_jerkk'"):
+        load_robot_config(folder)
