@@ -19,7 +19,7 @@ import logging
 import math
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..errors import ConfigError, UnknownName, known
@@ -101,12 +101,34 @@ def parse_srdf(text: str, path: Path, joints: dict[str, UrdfJoint]) -> Srdf:
         raise ConfigError(f"{path}: not an SRDF (root element is <{root.tag}>, expected <robot>)")
     virtual = _virtual_joints(root.findall("virtual_joint"), path, joints)
     tree = _Tree(joints, virtual, path)
-    groups = _groups(root.findall("group"), tree)
+    groups = _with_end_effector_tips(_groups(root.findall("group"), tree), root.findall("end_effector"), tree,
+                                     {e.get("name", "").strip() for e in root.findall("group") if e.find("chain")
+                                      is not None})
     states = _group_states(root.findall("group_state"), tree, groups)
     disabled = frozenset(
         frozenset((e.get("link1", ""), e.get("link2", ""))) for e in root.findall("disable_collisions")
     )
     return Srdf(root.get("name", ""), groups, states, disabled, virtual)
+
+
+def _with_end_effector_tips(
+    groups: dict[str, Group], end_effectors: list[ET.Element], tree: _Tree, chains: set[str]
+) -> dict[str, Group]:
+    """Return the groups with MoveIt's tip where no chain names it.
+
+    The tip is the parent link of the group's end effector, else the group's last link, trailing
+    fixed joints included: MoveGroupInterface's end-effector link.
+    """
+    parents: dict[str, str] = {}
+    for element in end_effectors:
+        owner, link = (element.get("parent_group") or "").strip(), (element.get("parent_link") or "").strip()
+        if owner in groups and link in tree.links:
+            parents.setdefault(owner, link)
+    result: dict[str, Group] = {}
+    for name, group in groups.items():
+        tip = group.tip if name in chains else parents.get(name) or (group.links[-1] if group.links else group.tip)
+        result[name] = group if tip == group.tip else replace(group, tip=tip)
+    return result
 
 
 def _name(element: ET.Element, attribute: str, path: Path, what: str) -> str:

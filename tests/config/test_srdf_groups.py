@@ -210,3 +210,20 @@ def test_moveit_resources_fanuc_fixed_virtual_joint(realworld: Path) -> None:
     srdf_path = resources / "fanuc_moveit_config" / "config" / "fanuc.srdf"
     srdf = parse_srdf(srdf_path.read_text(), srdf_path, parse_urdf(urdf.read_text(), urdf))
     assert srdf.plannable("manipulator", srdf_path).joints == tuple(f"joint_{i}" for i in range(1, 7))
+
+
+_TOOL_URDF = """<robot name="arm"><link name="base"/><link name="l1"/><link name="tool"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+  <joint name="tool_joint" type="fixed"><parent link="l1"/><child link="tool"/></joint></robot>"""
+
+
+def test_a_group_without_a_chain_ends_where_moveit_puts_its_end_effector_link(tmp_path: Path) -> None:
+    # MoveGroupInterface: the end effector's parent link, else the group's last link, trailing fixed joints included.
+    joints = parse_urdf(_TOOL_URDF, tmp_path / "arm.urdf")
+    srdf = ('<robot name="arm"><group name="listed"><joint name="j1"/><joint name="tool_joint"/></group>'
+            '<group name="bare"><joint name="j1"/></group><group name="held"><joint name="j1"/></group>'
+            '<group name="eef"><link name="tool"/></group>'
+            '<end_effector name="e" parent_link="tool" group="eef" parent_group="held"/></robot>')
+    groups = parse_srdf(srdf, tmp_path / "arm.srdf", joints).groups
+    assert (groups["listed"].tip, groups["bare"].tip, groups["held"].tip) == ("tool", "l1", "tool")
