@@ -56,11 +56,17 @@ def plan_summary(plan: PlanResult, output: Path, as_json: bool, quiet: bool) -> 
 
 
 def _end_poses(names: list[str], states: tuple[RobotState, ...]) -> None:
-    """Print one row per step: where its end puts the tip, in the planning frame."""
+    """Print one row per step: where its end puts the link its goal moved (the tip's), in the planning frame."""
     pose = states[0].pose
-    rows = table(f"end of each step: {pose.link} in {pose.frame}", ("step", "position [m]", "rpy [rad]"))
-    for name, state in zip(names, states, strict=True):
-        rows.add_row(name, _triple(state.pose.position, ".4f"), _triple(state.pose.rpy, ".4f"))
+    links = {state.pose.link for state in states}
+    if len(links) == 1:
+        rows = table(f"end of each step: {pose.link} in {pose.frame}", ("step", "position [m]", "rpy [rad]"))
+        for name, state in zip(names, states, strict=True):
+            rows.add_row(name, _triple(state.pose.position, ".4f"), _triple(state.pose.rpy, ".4f"))
+    else:
+        rows = table(f"end of each step, in {pose.frame}", ("step", "link", "position [m]", "rpy [rad]"))
+        for name, state in zip(names, states, strict=True):
+            rows.add_row(name, state.pose.link, _triple(state.pose.position, ".4f"), _triple(state.pose.rpy, ".4f"))
     show(rows)
 
 

@@ -276,7 +276,9 @@ def assemble(
     It takes the robot, scene and base, not a Problem: a commander session assembles its executed
     motions without building collision checks.
     """
-    ends = tuple(robot_state(robot, scene, robot.configuration(step.trajectory.positions[-1], base)) for step in steps)
+    # Each step's end: the pose of the link its goal moved (a pose goal's link), else the tip's.
+    ends = tuple(robot_state(robot, scene, robot.configuration(step.trajectory.positions[-1], base), _goal_link(step))
+                 for step in steps)
     return PlanResult(
         robot_name=config.name,
         group=robot.group.name,
@@ -324,3 +326,10 @@ def _attachments(config: RobotConfig, request: PlanRequest) -> dict[str, bytes]:
     if request.motion_request is not None:
         files["request.yaml"] = request.motion_request.raw
     return files
+
+
+def _goal_link(step: StepResult) -> str | None:
+    """Return the link a step's pose goal moved (`--link`, a task's `link`), None for the tip."""
+    pose = step.goal.get("pose")
+    link = pose.get("link") if isinstance(pose, dict) else None
+    return link if isinstance(link, str) and link else None

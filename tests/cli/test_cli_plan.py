@@ -237,3 +237,14 @@ def test_missing_robot_config_exits_3(cli: Cli, tmp_path: Path) -> None:
     result = cli("plan", "--robot", tmp_path / "nowhere", "--named", "home", "-o", tmp_path / "o.mcap")
     assert result.exit_code == 3
     assert "robot config not found" in result.stderr
+
+
+def test_a_step_ends_reported_at_the_link_its_goal_moved(cli: Cli, tmp_path: Path) -> None:
+    # The summary and `inspect` show where the --link went, not the group's tip.
+    out = tmp_path / "hand.mcap"
+    code, document = cli.json("plan", "--robot", "panda", "--start-named", "ready", "--pose", "0.4,0.1,0.4,pi,0,0",
+                              "--link", "panda_hand", "-o", out)
+    assert code == 0, document
+    pose = document["steps"][0]["end_state"]["pose"]
+    assert pose["link"] == "panda_hand" and pose["position"] == pytest.approx([0.4, 0.1, 0.4], abs=1e-4)
+    assert "end of each step: panda_hand in panda_link0" in cli("inspect", out).stdout
