@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.config import AllowedCollisions
+from ..core.config import allowed_collisions
 from ..core.errors import UsageError
 from ..core.types import CollisionObject, Shape
 from ._objects import apply_object, attach_existing, detach
@@ -35,6 +35,7 @@ from .msgs import (
     RobotState,
     SolidPrimitive,
     TransformStamped,
+    plain,
 )
 from .msgs import CollisionObject as CollisionObjectMsg
 
@@ -106,7 +107,7 @@ def apply_scene(world: World, scene: Any) -> None:
         world.set_joints(scene.robot_state.joint_state, "apply_planning_scene: robot_state.joint_state")
     acm = scene.allowed_collision_matrix
     if acm.entry_names or acm.default_entry_names:
-        world.change(acm=_allowed(acm))
+        world.change(acm=allowed_collisions(plain(acm), "apply_planning_scene: allowed_collision_matrix"))
 
 
 def scene_message(world: World, components: int) -> PlanningScene:
@@ -148,25 +149,6 @@ def _matrix(world: World) -> AllowedCollisionMatrix:
         entries[index[a]].enabled[index[b]] = entries[index[b]].enabled[index[a]] = allowed
     defaults = world.acm.defaults
     return AllowedCollisionMatrix(names, entries, list(defaults), list(defaults.values()))
-
-
-def _allowed(acm: AllowedCollisionMatrix) -> AllowedCollisions:
-    """Return what an AllowedCollisionMatrix message allows, as a PlanningScene YAML's is read.
-
-    Raises:
-        UsageError: entry_values not one row of len(entry_names) flags per name, or defaults of another length.
-    """
-    names, rows = list(acm.entry_names), list(acm.entry_values)
-    if len(rows) != len(names) or any(len(r.enabled) != len(names) for r in rows):
-        raise UsageError(f"apply_planning_scene: allowed_collision_matrix: {len(names)} entry_names need as many "
-                         "entry_values, each of as many flags")
-    if len(acm.default_entry_names) != len(acm.default_entry_values):
-        raise UsageError("apply_planning_scene: allowed_collision_matrix: default_entry_names and "
-                         "default_entry_values differ in length")
-    explicit = {frozenset((names[i], names[j])): bool(rows[i].enabled[j])
-                for i in range(len(names)) for j in range(i, len(names))}
-    return AllowedCollisions(explicit, dict(zip(acm.default_entry_names, map(bool, acm.default_entry_values),
-                                                strict=True)))
 
 
 def _add_shapes(message: CollisionObjectMsg, parts: list[CollisionObject], object_T_root: NDArray[np.float64]) -> None:

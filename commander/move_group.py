@@ -246,7 +246,7 @@ class MoveGroupCommander(PlanningSettings):
         full = pin.getFrameJacobian(model, data, frame, pin.LOCAL_WORLD_ALIGNED)
         if reference_point is not None:
             offset = data.oMf[frame].rotation @ np.asarray([float(v) for v in reference_point][:3])
-            full[:3] -= _skew(offset) @ full[3:]  # v_point = v_origin + w x offset
+            full[:3] -= pin.skew(offset) @ full[3:]  # v_point = v_origin + w x offset
         columns = [model.idx_vs[model.getJointId(j)] for j in robot.joint_names]
         jacobian: NDArray[np.float64] = np.array(full[:, columns], dtype=float)
         for mimic in robot.mimics:
@@ -687,11 +687,6 @@ class MoveGroupCommander(PlanningSettings):
 def _step_name(goal: Goal) -> str:
     """Return a step's name in a saved plan: the named target's name, else the kind of goal."""
     return goal.name if isinstance(goal, NamedGoal) else goal.kind
-
-
-def _skew(v: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Return the cross-product matrix of a 3-vector `v`: its product with b is v x b."""
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
 def _constraining(constraints: Constraints) -> bool:

@@ -213,8 +213,7 @@ def _seconds(value: Any, where: str) -> float:
 
 def _split(seconds: float) -> tuple[int, int]:
     """Return whole seconds and nanoseconds of `seconds`, nanoseconds rounded."""
-    total = int(round(seconds * 1e9))
-    return total // 1_000_000_000, total % 1_000_000_000
+    return _split_ns(int(round(seconds * 1e9)))
 
 
 _CLOCK = [time.time()]  # the script's clock [s]: wall time at start, then advanced by rospy.sleep

@@ -51,6 +51,7 @@ if TYPE_CHECKING:
         AllowedCollisions,
         FixedTransform,
         PlanningSceneFile,
+        allowed_collisions,
         parse_planning_scene,
     )
     from .poses import pose_matrix
@@ -103,6 +104,7 @@ __all__ = [
     "StartFrom",
     "StepSpec",
     "TaskFile",
+    "allowed_collisions",
     "angle",
     "arc_point",
     "attached_collision_object",
@@ -183,6 +185,7 @@ __getattr__ = lazy_exports(__name__, {
     "StartFrom": "goals",
     "StepSpec": "tasks",
     "TaskFile": "tasks",
+    "allowed_collisions": "planning_scene_yaml",
     "angle": "fields",
     "arc_point": "constraints",
     "attached_collision_object": "collision_objects",

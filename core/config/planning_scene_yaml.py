@@ -38,7 +38,10 @@ from .ros_messages import header_frame, robot_state, string_list, transform, yam
 from .scene_yaml import check_shape_count
 from .xacro import PackagePath
 
-__all__ = ["PLANNING_SCENE_KEYS", "AllowedCollisions", "FixedTransform", "PlanningSceneFile", "parse_planning_scene"]
+__all__ = [
+    "PLANNING_SCENE_KEYS", "AllowedCollisions", "FixedTransform", "PlanningSceneFile", "allowed_collisions",
+    "parse_planning_scene",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -146,7 +149,7 @@ def parse_planning_scene(top: dict[str, Any], path: Path, config: RobotConfig) -
     where = f"{source}: robot_state.attached_collision_objects"
     attached_messages = tuple(attached_collision_object(value, f"{where}[{k}]", path.parent, packages)
                               for k, value in enumerate(attached))
-    allowed = _allowed_collisions(top.get("allowed_collision_matrix"), f"{source}: allowed_collision_matrix")
+    allowed = allowed_collisions(top.get("allowed_collision_matrix"), f"{source}: allowed_collision_matrix")
     return PlanningSceneFile(source, joints, fixed, tuple(objects.values()), attached_messages, allowed)
 
 
@@ -198,7 +201,7 @@ def _fixed_transforms(value: Any, source: str) -> tuple[FixedTransform, ...]:
     return tuple(entries)
 
 
-def _allowed_collisions(value: Any, where: str) -> AllowedCollisions:
+def allowed_collisions(value: Any, where: str) -> AllowedCollisions:
     """Return a moveit_msgs/AllowedCollisionMatrix's entries, read as MoveIt reads them."""
     acm = mapping(value, where)
     check_keys(acm, _ACM_KEYS, where)
