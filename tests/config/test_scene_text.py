@@ -55,3 +55,14 @@ def test_a_malformed_scene_file_names_the_file_and_line(tmp_path: Path, text: st
     path.write_text(text)
     with pytest.raises(ConfigError, match=f"{path}: .*{message}" if "line" not in message else f"{path}: {message}"):
         parse_scene_text(text, path)
+
+
+def test_a_malformed_scene_file_exits_3_on_one_line_and_writes_nothing(cli: Cli, tmp_path: Path) -> None:
+    scene = tmp_path / "bad.scene"
+    scene.write_text("s\n* p\n1\nplane\n0 0 1 0\n0 0 0\n0 0 0 1\n0 0 0 0\n.\n")
+    out = tmp_path / "plan.mcap"
+    result = cli("plan", "--robot", "ur10e", "--scene", scene, "--joints", "0.5,-1.2,-1.8,0,1.57,0", "-o", out)
+    assert result.exit_code == 3 and not out.exists()
+    assert result.stderr.strip().count("\n") == 0 and "Traceback" not in result.stderr
+    assert f"{scene}: line 4: object 'p': shape 0: planes are not supported" in result.stderr
+

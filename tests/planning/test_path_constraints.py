@@ -115,5 +115,7 @@ def test_a_task_step_plans_pilz_circ_about_a_center(cli: Cli, tmp_path: Path) ->
 def test_circ_without_its_point_is_a_usage_error(cli: Cli, tmp_path: Path) -> None:
     path = tmp_path / "circ.yaml"
     path.write_text(yaml.safe_dump({"robot": "ur10e", "steps": [{"name": "s", "named": "home", "planner": "CIRC"}]}))
-    result = cli("plan", path, "-o", tmp_path / "x.mcap")
+    out = tmp_path / "x.mcap"
+    result = cli("plan", path, "-o", out)
     assert result.exit_code == 2 and "CIRC needs the point its arc passes through" in result.stderr
+    assert not out.exists() and len(result.stderr.strip().splitlines()) == 1
