@@ -150,12 +150,6 @@ class MoveGroupCommander(PlanningSettings):
         """Return the frame planning is done in: the URDF's root link."""
         return self._robot.root_link
 
-    def get_interface_description(self) -> dict[str, Any]:
-        """Return the planners available, as move_group's query_planner_interface does."""
-        from ..core.config import PILZ_PLANNERS, PLANNERS
-
-        return {"ompl": list(PLANNERS), "pilz_industrial_motion_planner": list(PILZ_PLANNERS)}
-
     # The current state --------------------------------------------------------------------------
 
     def get_current_joint_values(self) -> list[float]:
