@@ -24,6 +24,8 @@ from .options import (
     ROBOT_HELP,
     JointLimitsOpt,
     JsonOpt,
+    LaunchArgOpt,
+    LaunchOpt,
     PackagePathOpt,
     QuietOpt,
     SrdfOpt,
@@ -122,6 +124,8 @@ def plan(
     urdf: UrdfOpt = None,
     srdf: SrdfOpt = None,
     joint_limits: JointLimitsOpt = None,
+    launch: LaunchOpt = None,
+    launch_arg: LaunchArgOpt = None,
     strict_limits: StrictLimitsOpt = False,
     ros_distro: Annotated[str, typer.Option(help="Message layout to write: jazzy or humble.")] = "jazzy",
     as_json: JsonOpt = False,
@@ -145,7 +149,7 @@ def plan(
 
 def _plan_flags(args: dict[str, Any]) -> PlanFlags:
     """Return the plan command's flags as core's typed values; core checks the rules between them."""
-    from ..core.config import MotionSettings, parse_xacro_args
+    from ..core.config import MotionSettings, launch_arguments, parse_xacro_args
     from ..core.pipeline import PlanFlags
 
     def number(key: str) -> float | None:
@@ -164,7 +168,8 @@ def _plan_flags(args: dict[str, Any]) -> PlanFlags:
         timeout=number("timeout"), seed=args["seed"],
         package_paths=tuple(args["package_path"] or ()),
         xacro_args=parse_xacro_args(args["xacro_arg"] or ()), urdf=args["urdf"], srdf=args["srdf"],
-        strict_limits=args["strict_limits"], joint_limits=args["joint_limits"],
+        strict_limits=args["strict_limits"], joint_limits=args["joint_limits"], launch=args["launch"],
+        launch_args=launch_arguments(args["launch_arg"] or ()),
     )
 
 
@@ -278,6 +283,8 @@ def robot_info(
     urdf: UrdfOpt = None,
     srdf: SrdfOpt = None,
     joint_limits: JointLimitsOpt = None,
+    launch: LaunchOpt = None,
+    launch_arg: LaunchArgOpt = None,
     strict_limits: StrictLimitsOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
@@ -287,7 +294,8 @@ def robot_info(
     with exit_codes(as_json):
         from . import render
 
-        loaded = robot_source(config, package_path, xacro_arg, urdf, srdf, strict_limits, joint_limits).load()
+        loaded = robot_source(config, package_path, xacro_arg, urdf, srdf, strict_limits, joint_limits, launch,
+                              launch_arg).load()
         loaded.collision_meshes()  # a missing mesh is reported here too, not only when planning
     render.robot_summary(loaded, as_json, quiet)
 
@@ -340,6 +348,8 @@ def benchmark(
     urdf: UrdfOpt = None,
     srdf: SrdfOpt = None,
     joint_limits: JointLimitsOpt = None,
+    launch: LaunchOpt = None,
+    launch_arg: LaunchArgOpt = None,
     strict_limits: StrictLimitsOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
@@ -369,7 +379,8 @@ def benchmark(
         if timeout_s is not None:
             check_planning_time(timeout_s, "--timeout")
         found = find_problems(problems, count)
-        source = robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits, joint_limits)
+        source = robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits, joint_limits, launch,
+                              launch_arg)
         config = source.load()
         planners = [p.strip() for text in planner or [config.motion.planner] for p in text.split(",")]
         with render.benchmark_progress(len(found) * len(planners) * len(seed_list), quiet) as advance:

@@ -12,6 +12,8 @@ from .options import (
     ROBOT_HELP,
     JointLimitsOpt,
     JsonOpt,
+    LaunchArgOpt,
+    LaunchOpt,
     PackagePathOpt,
     QuietOpt,
     SrdfOpt,
@@ -43,6 +45,8 @@ def state(
     urdf: UrdfOpt = None,
     srdf: SrdfOpt = None,
     joint_limits: JointLimitsOpt = None,
+    launch: LaunchOpt = None,
+    launch_arg: LaunchArgOpt = None,
     strict_limits: StrictLimitsOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
@@ -55,14 +59,15 @@ def state(
         from . import render
 
         given = {"--package-path": package_path, "--xacro-arg": xacro_arg, "--urdf": urdf, "--srdf": srdf,
-                 "--joint-limits": joint_limits, "--strict-limits": strict_limits}
+                 "--joint-limits": joint_limits, "--strict-limits": strict_limits, "--launch": launch,
+                 "--launch-arg": launch_arg}
         if robot is None and (flags := [name for name, value in given.items() if value]):
             from ..core.errors import UsageError
 
             raise UsageError(f"{flags[0]} completes --robot: give --robot too (with --from alone, the plan's "
                              "embedded config is used as it is)")
         source = None if robot is None else robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits,
-                                                         joint_limits)
+                                                         joint_limits, launch, launch_arg)
         result = robot_state(StateRequest(
             robot=source, group=group, joints=parse_optional(parse_joints, joints, "--joints"), named=named,
             plan=from_plan, step=step, at_s=parse_optional(parse_time, at, "--at"), link=link, frame=frame, scene=scene,

@@ -107,6 +107,8 @@ class RobotCommander:
             `$ROS_PACKAGE_PATH`.
         urdf, srdf, joint_limits, xacro_args, strict_limits: As `--urdf`, `--srdf`, `--joint-limits`,
             `--xacro-arg`, `--strict-limits`.
+        launch, launch_args: As `--launch` and `--launch-arg`: the MoveIt package's launch file to
+            read the robot from, and its launch arguments (name -> value).
         plant, plant_params, controllers: The simulated hardware motions execute on, as
             `execute --fake --plant`, `--plant-param` and `--controllers` choose it.
         seed: Seeds every plan (each one anew, as one `moveplan plan` run) and the plant.
@@ -124,6 +126,8 @@ class RobotCommander:
         joint_limits: str | None = None,
         xacro_args: Mapping[str, str] | None = None,
         strict_limits: bool = False,
+        launch: str | None = None,
+        launch_args: Mapping[str, str] | None = None,
         plant: str = "mirror",
         plant_params: Mapping[str, float] | None = None,
         controllers: str | Path | None = None,
@@ -146,11 +150,12 @@ class RobotCommander:
         paths = [] if package_path is None else [package_path] if isinstance(package_path, str | Path) else package_path
         if not hasattr(paths, "__iter__"):
             raise UsageError(f"{where}: package_path: expected a folder or a list of folders, got {package_path!r}")
-        _check_arguments(robot, {"urdf": urdf, "srdf": srdf, "joint_limits": joint_limits},
-                         {"xacro_args": xacro_args, "plant_params": plant_params}, seed)
+        _check_arguments(robot, {"urdf": urdf, "srdf": srdf, "joint_limits": joint_limits, "launch": launch},
+                         {"xacro_args": xacro_args, "plant_params": plant_params, "launch_args": launch_args}, seed)
         params = {str(k): finite_number(v, f"{where}: plant_params['{k}']") for k, v in (plant_params or {}).items()}
         source = RobotSource(robot, tuple(_path(p, f"{where}: package_path") for p in paths), dict(xacro_args or {}),
-                             urdf, srdf, strict_limits, joint_limits)
+                             urdf, srdf, strict_limits, joint_limits, launch,
+                             {str(k): str(v) for k, v in (launch_args or {}).items()})
         controllers_path = _path(controllers, f"{where}: controllers") if controllers else None
         execution = ExecutionSettings(plant, params, controllers_path, int(seed))
         scene_path = _path(scene, f"{where}: scene") if scene is not None else None

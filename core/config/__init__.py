@@ -41,6 +41,7 @@ if TYPE_CHECKING:
     )
     from .goals import SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
     from .joint_units import check_joint_units
+    from .launch_files import LaunchFiles, launch_arguments
     from .limits import DEFAULT_ACCELERATION, JointLimit
     from .meshes import mesh_file
     from .motion import MIN_SCALING, MotionSettings, Resolved, is_planning_time, is_scaling, layered, resolved
@@ -85,6 +86,7 @@ __all__ = [
     "JointBound",
     "JointGoal",
     "JointLimit",
+    "LaunchFiles",
     "MotionPlanRequest",
     "MotionSettings",
     "NamedGoal",
@@ -120,6 +122,7 @@ __all__ = [
     "first_repeated",
     "is_planning_time",
     "is_scaling",
+    "launch_arguments",
     "layered",
     "load_motion_plan_request",
     "load_robot_config",
@@ -166,6 +169,7 @@ __getattr__ = lazy_exports(__name__, {
     "JointBound": "constraints",
     "JointGoal": "goals",
     "JointLimit": "limits",
+    "LaunchFiles": "launch_files",
     "MotionPlanRequest": "moveit_request",
     "MotionSettings": "motion",
     "NamedGoal": "goals",
@@ -201,6 +205,7 @@ __getattr__ = lazy_exports(__name__, {
     "first_repeated": "scene_yaml",
     "is_planning_time": "motion",
     "is_scaling": "motion",
+    "launch_arguments": "launch_files",
     "layered": "motion",
     "load_motion_plan_request": "moveit_request",
     "load_robot_config": "robot_config",

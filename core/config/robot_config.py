@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..errors import ConfigError, UnknownName
+from ..errors import ConfigError, UnknownName, UsageError
 from ._descriptions import check_xacro_args, expand, file_xacro_args
 from ._initial_state import fake_controllers_initial, initial_state
 from ._settings import parse_kinematics, planning_defaults
@@ -28,6 +28,7 @@ from ._urdf import CollisionMesh, UrdfJoint, parse_urdf, resolve_collision_meshe
 from .controllers import ControllerConfig, ExecutionConfig, parse_controllers, parse_execution
 from .embed import carried_paths, embedded_files
 from .fields import load_yaml, read_input
+from .launch_files import LaunchFiles, RobotFile, read_launch
 from .limits import DEFAULT_SOURCE, JointLimit, is_moveit_joint_limits, merge_limits, parse_joint_limits
 from .motion import Resolved
 from .sources import (
@@ -146,6 +147,7 @@ class _Located:
     paths: dict[str, Path]
     xacro_args: dict[str, str] = field(default_factory=dict)  # from moveplan.yaml or .setup_assistant
     xacro_source: Path | None = None  # the file that gave them
+    launch: LaunchFiles = field(default_factory=LaunchFiles)  # what the package's launch files name
 
 
 @dataclass(frozen=True)
@@ -169,6 +171,8 @@ def load_robot_config(
     strict_limits: bool = False,
     embedded: bool = False,
     joint_limits: str | None = None,
+    launch: str | None = None,
+    launch_args: Mapping[str, str] | None = None,
 ) -> RobotConfig:
     """Return the parsed robot config at `robot`.
 
@@ -183,6 +187,10 @@ def load_robot_config(
         srdf: --srdf, likewise the SRDF.
         joint_limits: --joint-limits, likewise MoveIt's joint_limits.yaml (a vendor keeps it
             where a launch file names it).
+        launch: --launch, the one launch file of a MoveIt package to read (default: all of its
+            launch/ folder; core/config/launch_files.py).
+        launch_args: --launch-arg values, as `ros2 launch` takes them; a launch argument also
+            sets the URDF's and SRDF's xacro arg of the same name where they declare one.
         strict_limits: --strict-limits: a joint without an acceleration limit is an error
             instead of planning with the documented default.
         embedded: `robot` is the folder a plan file's attachments were written to: read as
@@ -194,7 +202,8 @@ def load_robot_config(
             names file and key, or the files and the flag that settles it.
         UsageError: A --xacro-arg the xacro files do not declare.
     """
-    found = _carried(Path(robot)) if embedded else _locate(robot, package_paths, urdf, srdf, joint_limits)
+    found = _carried(Path(robot)) if embedded else _locate(robot, package_paths, urdf, srdf, joint_limits, launch,
+                                                             launch_args or {})
     paths = found.paths
     model = _read_model(found, xacro_args or {})
     limit_overrides, v_scale, a_scale = parse_joint_limits(paths.get("joint_limits"))
@@ -250,6 +259,7 @@ def load_robot_config(
 
 def _locate(
     robot: str | Path, package_paths: Sequence[Path], urdf: str | None, srdf: str | None, joint_limits: str | None,
+    launch: str | None = None, launch_args: Mapping[str, str] | None = None,
 ) -> _Located:
     """Return where the config's files are: named by its moveplan.yaml, or found in its folder or beside a file."""
     path = resolve_config_path(robot, srdf_given=srdf is not None)
@@ -262,13 +272,17 @@ def _locate(
     packages = PackagePath(search_path(root, tuple(package_paths), extra))
     given = {key: flag_file(value, key, packages)
              for key, value in (("urdf", urdf), ("srdf", srdf), ("joint_limits", joint_limits)) if value}
+    if (launch or launch_args) and not path.is_dir():
+        raise UsageError(f"--launch and --launch-arg read a MoveIt package's launch files; {robot} is not a package "
+                         "folder")
     if manifest is not None:
         paths = manifest_files(manifest, top, packages, given)
         # A flag's file replaces moveplan.yaml's, named by URI: a plan then embeds the files as loaded.
         top = {**top, **{key: file.resolve().as_uri() for key, file in given.items()}}
         return _Located(manifest, root, top, packages, paths, file_xacro_args(manifest, top.get("xacro_args")),
                         manifest)
-    found = discover(root, packages, given) if path.is_dir() else discover_beside(path, given)
+    launched = read_launch(root, packages, launch_args or {}, launch) if path.is_dir() else LaunchFiles()
+    found = discover(root, packages, given, launched) if path.is_dir() else discover_beside(path, given)
     if found.root != root:
         packages = PackagePath(search_path(found.root, tuple(package_paths)))
     paths = {**found.paths, **{key: file for key, file in given.items() if key not in ("urdf", "srdf")}}
@@ -276,7 +290,7 @@ def _locate(
         # Found by name only: a description package's own limits (Franka's) beside its URDF, not MoveIt's.
         logger.warning("%s: not MoveIt's joint_limits.yaml (no joint_limits key); not read: pass --joint-limits "
                        "FILE to name MoveIt's", paths.pop("joint_limits"))
-    return _Located(None, found.root, top, packages, paths, found.xacro_args, found.xacro_source)
+    return _Located(None, found.root, top, packages, paths, found.xacro_args, found.xacro_source, launched)
 
 
 def _carried(folder: Path) -> _Located:
@@ -289,15 +303,36 @@ def _carried(folder: Path) -> _Located:
 
 
 def _read_model(found: _Located, flags: Mapping[str, str]) -> _Model:
-    """Return the URDF and SRDF read (through xacro, with flag > moveplan.yaml or .setup_assistant args) and parsed."""
+    """Return the URDF and SRDF read (through xacro) and parsed.
+
+    xacro args, later ones winning: the launch file's for that file, moveplan.yaml's or
+    .setup_assistant's, --launch-arg, --xacro-arg. Only the last three are checked against what
+    the files declare: a launch file may pass args a xacro does not use, as xacro allows.
+    """
     args = {**found.xacro_args, **flags}
+    launch = found.launch
     urdf_path, srdf_path = found.paths["urdf"], found.paths["srdf"]
-    urdf_text, urdf_includes, declared = expand(urdf_path, found.root, args, found.packages)
-    srdf_text, _, srdf_declared = expand(srdf_path, found.root, args, found.packages)
+    urdf_args = {**_launched(launch.urdf, urdf_path), **found.xacro_args, **launch.given, **flags}
+    srdf_args = {**_launched(launch.srdf, srdf_path), **found.xacro_args, **launch.given, **flags}
+    try:
+        urdf_text, urdf_includes, declared = expand(urdf_path, found.root, urdf_args, found.packages)
+    except ConfigError as exc:
+        named = launch.urdf is not None and launch.urdf.path.resolve() == urdf_path.resolve()
+        if not named or launch.source is None:
+            raise
+        where = launch.source.relative_to(found.root) if launch.source.is_relative_to(found.root) else launch.source
+        raise ConfigError(f"{exc} (the URDF {where} names; pass --urdf FILE for another)") from None
+    srdf_text, _, srdf_declared = expand(srdf_path, found.root, srdf_args, found.packages)
     check_xacro_args(args, frozenset(flags), declared | srdf_declared, (urdf_path, srdf_path), found.xacro_source)
     urdf_joints = parse_urdf(urdf_text, urdf_path)
     srdf = parse_srdf(srdf_text, srdf_path, urdf_joints)
-    return _Model(urdf_text, urdf_includes, urdf_joints, srdf_text, srdf, dict(args))
+    used = {name: value for name, value in {**srdf_args, **urdf_args}.items() if name in declared | srdf_declared}
+    return _Model(urdf_text, urdf_includes, urdf_joints, srdf_text, srdf, {**used, **args})
+
+
+def _launched(named: RobotFile | None, path: Path) -> dict[str, str]:
+    """Return the xacro args a launch file gives `path`, {} if it names another file."""
+    return dict(named.args) if named is not None and named.path.resolve() == path.resolve() else {}
 
 
 def _kinematics(path: Path | None, srdf: Srdf, named: bool) -> dict[str, dict[str, Any]] | None:
@@ -320,6 +355,8 @@ def _sources(found: _Located, planning_source: Path) -> dict[str, Path]:
     sources = dict(found.paths)
     if found.manifest is not None:
         sources["moveplan"] = found.manifest
+    if found.launch.source is not None:
+        sources["launch"] = found.launch.source
     sources["planning"] = planning_source
     return sources
 

@@ -24,6 +24,7 @@
 
 from __future__ import annotations
 
+import logging
 import os
 import re
 import sys
@@ -35,8 +36,9 @@ from typing import Any
 
 from ..errors import ConfigError, UsageError, known
 from ._setup_assistant import SETUP_ASSISTANT_FILE, builder_srdf, builder_urdf, read_setup_assistant, robot_names
-from ._workspace import workspace_src
+from ._workspace import packages_under, workspace_src
 from .fields import check_keys, load_yaml, mapping, read_input_text, string_list
+from .launch_files import LaunchFiles
 from .xacro import PackagePath
 
 __all__ = [
@@ -44,6 +46,8 @@ __all__ = [
     "read_manifest", "resolve_config_path", "robot_file_kind", "search_path", "shipped_config", "shipped_configs",
     "stem",
 ]
+
+logger = logging.getLogger(__name__)
 
 CONFIG_FILE = "moveplan.yaml"
 FILE_KEYS = ("urdf", "srdf", "joint_limits", "kinematics", "controllers", "moveit_controllers", "initial_positions")
@@ -93,8 +97,8 @@ def resolve_config_path(robot: str | Path, srdf_given: bool = False) -> Path:
 
     A bare name such as `ur10e` names a config shipped with moveplan. A folder holding a
     moveplan.yaml means that file; a folder without one is read as a MoveIt config package
-    (or a plain folder holding a URDF and an SRDF) if it holds an SRDF or a .setup_assistant,
-    or if `srdf_given` (--srdf names the SRDF).
+    (or a plain folder holding a URDF and an SRDF) if it holds an SRDF, a .setup_assistant or
+    a launch/ folder, or if `srdf_given` (--srdf names the SRDF).
     """
     path = Path(robot)
     shipped = shipped_config(str(robot))
@@ -103,11 +107,12 @@ def resolve_config_path(robot: str | Path, srdf_given: bool = False) -> Path:
     if path.is_dir():
         if (path / CONFIG_FILE).is_file():
             return path / CONFIG_FILE
-        if srdf_given or (path / SETUP_ASSISTANT_FILE).is_file() or any(
+        if srdf_given or (path / SETUP_ASSISTANT_FILE).is_file() or (path / "launch").is_dir() or any(
                 _candidates(path / sub, _SRDF_SUFFIXES) for sub in _SRDF_FOLDERS):
             return path
         raise ConfigError(f"{robot}: no robot config: no {CONFIG_FILE}, and no *.srdf in config/, srdf/ "
-                          "or the folder itself (a MoveIt config package); pass --srdf FILE to name one")
+                          "or the folder itself, and no launch/ folder (a MoveIt config package); "
+                          "pass --srdf FILE to name one")
     if not path.is_file():
         raise ConfigError(f"{robot}: robot config not found (expected {_ACCEPTED}, or a shipped config: "
                           f"{known(shipped_configs())})")
@@ -206,20 +211,122 @@ def flag_file(value: str, key: str, packages: PackagePath) -> Path:
     return path
 
 
-def discover(root: Path, packages: PackagePath, given: Mapping[str, Path]) -> Discovered:
-    """Return the files of a folder without moveplan.yaml (see the module's rules); `given` (flags) wins."""
+def discover(
+    root: Path, packages: PackagePath, given: Mapping[str, Path], launch: LaunchFiles | None = None
+) -> Discovered:
+    """Return the files of a folder without moveplan.yaml (see the module's rules); `given` (flags) wins.
+
+    `launch` is what the package's launch files name (core/config/launch_files.py): after the
+    flags, before the rules by name.
+    """
+    launched = launch or LaunchFiles()
     names = robot_names(root)
     assistant = read_setup_assistant(root)
-    srdf = given.get("srdf") or builder_srdf(root, names, assistant) or _pick(
-        [root / sub for sub in _SRDF_FOLDERS], "srdf", names, f"{root}: no SRDF file", _where(_SRDF_FOLDERS))
+    if "urdf" not in given:
+        _check_required(root, launched)
+    srdf = (given.get("srdf") or (launched.srdf.path if launched.srdf else None)
+            or builder_srdf(root, names, assistant) or _pick([root / sub for sub in _SRDF_FOLDERS], "srdf", names)
+            or _below(root, launched))
+    if srdf is None:
+        raise ConfigError(_absent(root, "srdf", _where(_SRDF_FOLDERS), launched))
     names = tuple(dict.fromkeys((*names, stem(srdf))))
-    urdf = given.get("urdf") or builder_urdf(root, names, assistant, packages) or _pick(
-        [root / sub for sub in _URDF_FOLDERS], "urdf", (stem(srdf), *names), f"{root}: no URDF file",
-        _where(_URDF_FOLDERS) + f", and no {SETUP_ASSISTANT_FILE} naming one")
-    paths = {"srdf": srdf, "urdf": urdf, **_settings((root / "config", root))}
-    if "urdf" in given or assistant is None or not assistant.xacro_args:
+    urdf = given.get("urdf") or (launched.urdf.path if launched.urdf else None)
+    from_assistant = urdf is None and builder_urdf(root, names, assistant, packages) is not None
+    urdf = (urdf or builder_urdf(root, names, assistant, packages)
+            or _pick([root / sub for sub in _URDF_FOLDERS], "urdf", (stem(srdf), *names))
+            or _robot_urdf(root, srdf, names, packages))
+    if urdf is None:
+        raise ConfigError(_absent(root, "urdf", _where(_URDF_FOLDERS) + f", and no {SETUP_ASSISTANT_FILE} naming one",
+                                  launched))
+    paths = {"srdf": srdf, "urdf": urdf, **_settings((root / "config", root)), **launched.files}
+    if not from_assistant or assistant is None or not assistant.xacro_args:
         return Discovered(root, paths)
     return Discovered(root, paths, dict(assistant.xacro_args), assistant.path)
+
+
+def _check_required(root: Path, launched: LaunchFiles) -> None:
+    """Raise for a launch argument declared with choices and given no value: ros2 launch asks for it too."""
+    missing = {name: choices for name, choices in launched.required.items() if name not in launched.given}
+    if not missing:
+        return
+    name, choices = next(iter(missing.items()))
+    listed = f"; choices: {', '.join(choices)}" if choices else ""
+    below = _below_candidates(root)
+    srdfs = f"; SRDFs in the package: {', '.join(stem(p) for p in below)}" if below else ""
+    launch = ", ".join(p.name for p in launched.launch)
+    raise ConfigError(f"{root}: launch argument '{name}' has no value ({launch}: declared with choices and no "
+                      f"default{listed}){srdfs}; pass --launch-arg {name}:=VALUE")
+
+
+def _below(root: Path, launched: LaunchFiles) -> Path | None:
+    """Return the SRDF one folder down (config/srdf/) that is the only one, or the one a launch argument names."""
+    found = _below_candidates(root)
+    if len(found) == 1:
+        return found[0]
+    named = [p for p in found if stem(p) in launched.given.values()]
+    return named[0] if len(named) == 1 else None
+
+
+def _below_candidates(root: Path) -> list[Path]:
+    """Return the SRDFs in the subfolders of config/ and srdf/ (a family's package keeps one per robot there)."""
+    found: list[Path] = []
+    for sub in ("config", "srdf"):
+        if (root / sub).is_dir():
+            for folder in sorted(p for p in (root / sub).iterdir() if p.is_dir()):
+                found.extend(_files(folder, "srdf"))
+    return found
+
+
+def _robot_urdf(root: Path, srdf: Path, names: Sequence[str], packages: PackagePath) -> Path | None:
+    """Return the URDF of the SRDF's robot in a package of the search path (urdf/ or robots/ <name>.urdf[.xacro]).
+
+    MoveIt packages whose launch files take the URDF from the robot's driver (robot_description
+    on a topic) do not name it; the description package of the workspace holds it.
+    """
+    wanted = dict.fromkeys((*_srdf_robot_names(srdf), stem(srdf), *names))
+    hits: list[Path] = []
+    for folder in packages.folders:
+        if not folder.is_dir() or folder == root:
+            continue
+        for package in dict.fromkeys((*(([folder]) if (folder / "package.xml").is_file() else []),
+                                      *packages_under(folder).values())):
+            for name in wanted:
+                hits.extend(package / sub / f"{name}{suffix}" for sub in _XACRO_URDF_FOLDERS
+                            for suffix in (".urdf.xacro", ".urdf") if (package / sub / f"{name}{suffix}").is_file())
+        if hits:
+            break
+    hits = list(dict.fromkeys(hits))
+    if len(hits) > 1:
+        raise ConfigError(f"{root}: names no URDF, and the workspace holds several of its robot: "
+                          f"{', '.join(map(str, hits))}; pass --urdf FILE")
+    if hits:
+        logger.warning("%s: no launch file or config names the URDF; using %s, the robot's in the workspace "
+                       "(pass --urdf FILE for another)", root, hits[0])
+    return hits[0] if hits else None
+
+
+_ROBOT_NAME = re.compile(r"<robot\b[^>]*?\bname\s*=\s*[\"']([A-Za-z0-9_.-]+)[\"']")
+
+
+def _srdf_robot_names(srdf: Path) -> tuple[str, ...]:
+    """Return the robot name an SRDF's <robot name=...> gives, when it is written out (not a xacro arg)."""
+    try:
+        match = _ROBOT_NAME.search(read_input_text(srdf)[:4096])
+    except ConfigError:
+        return ()
+    return (match.group(1),) if match else ()
+
+
+def _absent(root: Path, kind: str, where: str, launched: LaunchFiles) -> str:
+    """Return the error for a config without a URDF or SRDF: where moveplan looked, what the launch files wait for."""
+    flag = _FLAGS[kind]
+    example = "package://pkg/urdf/robot.urdf.xacro" if kind == "urdf" else "package://pkg/config/robot.srdf"
+    below = _below_candidates(root) if kind == "srdf" else []
+    several = f"; one folder down: {', '.join(str(p.relative_to(root)) for p in below)}" if below else ""
+    waits = (f"; its launch files read launch arguments without a value: {', '.join(launched.needs)} "
+             "(pass --launch-arg NAME:=VALUE)") if launched.needs else ""
+    return (f"{root}: no {kind.upper()} file ({where}){several}{waits}; pass {flag} FILE or {flag} {example}, "
+            f"or write a {CONFIG_FILE} that names it")
 
 
 def discover_beside(file: Path, given: Mapping[str, Path]) -> Discovered:
@@ -230,9 +337,12 @@ def discover_beside(file: Path, given: Mapping[str, Path]) -> Discovered:
     other = "urdf" if kind == "srdf" else "srdf"
     subs = ("../urdf", "../robots", "../config") if other == "urdf" else ("../config", "../srdf")
     folders = [folder, *(folder.parent / sub.removeprefix("../") for sub in subs)]
-    paths[other] = given.get(other) or _pick(
-        folders, other, (stem(file),), f"{file}: no {other.upper()} beside it",
-        f"of the same name or the only one, in {folder}, {', '.join(subs)}")
+    found = given.get(other) or _pick(folders, other, (stem(file),))
+    if found is None:
+        flag = _FLAGS[other]
+        raise ConfigError(f"{file}: no {other.upper()} beside it (of the same name or the only one, in {folder}, "
+                          f"{', '.join(subs)}); pass {flag} FILE, or write a {CONFIG_FILE} that names it")
+    paths[other] = found
     root = next((p for p in (folder, folder.parent, folder.parent.parent) if (p / "package.xml").is_file()), folder)
     paths.update(_settings((paths["srdf"].parent, root / "config", root)))
     return Discovered(root, paths)
@@ -273,8 +383,12 @@ def _files(folder: Path, kind: str) -> list[Path]:
     return [p for p in _candidates(folder, suffixes) if not p.name.endswith(_SRDF_SUFFIXES)]
 
 
-def _pick(folders: Sequence[Path], kind: str, prefer: Sequence[str], missing: str, where: str) -> Path:
-    """Return the one `kind` file in the first of `folders` that has any (see _narrow); else raise naming the flag."""
+def _pick(folders: Sequence[Path], kind: str, prefer: Sequence[str]) -> Path | None:
+    """Return the one `kind` file in the first of `folders` that has any (see _narrow), None if none has any.
+
+    Raises:
+        ConfigError: Several candidates in that folder; names them and the flag that settles it.
+    """
     flag = _FLAGS[kind]
     for folder in folders:
         found = _files(folder, kind)
@@ -285,9 +399,7 @@ def _pick(folders: Sequence[Path], kind: str, prefer: Sequence[str], missing: st
             return chosen[0]
         raise ConfigError(f"{folder}: several {kind.upper()} files ({', '.join(p.name for p in chosen)}); "
                           f"write a {CONFIG_FILE} that names one, or pass {flag} FILE")
-    example = "package://pkg/urdf/robot.urdf.xacro" if kind == "urdf" else "package://pkg/config/robot.srdf"
-    raise ConfigError(f"{missing} ({where}); pass {flag} FILE or {flag} {example}, "
-                      f"or write a {CONFIG_FILE} that names it")
+    return None
 
 
 def _narrow(found: list[Path], prefer: Sequence[str]) -> list[Path]:

@@ -66,7 +66,8 @@ def plan_to_file(task: Path | None, flags: PlanFlags, output: Path, ros_distro: 
     request = resolve_request(load_task(task) if task is not None else None, flags)
     config = load_robot_config(request.robot, request.package_paths, request.xacro_args, urdf=request.urdf,
                                srdf=request.srdf, strict_limits=request.strict_limits,
-                               joint_limits=request.joint_limits)
+                               joint_limits=request.joint_limits, launch=request.launch,
+                               launch_args=request.launch_args)
     _refuse_replacing_inputs(output, request, config)
     if (request.group or config.planning["group"]) in config.srdf.groups:
         _warn_default_accelerations(config, request.group or config.planning["group"])
@@ -114,7 +115,8 @@ def plan(
     if config is None:
         config = load_robot_config(request.robot, request.package_paths, request.xacro_args, urdf=request.urdf,
                                    srdf=request.srdf, strict_limits=request.strict_limits,
-                                   joint_limits=request.joint_limits)
+                                   joint_limits=request.joint_limits, launch=request.launch,
+                                   launch_args=request.launch_args)
     robot = _robot(request, config)
     if loaded_here:
         _warn_default_accelerations(config, robot.group.name)

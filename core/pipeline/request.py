@@ -59,6 +59,8 @@ class RobotSource:
         urdf, srdf: --urdf and --srdf: a file or `package://pkg/path`, replacing the config's.
         strict_limits: --strict-limits: a missing acceleration limit is an error.
         joint_limits: --joint-limits: MoveIt's joint_limits.yaml, a file or `package://pkg/path`.
+        launch: --launch: the one launch file of a MoveIt package to read.
+        launch_args: --launch-arg values, name -> value.
     """
 
     robot: str | Path
@@ -68,11 +70,14 @@ class RobotSource:
     srdf: str | None = None
     strict_limits: bool = False
     joint_limits: str | None = None
+    launch: str | None = None
+    launch_args: Mapping[str, str] = field(default_factory=dict)
 
     def load(self) -> RobotConfig:
         """Return the robot config these arguments name."""
         return load_robot_config(self.robot, self.package_paths, self.xacro_args, urdf=self.urdf, srdf=self.srdf,
-                                 strict_limits=self.strict_limits, joint_limits=self.joint_limits)
+                                 strict_limits=self.strict_limits, joint_limits=self.joint_limits,
+                                 launch=self.launch, launch_args=self.launch_args)
 
 
 @dataclass(frozen=True)
@@ -106,6 +111,8 @@ class PlanFlags:
         urdf, srdf: The URDF and SRDF (a file or `package://pkg/path`), replacing the config's.
         strict_limits: A missing acceleration limit is an error instead of the default.
         joint_limits: MoveIt's joint_limits.yaml (a file or `package://pkg/path`), replacing the config's.
+        launch, launch_args: --launch and --launch-arg: which launch file of a MoveIt package to read,
+            with which arguments.
     """
 
     robot: Path | None = None
@@ -133,6 +140,8 @@ class PlanFlags:
     srdf: str | None = None
     strict_limits: bool = False
     joint_limits: str | None = None
+    launch: str | None = None
+    launch_args: Mapping[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         starts = [k for k in ("start_joints", "start_named", "start_from") if getattr(self, k) is not None]
@@ -203,6 +212,8 @@ class PlanRequest:
     srdf: str | None = None
     strict_limits: bool = False
     joint_limits: str | None = None
+    launch: str | None = None
+    launch_args: Mapping[str, str] = field(default_factory=dict)
 
 
 def resolve_request(task: TaskFile | None, flags: PlanFlags) -> PlanRequest:
@@ -230,6 +241,7 @@ def resolve_request(task: TaskFile | None, flags: PlanFlags) -> PlanRequest:
         min_fraction=1.0 if flags.min_fraction is None else flags.min_fraction,
         package_paths=flags.package_paths, xacro_args=dict(flags.xacro_args), task=task, motion_request=motion,
         urdf=flags.urdf, srdf=flags.srdf, strict_limits=flags.strict_limits, joint_limits=flags.joint_limits,
+        launch=flags.launch, launch_args=dict(flags.launch_args),
     )
 
 

@@ -71,10 +71,12 @@ def test_fanuc_config_finds_its_description_package_in_the_workspace(cli: Cli) -
 
 
 @pytest.mark.realworld
-def test_panda_config_with_three_srdfs_loads_the_one_setup_assistant_names(cli: Cli) -> None:
+def test_panda_config_with_three_srdfs_loads_the_one_its_demo_launch_names(cli: Cli) -> None:
+    """demo.launch.py: MoveItConfigsBuilder(...).robot_description_semantic(file_path="config/panda.srdf")."""
     code, document = cli.json("robot", real(PANDA))
     assert code == 0, document
-    assert document["sources"]["srdf"] == str(real(PANDA) / "config" / "panda_arm_hand.srdf.xacro")
+    assert document["sources"]["srdf"] == str(real(PANDA) / "config" / "panda.srdf")
+    assert document["sources"]["launch"] == str(real(PANDA) / "launch" / "demo.launch.py")
     # MoveItConfigsBuilder prefers the package's config/<robot name>.urdf.xacro (the folder names the robot).
     assert document["sources"]["urdf"] == str(real(PANDA) / "config" / "panda.urdf.xacro")
     assert list(document["groups"]) == ["panda_arm", "hand", "panda_arm_hand"]
@@ -96,8 +98,13 @@ def test_a_xacro_arg_flag_overrides_one_setup_assistant_arg_and_keeps_the_others
 
 
 @pytest.mark.realworld
-def test_gen3_lite_loads_the_urdf_named_like_its_srdf(cli: Cli) -> None:
-    code, document = cli.json("robot", real(GEN3_LITE))
+def test_gen3_lite_launch_files_name_a_urdf_xacro_refuses_and_the_error_says_so(cli: Cli) -> None:
+    """Its launch files build gen3_lite_gen3_lite_2f.urdf.xacro, whose macro call xacro refuses (as ROS's would)."""
+    result = cli("robot", real(GEN3_LITE))
+    assert result.exit_code == 3 and result.stderr.count("\n") == 1, result.stderr
+    assert 'Invalid parameter "gripper"' in result.stderr
+    assert "the URDF launch/demo.launch.py names; pass --urdf FILE for another" in result.stderr
+    code, document = cli.json("robot", real(GEN3_LITE), "--urdf", real(GEN3_LITE) / "config" / "gen3_lite.urdf.xacro")
     assert code == 0, document
     assert document["sources"]["urdf"] == str(real(GEN3_LITE) / "config" / "gen3_lite.urdf.xacro")
     assert list(document["groups"]) == ["arm", "gripper"]
@@ -112,11 +119,18 @@ def test_abb_srdf_the_setup_assistant_names_without_xacro_is_found_with_it() -> 
 
 
 @pytest.mark.realworld
-def test_ur_config_without_urdf_says_to_pass_urdf(cli: Cli) -> None:
+def test_ur_config_asks_for_the_ur_type_its_launch_file_declares_with_choices(cli: Cli) -> None:
+    """ur_moveit.launch.py: DeclareLaunchArgument("ur_type", choices=[...]) without a default."""
     result = cli("robot", real(UR))
     assert result.exit_code == 3, result.stderr
     assert result.stderr.count("\n") == 1
-    assert f"{real(UR)}: no URDF file" in result.stderr and "pass --urdf FILE" in result.stderr
+    assert f"{real(UR)}: launch argument 'ur_type' has no value" in result.stderr
+    assert "choices: ur3, ur5, ur10, ur3e, ur5e" in result.stderr
+    assert "pass --launch-arg ur_type:=VALUE" in result.stderr
+    code, document = cli.json("robot", real(UR), "--launch-arg", "ur_type:=ur10e", "--xacro-arg", "name:=ur")
+    assert code == 0, document
+    assert document["sources"]["urdf"] == str(real("Universal_Robots_ROS2_Description/urdf/ur.urdf.xacro"))
+    assert document["xacro_args"]["ur_type"] == "ur10e"
 
 
 @pytest.mark.realworld

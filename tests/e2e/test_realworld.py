@@ -41,7 +41,10 @@ PACKAGES = {
     "ur5e": Package("Universal_Robots_ROS2_Driver/ur_moveit_config", "ur_manipulator", UR_FLAGS,
                     "Universal_Robots_ROS2_Driver/ur_robot_driver/config/ur_controllers.yaml"),
     "gen3": Package("ros2_kortex/kortex_moveit_config/kinova_gen3_7dof_robotiq_2f_85_moveit_config", "manipulator"),
-    "gen3_lite": Package("ros2_kortex/kortex_moveit_config/kinova_gen3_lite_moveit_config", "arm"),
+    # Its launch files name a URDF xacro refuses (a macro parameter the arm's macro lacks): the Setup
+    # Assistant's copy named like the SRDF is the one that expands.
+    "gen3_lite": Package("ros2_kortex/kortex_moveit_config/kinova_gen3_lite_moveit_config", "arm", (
+        "--urdf", "package://kinova_gen3_lite_moveit_config/config/gen3_lite.urdf.xacro")),
     "irb1200": Package("abb_ros2/robot_specific_config/abb_irb1200_5_90_moveit_config", "manipulator"),
 }
 
