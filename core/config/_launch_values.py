@@ -96,13 +96,15 @@ class LaunchContext:
     declared: dict[str, Declared] = field(default_factory=dict)
     missing: dict[str, None] = field(default_factory=dict)  # arguments read without a value, in order
 
-    def argument(self, name: str) -> Any:
-        """Return a launch argument's value: given, else its declared default; Unknown naming it without either."""
+    def argument(self, name: str, fallback: Any = None) -> Any:
+        """Return a launch argument's value: given, declared default, `fallback` (the substitution's), else Unknown."""
         if name in self.given:
             return self.given[name]
         declared = self.declared.get(name)
         if declared is not None and declared.default is not None:
             return declared.default
+        if fallback is not None:
+            return fallback
         self.missing[name] = None
         return Unknown(frozenset({name}))
 
@@ -159,10 +161,7 @@ def text(value: Any, context: LaunchContext, depth: int = 0) -> str | Unknown:
         name = text(value.parts[0], context, depth + 1)
         if isinstance(name, Unknown):
             return name
-        found = context.argument(name)
-        if isinstance(found, Unknown) and value.parts[1] is not None:
-            found = value.parts[1]
-        return text(found, context, depth + 1)
+        return text(context.argument(name, value.parts[1]), context, depth + 1)
     if value.kind == "share":
         package = text(value.parts[0], context, depth + 1)
         if isinstance(package, Unknown):

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError, UsageError
+from ._launch_markup import evaluate_markup_launch
 from ._launch_python import evaluate_python_launch
 from ._launch_values import Builder, LaunchContext, LaunchRecord, Lazy, Unknown, XacroFile, YamlFile, text
 from ._setup_assistant import builder_srdf, builder_urdf, read_setup_assistant
@@ -189,10 +190,7 @@ def _evaluate(file: Path, given: dict[str, str], packages: PackagePath, depth: i
 
     if file.name.endswith(".py"):
         return evaluate_python_launch(file, context, lambda module: _find_module(packages, module), include)
-    from ._launch_markup import evaluate_markup_launch
-
-    record: LaunchRecord = evaluate_markup_launch(file, context, include)
-    return record
+    return evaluate_markup_launch(file, context, include)
 
 
 def _walk(record: LaunchRecord) -> list[LaunchRecord]:
@@ -512,7 +510,6 @@ def _combine(root: Path, found: list[_Found], given: dict[str, str]) -> LaunchFi
         needs.update(item.needs)
         for name, choices in item.required.items():
             required.setdefault(name, choices)
-    named = urdf or srdf
-    source = named.launch if named is not None else None
+    source = urdf.launch if urdf is not None else srdf.launch if srdf is not None else None
     return LaunchFiles(tuple(f.launch for f in found), urdf.urdf if urdf else None, srdf.srdf if srdf else None,
                        files, tuple(needs), required, given, source)

@@ -128,7 +128,9 @@ def plan_controller(
     """
     joints = plan.steps[0].trajectory.joint_names
     if override is not None:
-        return pick_controller(parse_controllers(override, substitute=substitute), joints, str(override))
+        # MoveIt's preference comes from its own controllers file, whichever file ros2_control reads.
+        return pick_controller(parse_controllers(override, substitute=substitute), joints, str(override),
+                               config.execution.default_controllers)
     if "controllers" not in config.sources:
         # A config without ros2_controllers.yaml (ABB's, most Setup Assistant packages before Humble): the
         # controller ros2_control would load with no parameters file, as users get from mock hardware.

@@ -468,3 +468,65 @@ def test_a_switch_moveit_does_not_read_is_ignored_with_a_warning_but_an_unknown_
     (folder / "joint_limits.yaml").write_text(limits.replace("has_jerk: false", "max_jerkk: 5"))
     with pytest.raises(ConfigError, match="unknown key 'max_jerkk'"):
         load_robot_config(folder)
+
+
+# --- vendors' packages: the robot their launch files name -----------------------------------------
+
+FRANKA = "franka_ros2/franka_fr3_moveit_config"
+KUKA = "kuka_robot_descriptions/kuka_kr_moveit_config"
+INTERBOTIX = "interbotix_ros_manipulators/interbotix_ros_xsarms/interbotix_xsarm_moveit"
+TIAGO = "tiago_moveit_config"
+
+
+@pytest.mark.realworld
+def test_franka_loads_as_given_from_the_xacro_commands_of_its_launch_file(cli: Cli) -> None:
+    """moveit.launch.py: Command([xacro, fr3.urdf.xacro, ' hand:=true', ' robot_ip:=', robot_ip, ...])."""
+    code, document = cli.json("robot", real(FRANKA))
+    assert code == 0, document
+    assert document["sources"]["urdf"] == str(real("franka_description/robots/fr3/fr3.urdf.xacro"))
+    assert document["sources"]["srdf"] == str(real("franka_description/robots/fr3/fr3.srdf.xacro"))
+    assert document["sources"]["controllers"] == str(real(FRANKA) / "config" / "fr3_ros_controllers.yaml")
+    assert document["xacro_args"]["hand"] == "true"
+    assert {"fr3_arm", "fr3_hand"} <= set(document["groups"])
+
+
+@pytest.mark.realworld
+def test_kuka_loads_as_given_with_the_limits_and_srdf_its_launch_and_cmake_name(cli: Cli) -> None:
+    """moveit_server_template.launch.py names <support>/config/<model>_joint_limits.yaml and urdf/<model>.srdf,
+    which CMakeLists.txt's xacro_add_files makes from srdf/kr_arm.srdf.xacro with robot_name:=<model>."""
+    code, document = cli.json("robot", real(KUKA))
+    assert code == 0, document
+    limits = real("kuka_robot_descriptions/kuka_agilus_support/config/kr6_r700_sixx_joint_limits.yaml")
+    assert document["sources"]["joint_limits"] == str(limits)
+    assert document["sources"]["srdf"] == str(real(KUKA) / "srdf" / "kr_arm.srdf.xacro")
+    assert document["xacro_args"]["robot_name"] == "kr6_r700_sixx"
+    joint = document["joints"]["joint_1"]
+    assert joint["max_acceleration"] == pytest.approx(41.67291) and joint["source"]["acceleration"].endswith(
+        "kr6_r700_sixx_joint_limits.yaml")
+
+
+@pytest.mark.realworld
+def test_interbotix_asks_for_its_robot_model_and_lists_its_srdfs(cli: Cli) -> None:
+    result = cli("robot", real(INTERBOTIX))
+    assert result.exit_code == 3 and result.stderr.count("\n") == 1, result.stderr
+    assert "launch argument 'robot_model' has no value" in result.stderr
+    assert "SRDFs in the package: mobile_px100," in result.stderr and ", wx250s;" in result.stderr
+    code, document = cli.json("robot", real(INTERBOTIX), "--launch-arg", "robot_model:=wx250s")
+    assert code == 0, document
+    assert document["sources"]["joint_limits"] == str(real(INTERBOTIX) / "config/joint_limits/wx250s_joint_limits.yaml")
+    assert document["sources"]["srdf"] == str(real(INTERBOTIX) / "config/srdf/wx250s.srdf.xacro")
+
+
+@pytest.mark.realworld
+def test_tiago_names_the_launch_arguments_and_srdfs_to_choose_from(cli: Cli) -> None:
+    """move_group.launch.py: 'config/srdf/tiago' + get_tiago_hw_suffix(arm, end_effector, ft_sensor) + '.srdf'."""
+    result = cli("robot", real(TIAGO))
+    assert result.exit_code == 3 and result.stderr.count("moveplan: error") == 1, result.stderr
+    assert "config/srdf/tiago_pal-hey5_schunk-ft.srdf" in result.stderr
+    assert "launch arguments without a value: arm, " in result.stderr and "end_effector" in result.stderr
+    args = ("--launch-arg", "arm:=tiago-arm", "--launch-arg", "end_effector:=pal-hey5", "--launch-arg",
+            "ft_sensor:=schunk-ft")
+    code, document = cli.json("robot", real(TIAGO), *args)
+    assert code == 0, document
+    assert document["sources"]["srdf"] == str(real(TIAGO) / "config/srdf/tiago_pal-hey5_schunk-ft.srdf")
+    assert document["xacro_args"]["end_effector"] == "pal-hey5"  # the URDF of the same hardware

@@ -1,8 +1,10 @@
-"""Seven real MoveIt 2 config packages, laid out as a colcon workspace's src/, used as they are.
+"""Eleven real MoveIt 2 config packages, laid out as a colcon workspace's src/, used as they are.
 
-Each loads with no environment set, plans a joint goal and a pose goal in its arm group, the
-files read back in rosbags, and the plan executes on the fake controller with the package's own
-controllers (UR: the driver's ur_controllers.yaml, as its launch file loads it).
+Each loads with no environment set (vendors' packages through their launch files, with the one
+launch argument that picks the robot of a family), plans a joint goal and a pose goal in its arm
+group, the files read back in rosbags, and the plan executes on the fake controller with the
+package's own controllers (UR: the driver's ur_controllers.yaml, as its launch file loads it;
+TIAGo: tiago_controller_configuration's arm controller, as its bringup spawns it).
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ class Package:
     group: str
     flags: tuple[str, ...] = ()
     controllers: str = ""  # a controllers file outside the package (execute --controllers)
+    launch_args: tuple[str, ...] = ()  # --launch-arg NAME:=VALUE, the robot of a family
 
 
 UR_FLAGS = ("--urdf", "package://ur_description/urdf/ur.urdf.xacro", "--xacro-arg", "ur_type:=ur5e",
@@ -46,6 +49,13 @@ PACKAGES = {
     "gen3_lite": Package("ros2_kortex/kortex_moveit_config/kinova_gen3_lite_moveit_config", "arm", (
         "--urdf", "package://kinova_gen3_lite_moveit_config/config/gen3_lite.urdf.xacro")),
     "irb1200": Package("abb_ros2/robot_specific_config/abb_irb1200_5_90_moveit_config", "manipulator"),
+    "fr3": Package("franka_ros2/franka_fr3_moveit_config", "fr3_arm"),
+    "kr6_r700_sixx": Package("kuka_robot_descriptions/kuka_kr_moveit_config", "manipulator"),
+    "wx250s": Package("interbotix_ros_manipulators/interbotix_ros_xsarms/interbotix_xsarm_moveit", "interbotix_arm",
+                      launch_args=("robot_model:=wx250s",)),
+    "tiago": Package("tiago_moveit_config", "arm",
+                     controllers="tiago_robot/tiago_controller_configuration/config/arm_controller.yaml",
+                     launch_args=("arm:=tiago-arm", "end_effector:=pal-hey5", "ft_sensor:=schunk-ft")),
 }
 
 
@@ -60,7 +70,8 @@ def _goal(package: Package) -> tuple[Robot, np.ndarray, np.ndarray]:
     """Return the robot, its start values and a joint goal a fifth of the way from the start to mid-range."""
     flags = dict(zip(package.flags[::2], package.flags[1::2], strict=True))
     args = dict(a.split(":=") for a in package.flags[3::2]) if package.flags else {}
-    config = load_robot_config(SRC / package.path, urdf=flags.get("--urdf"), xacro_args=args)
+    config = load_robot_config(SRC / package.path, urdf=flags.get("--urdf"), xacro_args=args,
+                               launch_args=dict(a.split(":=") for a in package.launch_args))
     robot = Robot(config, package.group)
     start = np.array([config.initial_positions[j] for j in robot.group.joints])
     lower = np.array([max(config.limits[j].lower, -np.pi) for j in robot.group.joints])
@@ -81,7 +92,8 @@ def _read_back(path: Path) -> set[str]:
 def test_a_real_config_plans_joint_and_pose_goals_and_executes(name: str, cli: Cli, tmp_path: Path) -> None:
     package = PACKAGES[name]
     robot, start, goal = _goal(package)
-    config = [*package.flags, "--robot", SRC / package.path, "--group", package.group, "--seed", 0]
+    launch = [word for arg in package.launch_args for word in ("--launch-arg", arg)]
+    config = [*package.flags, *launch, "--robot", SRC / package.path, "--group", package.group, "--seed", 0]
     joints = ",".join(f"{j}={v:.6f}" for j, v in zip(robot.group.joints, goal, strict=True))
     result = cli("plan", *config, "--joints", joints, "-o", tmp_path / "joint.mcap")
     assert result.exit_code == 0, result.stderr
