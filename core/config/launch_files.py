@@ -26,18 +26,18 @@ from __future__ import annotations
 
 import logging
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..errors import ConfigError, UsageError
+from ..errors import ConfigError
 from ._launch_markup import evaluate_markup_launch
 from ._launch_python import evaluate_python_launch
 from ._launch_values import Builder, LaunchContext, LaunchRecord, Lazy, Unknown, XacroFile, YamlFile, text
 from ._setup_assistant import builder_srdf, builder_urdf, read_setup_assistant
 from .fields import load_yaml, read_input_text
-from .xacro import PackagePath
+from .xacro import PackagePath, parse_xacro_args
 
 __all__ = ["LaunchFiles", "RobotFile", "launch_arguments", "read_launch"]
 
@@ -98,15 +98,9 @@ class _Found:
     required: dict[str, tuple[str, ...]] = field(default_factory=dict)  # read without value, declared with choices
 
 
-def launch_arguments(words: tuple[str, ...] | list[str]) -> dict[str, str]:
-    """Return NAME:=VALUE words as a mapping, as `ros2 launch` takes them; UsageError for another word."""
-    given: dict[str, str] = {}
-    for word in words:
-        name, sep, value = word.partition(":=")
-        if not sep or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_.-]*", name):
-            raise UsageError(f"--launch-arg {word!r}: expected NAME:=VALUE, as ros2 launch takes it")
-        given[name] = value
-    return given
+def launch_arguments(words: Sequence[str]) -> dict[str, str]:
+    """Return --launch-arg NAME:=VALUE words as a mapping, as `ros2 launch` takes them (each name once)."""
+    return parse_xacro_args(words, "--launch-arg")
 
 
 def read_launch(root: Path, packages: PackagePath, given: Mapping[str, str], launch: str | None = None) -> LaunchFiles:
@@ -259,8 +253,9 @@ def _builder(builder: Builder, context: LaunchContext, found: _Found, packages: 
                       else builder_srdf(root, (robot,), assistant))
             mappings = builder.calls.get(method, (None, None))[1]
             if chosen is not None:
+                # MoveItConfigsBuilder: `mappings or` .setup_assistant's xacro_args, not both.
                 args = dict(assistant.xacro_args) if assistant is not None and setting == "urdf" else {}
-                _set_description(setting, chosen, {**args, **_mappings(mappings, context, found)}, found)
+                _set_description(setting, chosen, _mappings(mappings, context, found) if mappings else args, found)
     for method, setting, default in (("joint_limits", "joint_limits", "config/joint_limits.yaml"),
                                      ("robot_description_kinematics", "kinematics", "config/kinematics.yaml"),
                                      ("trajectory_execution", "moveit_controllers", "config/moveit_controllers.yaml")):

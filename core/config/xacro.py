@@ -160,23 +160,23 @@ MAX_ARG_LENGTH = 4096
 """Characters of one --xacro-arg value: a name, a prefix, a path or a number is far shorter."""
 
 
-def parse_xacro_args(items: Sequence[str]) -> dict[str, str]:
-    """Return `name:=value` strings (the --xacro-arg flag, as ros2 launch writes them) as a mapping."""
+def parse_xacro_args(items: Sequence[str], flag: str = "--xacro-arg") -> dict[str, str]:
+    """Return `name:=value` strings (--xacro-arg or --launch-arg, `flag`, as ros2 launch writes them) as a mapping."""
     args: dict[str, str] = {}
     for item in items:
         shown = item.encode("utf-8", "backslashreplace").decode("utf-8")
         shown = shown if len(shown) <= 80 else f"{shown[:77]}..."
         name, sep, value = item.partition(":=")
         if not sep or not name.strip():
-            raise UsageError(f"--xacro-arg '{shown}': expected name:=value")
+            raise UsageError(f"{flag} '{shown}': expected name:=value")
         try:
             item.encode("utf-8")
         except UnicodeEncodeError:  # bytes the shell passed that are no UTF-8 arrive as surrogates
-            raise UsageError(f"--xacro-arg '{shown}': not UTF-8 text") from None
+            raise UsageError(f"{flag} '{shown}': not UTF-8 text") from None
         if len(value) > MAX_ARG_LENGTH:
-            raise UsageError(f"--xacro-arg '{shown}': {len(value):,} characters; at most {MAX_ARG_LENGTH:,}")
+            raise UsageError(f"{flag} '{shown}': {len(value):,} characters; at most {MAX_ARG_LENGTH:,}")
         if name.strip() in args:
-            raise UsageError(f"--xacro-arg {name.strip()}: given twice")
+            raise UsageError(f"{flag} {name.strip()}: given twice")
         args[name.strip()] = value
     return args
 

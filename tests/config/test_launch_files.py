@@ -267,8 +267,10 @@ def test_a_launch_file_python_cannot_parse_names_the_file_with_launch(workspace:
 
 def test_launch_arguments_are_name_value_pairs_as_ros2_launch_takes_them() -> None:
     assert launch_arguments(["robot_model:=wx250s", "a.b:="]) == {"robot_model": "wx250s", "a.b": ""}
-    with pytest.raises(UsageError, match=r"--launch-arg 'robot_model=wx250s': expected NAME:=VALUE"):
+    with pytest.raises(UsageError, match=r"--launch-arg 'robot_model=wx250s': expected name:=value"):
         launch_arguments(["robot_model=wx250s"])
+    with pytest.raises(UsageError, match=r"--launch-arg robot_model: given twice"):
+        launch_arguments(["robot_model:=a", "robot_model:=b"])
 
 
 def test_launch_on_a_lone_urdf_is_a_usage_error(workspace: Path) -> None:
@@ -292,5 +294,5 @@ def test_plan_and_robot_take_launch_and_launch_arg(workspace: Path, cli: Cli, tm
     assert code == 0, report
     result = cli("plan", "--robot", package, "--launch-arg", "robot_model", "--named", "home",
                  "-o", tmp_path / "bad.mcap")
-    assert result.exit_code == 2 and "expected NAME:=VALUE" in result.stderr
+    assert result.exit_code == 2 and "expected name:=value" in result.stderr
     assert not (tmp_path / "bad.mcap").exists()
