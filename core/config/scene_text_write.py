@@ -38,11 +38,11 @@ def format_scene_text(name: str, objects: Mapping[str, Sequence[CollisionObject]
     Every part is a world object whose mesh, if any, is inline (vertices and triangles).
 
     Raises:
-        ConfigError: The name or an id is empty or holds a line break (a .scene file is read by lines);
-            names `source`.
+        ConfigError: An id is empty, or the name or an id holds a line break (a .scene file is read by
+            lines); names `source`.
         ValueError: A part is attached to a link, or its mesh is a file.
     """
-    if name.splitlines() != [name] and name:
+    if name and name.splitlines() != [name]:
         raise ConfigError(f"{source}: scene name {name!r}: a .scene file cannot hold a name with a line break")
     lines = [name]
     for object_id, parts in objects.items():
