@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from . import state_command, tune_command
+from . import scene_command, state_command, tune_command
 from .errors import (
     GuardedGroup,
     all_or_none,
@@ -396,6 +396,7 @@ def benchmark(
 
 
 app.command("state")(state_command.state)
+app.command("scene")(scene_command.scene)
 app.command("tune-pid")(tune_command.tune_pid)
 
 

@@ -8,6 +8,7 @@ if TYPE_CHECKING:
     from ._verdicts import MAYBE
     from .checker import CollisionChecker, GeometryMode
     from .compiled import add_setup_time, kernels_loaded, kernels_ready, setup_time_spent
+    from .mesh_arrays import inline_mesh
     from .motion import MotionChecker, build_sphere_filter, exact_checks, hull_checker
     from .sphere_filter import SphereFilter
 
@@ -21,6 +22,7 @@ __all__ = [
     "build_sphere_filter",
     "exact_checks",
     "hull_checker",
+    "inline_mesh",
     "kernels_loaded",
     "kernels_ready",
     "setup_time_spent",
@@ -36,6 +38,7 @@ __getattr__ = lazy_exports(__name__, {
     "build_sphere_filter": "motion",
     "exact_checks": "motion",
     "hull_checker": "motion",
+    "inline_mesh": "mesh_arrays",
     "kernels_loaded": "compiled",
     "kernels_ready": "compiled",
     "setup_time_spent": "compiled",

@@ -58,6 +58,7 @@ if TYPE_CHECKING:
     from .poses import pose_matrix
     from .robot_config import RobotConfig, load_robot_config
     from .scene_text import parse_scene_text
+    from .scene_text_write import format_scene_text
     from .scene_yaml import SceneFile, check_shape_count, first_repeated, parse_scene
     from .sources import CONFIG_FILE
     from .srdf import Group
@@ -120,6 +121,7 @@ __all__ = [
     "default_position",
     "expression",
     "first_repeated",
+    "format_scene_text",
     "is_planning_time",
     "is_scaling",
     "launch_arguments",
@@ -203,6 +205,7 @@ __getattr__ = lazy_exports(__name__, {
     "default_position": "_initial_state",
     "expression": "fields",
     "first_repeated": "scene_yaml",
+    "format_scene_text": "scene_text_write",
     "is_planning_time": "motion",
     "is_scaling": "motion",
     "launch_arguments": "launch_files",

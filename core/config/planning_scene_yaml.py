@@ -111,6 +111,7 @@ class PlanningSceneFile:
         objects: world.collision_objects, each with parts and a unique id.
         attached: robot_state.attached_collision_objects, in file order.
         allowed: The allowed collision matrix.
+        name: The scene's `name` ("" when it has none).
     """
 
     source: str
@@ -119,6 +120,7 @@ class PlanningSceneFile:
     objects: tuple[ObjectMessage, ...]
     attached: tuple[AttachedMessage, ...]
     allowed: AllowedCollisions
+    name: str = ""
 
 
 def parse_planning_scene(top: dict[str, Any], path: Path, config: RobotConfig) -> PlanningSceneFile:
@@ -150,7 +152,10 @@ def parse_planning_scene(top: dict[str, Any], path: Path, config: RobotConfig) -
     attached_messages = tuple(attached_collision_object(value, f"{where}[{k}]", path.parent, packages)
                               for k, value in enumerate(attached))
     allowed = allowed_collisions(top.get("allowed_collision_matrix"), f"{source}: allowed_collision_matrix")
-    return PlanningSceneFile(source, joints, fixed, tuple(objects.values()), attached_messages, allowed)
+    name = top.get("name")
+    if name is not None and not isinstance(name, str):
+        raise ConfigError(f"{source}: name: expected a string, got {name!r}")
+    return PlanningSceneFile(source, joints, fixed, tuple(objects.values()), attached_messages, allowed, name or "")
 
 
 def _shape_count(collision_objects: Any, attached: list[Any]) -> int:

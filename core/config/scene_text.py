@@ -14,7 +14,8 @@
     .
 
 Boxes are full sizes, cylinders and cones radius then length. Objects are world objects in the
-planning frame; one of several shapes becomes `id/0`, `id/1`... as a PlanningScene YAML's does.
+planning frame; one of several shapes becomes `id/0`, `id/1`... as a PlanningScene YAML's does, and
+the scene keeps them grouped under their id (`SceneFile.parts`).
 A cone is checked as the cylinder that encloses it; planes are refused; subframes are not read.
 """
 
@@ -108,6 +109,7 @@ def parse_scene_text(text: str, path: Path) -> SceneFile:
     # MoveIt's test: the line after the first '*' has spaces (an object pose) in the newer format.
     new_format = bool(starts) and starts[0] + 1 < len(body) and " " in body[starts[0] + 1].strip()
     tokens = _Tokens(body, path)
+    parts: dict[str, tuple[str, ...]] = {}
     while True:
         line = tokens.line()
         marker = tokens.word("'*' (an object) or '.' (the end)")
@@ -115,9 +117,12 @@ def parse_scene_text(text: str, path: Path) -> SceneFile:
             break
         if marker != "*":
             raise ConfigError(f"{path}: line {line}: expected '*' (an object) or '.' (the end), got {marker!r}")
-        objects.extend(_object(tokens, tokens.words[tokens.at - 1][2], line, new_format, path))
+        object_id = tokens.words[tokens.at - 1][2]
+        entries = _object(tokens, object_id, line, new_format, path)
+        objects.extend(entries)
+        parts[object_id] = (*parts.get(object_id, ()), *(entry.name for entry in entries))
     check_shape_count(len(objects), str(path))
-    return SceneFile(str(path), (), tuple(objects), ())
+    return SceneFile(str(path), (), tuple(objects), (), name=lines[0], parts=parts)
 
 
 def _object(tokens: _Tokens, name: str, line: int, new_format: bool, path: Path) -> list[SceneEntry]:

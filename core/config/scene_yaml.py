@@ -7,7 +7,7 @@ resolves either against a robot into a Scene.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -67,12 +67,17 @@ class SceneFile:
         frames: Scene frames as written (`parent_T_frame`).
         objects: World objects.
         attached: Objects carried by robot links.
+        name: The scene's name, where the file gives one (a `.scene` file's first line).
+        parts: Object id -> the names of the objects its shapes became (`id/0`, `id/1`, ...), where the
+            file groups shapes under an id (a `.scene` file); empty when each object is its own id.
     """
 
     source: str
     frames: tuple[Frame, ...]
     objects: tuple[SceneEntry, ...]
     attached: tuple[SceneEntry, ...]
+    name: str = ""
+    parts: dict[str, tuple[str, ...]] = field(default_factory=dict)
 
 
 def parse_scene(top: dict[str, Any], path: Path) -> SceneFile:

@@ -87,7 +87,7 @@ def read_planning_scene(top: dict[str, Any], path: Path, robot: Robot) -> Scene:
         q = robot.set_joint(q, joint, value)
 
     frames = _fixed_frames(file.fixed_transforms, robot)
-    fixed = Scene(source, tuple(frames), (), resolve_frames(frames, robot, source), robot_state=state)
+    fixed = Scene(source, tuple(frames), (), resolve_frames(frames, robot, source), robot_state=state, name=file.name)
     objects = _Objects()
     for message in file.objects:
         objects.world[message.id] = _place(message, "", robot, fixed, q)

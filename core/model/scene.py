@@ -46,8 +46,9 @@ class Scene:
             collision matrix; the SRDF's disabled pairs come on top).
         robot_state: Joint name -> position in [rad] or [m], the robot state a PlanningScene
             carries (empty for moveplan scenes).
-        parts: PlanningScene object id -> the names of the objects it became (one per shape).
+        parts: PlanningScene (or `.scene`) object id -> the names of the objects it became (one per shape).
         subframes: PlanningScene object id -> the names of the frames its subframes became.
+        name: The scene's name, where its file gives one (a PlanningScene's `name`, a `.scene` file's first line).
     """
 
     source: str
@@ -58,6 +59,7 @@ class Scene:
     robot_state: dict[str, float] = field(default_factory=dict)
     parts: dict[str, tuple[str, ...]] = field(default_factory=dict)
     subframes: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    name: str = ""
 
     def anchor(self, frame: str, robot: Robot) -> tuple[str, NDArray[np.float64]]:
         """Return (robot link, `link_T_frame`) for a scene frame, a robot link or a name of the planning frame."""
@@ -69,6 +71,15 @@ class Scene:
         if frame in planning:
             return robot.root_link, np.eye(4)
         raise FrameNotFound(frame, self.source, [*self.anchors, *robot.link_names, *planning])
+
+    def object_groups(self, attached: bool = False) -> dict[str, tuple[CollisionObject, ...]]:
+        """Return the world objects (attached ones with `attached`) by object id, each id's parts in scene order."""
+        id_of = {name: object_id for object_id, names in self.parts.items() for name in names}
+        groups: dict[str, list[CollisionObject]] = {}
+        for obj in self.objects:
+            if bool(obj.link) == attached:  # a moveplan scene's objects are their own ids
+                groups.setdefault(id_of.get(obj.name, obj.name), []).append(obj)
+        return {object_id: tuple(parts) for object_id, parts in groups.items()}
 
 
 def planning_frame_names(robot: Robot) -> frozenset[str]:
@@ -112,7 +123,7 @@ def resolved_scene(file: SceneFile, robot: Robot) -> Scene:
         if entry.link not in robot.link_names:
             raise FrameNotFound(entry.link, entry.where, robot.link_names)
         objects.append(CollisionObject(entry.name, entry.shape, entry.transform, entry.link, entry.touch_links))
-    return Scene(file.source, file.frames, tuple(objects), anchors)
+    return Scene(file.source, file.frames, tuple(objects), anchors, parts=dict(file.parts), name=file.name)
 
 
 def resolve_frames(

@@ -3,8 +3,8 @@
 Modules: `plan` (plan, plan_to_file; one step's stages in `step`), `request` (PlanFlags,
 resolve_request), `execute` (execute, check), `plan_files` (what every command reading a plan
 needs: its config, its steps checked, its controller), `report` (the result document and the
-executed file), `inspection` (inspect_file), `benchmark` (run_benchmark, summarize), `plots/`
-(the --plot files). Nothing is imported
+executed file), `inspection` (inspect_file), `benchmark` (run_benchmark, summarize), `scene_export`
+(export_scene: a scene as MoveIt's .scene), `plots/` (the --plot files). Nothing is imported
 here, so that a command loads only what it runs (execute never loads OMPL).
 """
 
@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from .report import check_document, execute_to_file, execution_document
     from .request import PlanFlags, RobotSource, check_planning_time
     from .robot_state import StateRequest, StateResult, state
+    from .scene_export import SceneExport, check_scene_path, export_scene, scene_document
     from .session import (
         ExecutionSettings,
         cartesian_motion,
@@ -58,6 +59,7 @@ __all__ = [
     "ProblemFiles",
     "RobotSource",
     "Run",
+    "SceneExport",
     "StateRequest",
     "StateResult",
     "TuneRequest",
@@ -70,11 +72,13 @@ __all__ = [
     "check_planning_time",
     "check_plot_path",
     "check_plotted",
+    "check_scene_path",
     "compose_scene",
     "execute",
     "execute_motion",
     "execute_plotted",
     "execute_to_file",
+    "export_scene",
     "execution_document",
     "failure_document",
     "find_problems",
@@ -89,6 +93,7 @@ __all__ = [
     "plot_benchmark",
     "robot_document",
     "run_benchmark",
+    "scene_document",
     "session_plan",
     "start_configuration",
     "state",
@@ -114,6 +119,7 @@ __getattr__ = lazy_exports(__name__, {
     "ProblemFiles": "benchmark",
     "RobotSource": "request",
     "Run": "benchmark",
+    "SceneExport": "scene_export",
     "StateRequest": "robot_state",
     "StateResult": "robot_state",
     "TuneRequest": "tuning",
@@ -126,11 +132,13 @@ __getattr__ = lazy_exports(__name__, {
     "check_planning_time": "request",
     "check_plot_path": "plots",
     "check_plotted": "plots",
+    "check_scene_path": "scene_export",
     "compose_scene": "session",
     "execute": "execution",
     "execute_motion": "session",
     "execute_plotted": "plots",
     "execute_to_file": "report",
+    "export_scene": "scene_export",
     "execution_document": "report",
     "failure_document": "documents",
     "find_problems": "benchmark",
@@ -145,6 +153,7 @@ __getattr__ = lazy_exports(__name__, {
     "plot_benchmark": "benchmark",
     "robot_document": "documents",
     "run_benchmark": "benchmark",
+    "scene_document": "scene_export",
     "session_plan": "session",
     "start_configuration": "session",
     "state": "robot_state",

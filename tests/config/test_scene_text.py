@@ -29,6 +29,13 @@ def test_an_object_of_two_shapes_is_placed_at_its_pose() -> None:
     np.testing.assert_allclose(by_name["pole"].transform[:3, 3], [1.0, 0.0, 0.5])
 
 
+def test_the_scene_keeps_its_name_and_each_id_its_shapes() -> None:
+    path = SCENES / "rviz_table.scene"
+    scene = parse_scene_text(path.read_text(), path)
+    assert scene.name == "(noname)+"
+    assert scene.parts == {"table top": ("table top/0", "table top/1"), "pole": ("pole",)}
+
+
 def test_the_older_format_without_object_poses_reads_too() -> None:
     path = SCENES / "rviz_old_format.scene"
     (box,) = parse_scene_text(path.read_text(), path).objects

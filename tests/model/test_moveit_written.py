@@ -83,6 +83,12 @@ def test_fixed_frames_are_read_as_moveit_writes_them_child_the_planning_frame(pa
     np.testing.assert_allclose(link_T_top[:3, 3], [0.55, 0.0, 0.25], atol=1e-9)
 
 
+def test_the_scene_keeps_its_name_and_a_name_that_is_no_string_names_the_key(panda: Robot, tmp_path: Path) -> None:
+    assert load_scene(SCENE, panda).name == "pick_cup"
+    with pytest.raises(ConfigError, match=r"bad.yaml: name: expected a string, got \[1\]"):
+        load_scene(write(tmp_path / "bad.yaml", {**yaml.safe_load(SCENE.read_text()), "name": [1]}), panda)
+
+
 def test_planning_frame_of_the_srdf_virtual_joint_names_the_child_of_fixed_frames(tmp_path: Path) -> None:
     robot = Robot(load_robot_config(MBM_PANDA))
     # No entry for `world` itself: the SRDF's virtual joint says it is the planning frame.
