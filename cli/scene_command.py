@@ -13,6 +13,8 @@ from .options import (
     ROBOT_HELP,
     JointLimitsOpt,
     JsonOpt,
+    LaunchArgOpt,
+    LaunchOpt,
     PackagePathOpt,
     QuietOpt,
     SrdfOpt,
@@ -41,6 +43,8 @@ def scene(
     urdf: UrdfOpt = None,
     srdf: SrdfOpt = None,
     joint_limits: JointLimitsOpt = None,
+    launch: LaunchOpt = None,
+    launch_arg: LaunchArgOpt = None,
     strict_limits: StrictLimitsOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
@@ -54,7 +58,8 @@ def scene(
         check_scene_path(output)
         check_outputs({"-o": output}, {"SCENE": scene_file, "--robot": robot,
                                        **description_inputs(urdf, srdf, joint_limits)})
-        source = robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits, joint_limits)
+        source = robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits, joint_limits, launch,
+                              launch_arg)
         result = export_scene(scene_file, source, output)
     _summary(result, as_json, quiet)
 
