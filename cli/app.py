@@ -30,6 +30,7 @@ from .options import (
     QuietOpt,
     SrdfOpt,
     StrictLimitsOpt,
+    StrictOpt,
     TimeoutOpt,
     UrdfOpt,
     VerboseOpt,
@@ -127,6 +128,7 @@ def plan(
     launch: LaunchOpt = None,
     launch_arg: LaunchArgOpt = None,
     strict_limits: StrictLimitsOpt = False,
+    strict: StrictOpt = False,
     ros_distro: Annotated[str, typer.Option(help="Message layout to write: jazzy or humble.")] = "jazzy",
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
@@ -169,7 +171,7 @@ def _plan_flags(args: dict[str, Any]) -> PlanFlags:
         package_paths=tuple(args["package_path"] or ()),
         xacro_args=parse_xacro_args(args["xacro_arg"] or ()), urdf=args["urdf"], srdf=args["srdf"],
         strict_limits=args["strict_limits"], joint_limits=args["joint_limits"], launch=args["launch"],
-        launch_args=launch_arguments(args["launch_arg"] or ()),
+        launch_args=launch_arguments(args["launch_arg"] or ()), strict=args["strict"],
     )
 
 
@@ -183,6 +185,7 @@ def execute(
     disturb: Annotated[list[str] | None, typer.Option(help="Fault: 't=1.2,joint=elbow_joint,delta=0.05'.")] = None,
     start_joints: Annotated[str | None, typer.Option(help="Robot away from the plan start: 'joint=value'.")] = None,
     controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml overriding the plan's.")] = None,
+    strict: StrictOpt = False,
     seed: Annotated[int, typer.Option(min=0, max=MAX_SEED, help="Seed for plant noise.")] = 0,
     ros_distro: Annotated[str, typer.Option(help="Controller-state layout to write: jazzy or humble.")] = "jazzy",
     plot: Annotated[Path | None, typer.Option(metavar="FILE.png", help=(
@@ -212,7 +215,7 @@ def execute(
             plan=plan_file, plant=plant, plant_params=parse_params(plant_param or [], "--plant-param"),
             disturbances=tuple(parse_disturbance(d) for d in disturb or []),
             start_joints=parse_joint_values(start_joints, "--start-joints") if start_joints else None,
-            controllers=controllers, seed=seed,
+            controllers=controllers, seed=seed, strict=strict,
         )
         if plot is not None:
             outcome = execute_plotted(request, plot, output, ros_distro)
@@ -233,6 +236,7 @@ def check_tolerances(
         metavar="RECORDING", help="A ROS 2 bag with sensor_msgs/JointState: .mcap, .db3 or a bag folder.")],
     topic: Annotated[str, typer.Option(help="JointState topic in the recording.")] = "/joint_states",
     controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml overriding the plan's.")] = None,
+    strict: StrictOpt = False,
     start: Annotated[str, typer.Option(help="auto, a time [s] from the recording's start, or all.")] = "auto",
     time_source: Annotated[str, typer.Option(help="header (message stamps) or log (receive times).")] = "header",
     skip_damaged: Annotated[bool, typer.Option("--skip-damaged", help=(
@@ -260,7 +264,7 @@ def check_tolerances(
         source: TimeSource = "log" if time_source == "log" else "header"
         when: RecordingStart = ("auto" if start == "auto" else "all" if start == "all"
                                 else parse_time(start, "--start (auto, all or seconds)"))
-        request = CheckRequest(plan_file, recording_file, topic, controllers, when, source, skip_damaged)
+        request = CheckRequest(plan_file, recording_file, topic, controllers, when, source, skip_damaged, strict)
         if plot is None:
             report = check(request)
         else:
@@ -286,6 +290,7 @@ def robot_info(
     launch: LaunchOpt = None,
     launch_arg: LaunchArgOpt = None,
     strict_limits: StrictLimitsOpt = False,
+    strict: StrictOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
 ) -> None:
@@ -295,7 +300,7 @@ def robot_info(
         from . import render
 
         loaded = robot_source(config, package_path, xacro_arg, urdf, srdf, strict_limits, joint_limits, launch,
-                              launch_arg).load()
+                              launch_arg, strict).load()
         loaded.collision_meshes()  # a missing mesh is reported here too, not only when planning
     render.robot_summary(loaded, as_json, quiet)
 
@@ -351,6 +356,7 @@ def benchmark(
     launch: LaunchOpt = None,
     launch_arg: LaunchArgOpt = None,
     strict_limits: StrictLimitsOpt = False,
+    strict: StrictOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
 ) -> None:
@@ -380,7 +386,7 @@ def benchmark(
             check_planning_time(timeout_s, "--timeout")
         found = find_problems(problems, count)
         source = robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits, joint_limits, launch,
-                              launch_arg)
+                              launch_arg, strict)
         config = source.load()
         planners = [p.strip() for text in planner or [config.motion.planner] for p in text.split(",")]
         with render.benchmark_progress(len(found) * len(planners) * len(seed_list), quiet) as advance:

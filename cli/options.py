@@ -13,7 +13,7 @@ if TYPE_CHECKING:  # imported by the command that loads a robot: `moveplan --hel
 
 __all__ = [
     "ROBOT_HELP", "JsonOpt", "LaunchArgOpt", "LaunchOpt", "PackagePathOpt", "QuietOpt", "SrdfOpt", "StrictLimitsOpt",
-    "TimeoutOpt", "UrdfOpt", "VerboseOpt", "XacroArgOpt", "robot_source", "setup_logging",
+    "StrictOpt", "TimeoutOpt", "UrdfOpt", "VerboseOpt", "XacroArgOpt", "robot_source", "setup_logging",
 ]
 
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON document on stdout, nothing else.")]
@@ -34,6 +34,9 @@ LaunchOpt = Annotated[str | None, typer.Option(
     help="The MoveIt package's launch file to read the robot from (read, never run; default: all of launch/).")]
 LaunchArgOpt = Annotated[list[str] | None, typer.Option(
     "--launch-arg", metavar="NAME:=VALUE", help="Launch argument, as ros2 launch takes it; repeatable.")]
+StrictOpt = Annotated[bool, typer.Option(
+    "--strict", help="A parameter a controller does not declare (in ros2_controllers.yaml) is an error, "
+                     "not a warning.")]
 StrictLimitsOpt = Annotated[bool, typer.Option(
     "--strict-limits", help="An acceleration limit missing in the config is an error instead of the documented "
                             "default.")]
@@ -66,11 +69,11 @@ def setup_logging(verbose: bool, quiet: bool) -> None:
 def robot_source(
     robot: Path, package_path: list[Path] | None, xacro_arg: list[str] | None, urdf: str | None, srdf: str | None,
     strict_limits: bool, joint_limits: str | None = None, launch: str | None = None,
-    launch_arg: list[str] | None = None,
+    launch_arg: list[str] | None = None, strict: bool = False,
 ) -> RobotSource:
     """Return what loads the robot config: --robot and the flags that complete it, as core's typed value."""
     from ..core.config import launch_arguments, parse_xacro_args
     from ..core.pipeline import RobotSource
 
     return RobotSource(robot, tuple(package_path or ()), parse_xacro_args(xacro_arg or ()), urdf, srdf, strict_limits,
-                       joint_limits, launch, launch_arguments(launch_arg or ()))
+                       joint_limits, launch, launch_arguments(launch_arg or ()), strict)

@@ -19,6 +19,7 @@ from .options import (
     QuietOpt,
     SrdfOpt,
     StrictLimitsOpt,
+    StrictOpt,
     UrdfOpt,
     VerboseOpt,
     XacroArgOpt,
@@ -46,6 +47,7 @@ def scene(
     launch: LaunchOpt = None,
     launch_arg: LaunchArgOpt = None,
     strict_limits: StrictLimitsOpt = False,
+    strict: StrictOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
     verbose: VerboseOpt = False,
@@ -59,7 +61,7 @@ def scene(
         check_outputs({"-o": output}, {"SCENE": scene_file, "--robot": robot,
                                        **description_inputs(urdf, srdf, joint_limits)})
         source = robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits, joint_limits, launch,
-                              launch_arg)
+                              launch_arg, strict)
         result = export_scene(scene_file, source, output)
     _summary(result, as_json, quiet)
 

@@ -18,6 +18,7 @@ from .options import (
     QuietOpt,
     SrdfOpt,
     StrictLimitsOpt,
+    StrictOpt,
     UrdfOpt,
     XacroArgOpt,
     robot_source,
@@ -48,6 +49,7 @@ def state(
     launch: LaunchOpt = None,
     launch_arg: LaunchArgOpt = None,
     strict_limits: StrictLimitsOpt = False,
+    strict: StrictOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
 ) -> None:
@@ -60,14 +62,14 @@ def state(
 
         given = {"--package-path": package_path, "--xacro-arg": xacro_arg, "--urdf": urdf, "--srdf": srdf,
                  "--joint-limits": joint_limits, "--strict-limits": strict_limits, "--launch": launch,
-                 "--launch-arg": launch_arg}
+                 "--launch-arg": launch_arg, "--strict": strict}
         if robot is None and (flags := [name for name, value in given.items() if value]):
             from ..core.errors import UsageError
 
             raise UsageError(f"{flags[0]} completes --robot: give --robot too (with --from alone, the plan's "
                              "embedded config is used as it is)")
         source = None if robot is None else robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits,
-                                                         joint_limits, launch, launch_arg)
+                                                         joint_limits, launch, launch_arg, strict)
         result = robot_state(StateRequest(
             robot=source, group=group, joints=parse_optional(parse_joints, joints, "--joints"), named=named,
             plan=from_plan, step=step, at_s=parse_optional(parse_time, at, "--at"), link=link, frame=frame, scene=scene,

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .errors import check_outputs, exit_codes
-from .options import JsonOpt, QuietOpt, VerboseOpt, setup_logging
+from .options import JsonOpt, QuietOpt, StrictOpt, VerboseOpt, setup_logging
 from .parsing import MAX_SEED, parse_params
 
 __all__ = ["tune_pid"]
@@ -26,6 +26,7 @@ def tune_pid(
     topic: Annotated[str, typer.Option(help="JointState topic in --recording.")] = "/joint_states",
     plot: Annotated[Path | None, typer.Option(metavar="FILE.png", help="Write a PNG of the responses.")] = None,
     seed: Annotated[int, typer.Option(min=0, max=MAX_SEED, help="Seed for plant noise.")] = 0,
+    strict: StrictOpt = False,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
     verbose: VerboseOpt = False,
@@ -49,6 +50,6 @@ def tune_pid(
         names = tuple(j.strip() for j in (joints or "").split(",") if j.strip())
         result = tune(TuneRequest(plan_file, output, controllers, names,
                                   parse_params(plant_param or [], "--plant-param"), oscillations, recording, topic,
-                                  seed, plot), write_tuning_plot)
+                                  seed, plot, strict), write_tuning_plot)
     tuning_summary(result, plot, as_json, quiet)
     raise typer.Exit(0 if result.ok else 5)

@@ -98,7 +98,7 @@ class ExecutionConfig:
 
 
 def parse_controllers(
-    path: Path, launch_args: Mapping[str, str] | None = None, substitute: bool = True
+    path: Path, launch_args: Mapping[str, str] | None = None, substitute: bool = True, strict: bool = False
 ) -> dict[str, ControllerConfig]:
     """Return the JointTrajectoryControllers (and GripperActionControllers) of a ros2_controllers.yaml, by name.
 
@@ -112,6 +112,7 @@ def parse_controllers(
         launch_args: Values of its `$(var NAME)` substitutions (the xacro args in force).
         substitute: False for a file a plan carries: its substitutions were made when the plan
             was, and a `$(` left in it is text (no environment variable is read for a plan).
+        strict: --strict: a parameter the controller does not declare is an error, not a warning.
 
     Raises:
         ConfigError: A malformed value, or an unknown key in a JointTrajectoryController's
@@ -138,7 +139,7 @@ def parse_controllers(
             declared = _JTC_KEYS | _NODE_KEYS | (_SCALED_JTC_KEYS if "Scaled" in kind else frozenset())
             params = _ros_parameters(top, name, path, declared)
             where = f"{path}: {name}.ros__parameters"
-            controllers[name] = _joint_trajectory_controller(name, kind, params, rate, where)
+            controllers[name] = _joint_trajectory_controller(name, kind, params, rate, where, strict)
         elif "GripperActionController" in kind:
             params = _ros_parameters(top, name, path, _GRIPPER_KEYS | _NODE_KEYS)
             joint = params.get("joint")
@@ -202,21 +203,30 @@ def _default_controllers(value: Any, path: Path) -> tuple[str, ...]:
                  and boolean(manager[name].get("default", False), f"{where}.{name}.default"))
 
 
-def _warn_unknown(params: Mapping[str, Any], allowed: frozenset[str], where: str) -> None:
+def _warn_unknown(params: Mapping[str, Any], allowed: frozenset[str], where: str, strict: bool) -> None:
     """Warn about parameters the controller does not declare: ros2_control ignores them, and so does moveplan.
 
     A node ignores an override it does not declare; the legacy `interface_name` (Foxy's) among them.
     A typo inside `constraints` or `gains` changes what is checked, and stays an error there.
+    With `strict` (--strict), each is a ConfigError instead.
     """
     for key in params:
+        if key in allowed:
+            continue
         if key == "interface_name":
+            if strict:
+                raise ConfigError(f"{where}: interface_name: today's JointTrajectoryController does not declare it "
+                                  "(command_interfaces name the interface); --strict refuses it")
             logger.warning("%s: interface_name is ignored, as today's JointTrajectoryController ignores it "
                            "(command_interfaces name the interface)", where)
-        elif key not in allowed:
-            near = difflib.get_close_matches(str(key), sorted(allowed), n=1)
-            hint = f" (did you mean '{near[0]}'?)" if near else ""
-            logger.warning("%s: unknown parameter '%s' ignored, as the controller ignores parameters it does not "
-                           "declare%s", where, key, hint)
+            continue
+        near = difflib.get_close_matches(str(key), sorted(allowed), n=1)
+        hint = f" (did you mean '{near[0]}'?)" if near else ""
+        if strict:
+            raise ConfigError(f"{where}: unknown parameter '{key}'{hint}: the controller does not declare it; "
+                              "--strict refuses it")
+        logger.warning("%s: unknown parameter '%s' ignored, as the controller ignores parameters it does not "
+                       "declare%s", where, key, hint)
 
 
 def _ros_parameters(
@@ -261,11 +271,11 @@ def _names_node(key: str, node: str) -> bool:
 
 
 def _joint_trajectory_controller(
-    name: str, kind: str, params: dict[str, Any], rate: float, where: str
+    name: str, kind: str, params: dict[str, Any], rate: float, where: str, strict: bool = False
 ) -> ControllerConfig:
     """Return one JointTrajectoryController's settings from its checked `ros__parameters` (at `where`)."""
     scaled = _SCALED_JTC_KEYS if "ScaledJointTrajectoryController" in kind else frozenset()
-    _warn_unknown(params, _JTC_KEYS | _NODE_KEYS | scaled, where)
+    _warn_unknown(params, _JTC_KEYS | _NODE_KEYS | scaled, where, strict)
     check_keys(mapping(params.get("speed_scaling"), f"{where}.speed_scaling"), _SPEED_SCALING_KEYS,
                f"{where}.speed_scaling")
     joints = tuple(string_list(params.get("joints"), f"{where}.joints", "joint names"))

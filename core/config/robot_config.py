@@ -173,6 +173,7 @@ def load_robot_config(
     joint_limits: str | None = None,
     launch: str | None = None,
     launch_args: Mapping[str, str] | None = None,
+    strict: bool = False,
 ) -> RobotConfig:
     """Return the parsed robot config at `robot`.
 
@@ -191,6 +192,7 @@ def load_robot_config(
             launch/ folder; core/config/launch_files.py).
         launch_args: --launch-arg values, as `ros2 launch` takes them; a launch argument also
             sets the URDF's and SRDF's xacro arg of the same name where they declare one.
+        strict: --strict: a parameter a controller does not declare is an error, not a warning.
         strict_limits: --strict-limits: a joint without an acceleration limit is an error
             instead of planning with the documented default.
         embedded: `robot` is the folder a plan file's attachments were written to: read as
@@ -210,7 +212,7 @@ def load_robot_config(
     limits = merge_limits(paths["urdf"], model.urdf_joints, paths.get("joint_limits"), limit_overrides,
                           strict=strict_limits)
     substitute = not embedded
-    controllers = (parse_controllers(paths["controllers"], model.xacro_args, substitute=substitute)
+    controllers = (parse_controllers(paths["controllers"], model.xacro_args, substitute=substitute, strict=strict)
                    if "controllers" in paths else {})
     _check_controller_joints(controllers, model.urdf_joints, paths.get("controllers"))
     execution = (parse_execution(paths["moveit_controllers"], model.xacro_args, substitute=substitute)

@@ -120,16 +120,18 @@ def pick_controller(
 
 
 def plan_controller(
-    config: RobotConfig, plan: recording.PlanFile, path: Path, override: Path | None, substitute: bool = True
+    config: RobotConfig, plan: recording.PlanFile, path: Path, override: Path | None, substitute: bool = True,
+    strict: bool = False,
 ) -> ControllerConfig:
     """Return the controller that executes the plan at `path`: from `override` (--controllers), else its own config.
 
-    `substitute` False reads `override` as data: launch substitutions are left as text.
+    `substitute` False reads `override` as data: launch substitutions are left as text. `strict`
+    (--strict) refuses a parameter `override`'s controller does not declare.
     """
     joints = plan.steps[0].trajectory.joint_names
     if override is not None:
         # MoveIt's preference comes from its own controllers file, whichever file ros2_control reads.
-        return pick_controller(parse_controllers(override, substitute=substitute), joints, str(override),
+        return pick_controller(parse_controllers(override, substitute=substitute, strict=strict), joints, str(override),
                                config.execution.default_controllers)
     if "controllers" not in config.sources:
         # A config without ros2_controllers.yaml (ABB's, most Setup Assistant packages before Humble): the

@@ -63,6 +63,8 @@ class ExecuteRequest:
     start_joints: JointGoal | None = None
     controllers: Path | None = None
     seed: int = 0
+    strict: bool = False
+    """--strict: a parameter the `controllers` file's controller does not declare is an error."""
     controllers_as_data: bool = False
     """The `controllers` file is a plan's own (tune-pid's gains written into it): read without launch substitutions."""
 
@@ -78,6 +80,7 @@ class CheckRequest:
     start: RecordingStart = "auto"
     time_source: TimeSource = "header"
     skip_damaged: bool = False
+    strict: bool = False
 
 
 @dataclass(frozen=True)
@@ -183,7 +186,8 @@ def execute(
     config = plan_config(plan, request.plan)
     if request.start_joints is not None:
         check_joint_units(request.start_joints, config, ())
-    controller = plan_controller(config, plan, request.plan, request.controllers, not request.controllers_as_data)
+    controller = plan_controller(config, plan, request.plan, request.controllers, not request.controllers_as_data,
+                                 request.strict)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
     plant = make_plant(request.plant, dict(request.plant_params or {}), controller, continuous)
     reports = _simulated_steps(request, plan, controller, config.execution, plant, continuous)
@@ -292,7 +296,7 @@ def check(request: CheckRequest, then: Callable[[CheckedRecording], None] | None
     """
     plan = read_valid_plan(request.plan)
     config = plan_config(plan, request.plan)
-    controller = plan_controller(config, plan, request.plan, request.controllers)
+    controller = plan_controller(config, plan, request.plan, request.controllers, strict=request.strict)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
     # The samples wait on disk and are read back a window at a time: memory does not grow with the recording.
     with open_joint_states(request.recording, request.topic, joints=controller.joints,

@@ -67,7 +67,7 @@ def plan_to_file(task: Path | None, flags: PlanFlags, output: Path, ros_distro: 
     config = load_robot_config(request.robot, request.package_paths, request.xacro_args, urdf=request.urdf,
                                srdf=request.srdf, strict_limits=request.strict_limits,
                                joint_limits=request.joint_limits, launch=request.launch,
-                               launch_args=request.launch_args)
+                               launch_args=request.launch_args, strict=request.strict)
     _refuse_replacing_inputs(output, request, config)
     if (request.group or config.planning["group"]) in config.srdf.groups:
         _warn_default_accelerations(config, request.group or config.planning["group"])
@@ -116,7 +116,7 @@ def plan(
         config = load_robot_config(request.robot, request.package_paths, request.xacro_args, urdf=request.urdf,
                                    srdf=request.srdf, strict_limits=request.strict_limits,
                                    joint_limits=request.joint_limits, launch=request.launch,
-                                   launch_args=request.launch_args)
+                                   launch_args=request.launch_args, strict=request.strict)
     robot = _robot(request, config)
     if loaded_here:
         _warn_default_accelerations(config, robot.group.name)

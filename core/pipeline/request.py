@@ -61,6 +61,7 @@ class RobotSource:
         joint_limits: --joint-limits: MoveIt's joint_limits.yaml, a file or `package://pkg/path`.
         launch: --launch: the one launch file of a MoveIt package to read.
         launch_args: --launch-arg values, name -> value.
+        strict: --strict: a parameter a controller does not declare is an error.
     """
 
     robot: str | Path
@@ -72,12 +73,13 @@ class RobotSource:
     joint_limits: str | None = None
     launch: str | None = None
     launch_args: Mapping[str, str] = field(default_factory=dict)
+    strict: bool = False
 
     def load(self) -> RobotConfig:
         """Return the robot config these arguments name."""
         return load_robot_config(self.robot, self.package_paths, self.xacro_args, urdf=self.urdf, srdf=self.srdf,
                                  strict_limits=self.strict_limits, joint_limits=self.joint_limits,
-                                 launch=self.launch, launch_args=self.launch_args)
+                                 launch=self.launch, launch_args=self.launch_args, strict=self.strict)
 
 
 @dataclass(frozen=True)
@@ -113,6 +115,7 @@ class PlanFlags:
         joint_limits: MoveIt's joint_limits.yaml (a file or `package://pkg/path`), replacing the config's.
         launch, launch_args: --launch and --launch-arg: which launch file of a MoveIt package to read,
             with which arguments.
+        strict: --strict: a parameter a controller does not declare is an error.
     """
 
     robot: Path | None = None
@@ -142,6 +145,7 @@ class PlanFlags:
     joint_limits: str | None = None
     launch: str | None = None
     launch_args: Mapping[str, str] = field(default_factory=dict)
+    strict: bool = False
 
     def __post_init__(self) -> None:
         starts = [k for k in ("start_joints", "start_named", "start_from") if getattr(self, k) is not None]
@@ -214,6 +218,7 @@ class PlanRequest:
     joint_limits: str | None = None
     launch: str | None = None
     launch_args: Mapping[str, str] = field(default_factory=dict)
+    strict: bool = False
 
 
 def resolve_request(task: TaskFile | None, flags: PlanFlags) -> PlanRequest:
@@ -241,7 +246,7 @@ def resolve_request(task: TaskFile | None, flags: PlanFlags) -> PlanRequest:
         min_fraction=1.0 if flags.min_fraction is None else flags.min_fraction,
         package_paths=flags.package_paths, xacro_args=dict(flags.xacro_args), task=task, motion_request=motion,
         urdf=flags.urdf, srdf=flags.srdf, strict_limits=flags.strict_limits, joint_limits=flags.joint_limits,
-        launch=flags.launch, launch_args=dict(flags.launch_args),
+        launch=flags.launch, launch_args=dict(flags.launch_args), strict=flags.strict,
     )
 
 

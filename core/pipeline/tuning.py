@@ -63,6 +63,7 @@ class TuneRequest:
     topic: str = "/joint_states"
     seed: int = 0
     plot: Path | None = None
+    strict: bool = False  # --strict: a parameter the controller does not declare is an error
 
 
 @dataclass(frozen=True)
@@ -116,7 +117,7 @@ def tune(request: TuneRequest, draw: Callable[[TuneResult, Path], None] | None =
         raise UsageError(f"--oscillations must be >= 0, got {request.oscillations}")
     plan = read_valid_plan(request.plan)
     config = plan_config(plan, request.plan)
-    controller = plan_controller(config, plan, request.plan, request.controllers)
+    controller = plan_controller(config, plan, request.plan, request.controllers, strict=request.strict)
     continuous = np.array([config.limits[j].continuous if j in config.limits else False for j in controller.joints])
     text, source = _controllers_text(request, plan, config.sources.get("controllers"))
     try:

@@ -106,6 +106,20 @@ def test_a_parameter_the_controller_does_not_declare_is_ignored_with_a_warning_n
     assert any("interface_name is ignored" in m for m in messages)
 
 
+def test_strict_refuses_a_parameter_the_controller_does_not_declare(tmp_path: Path, cli: Cli) -> None:
+    path = write_controllers(tmp_path, {"allow_partial_joint_goal": True})
+    with pytest.raises(ConfigError, match=r"unknown parameter 'allow_partial_joint_goal' \(did you mean "
+                                          r"'allow_partial_joints_goal'\?\): the controller does not declare it; "
+                                          r"--strict refuses it"):
+        parse_controllers(path, strict=True)
+    (tmp_path / "robot").mkdir()
+    folder = robot_folder(tmp_path / "robot", path.read_text())
+    assert cli("robot", folder).exit_code == 0
+    result = cli("robot", folder, "--strict")
+    assert result.exit_code == 3 and result.stderr.count("\n") == 1, result.stderr
+    assert "--strict refuses it" in result.stderr
+
+
 def test_several_wildcard_blocks_and_a_namespace_merge_as_rcl_reads_them(tmp_path: Path) -> None:
     # Franka's fr3_ros_controllers.yaml repeats `/**:`; Interbotix's wraps everything in `/wx250s:`.
     path = tmp_path / "ros2_controllers.yaml"
