@@ -85,18 +85,21 @@ def parse_joint_limits(path: Path | None) -> tuple[dict[str, dict[str, Any]], fl
         scales.append(value)
     entries = mapping(top.get("joint_limits"), f"{path}: joint_limits")
     overrides: dict[str, dict[str, Any]] = {}
+    ignored: dict[str, list[str]] = {}
     for joint, entry in entries.items():
         where = f"{path}: joint_limits.{joint}"
         entry = mapping(entry, where)
         for key in [k for k in entry if k not in _LIMIT_KEYS and isinstance(entry[k], bool)]:
             # A switch MoveIt does not read (KUKA writes has_jerk: false): MoveIt ignores it, and so does moveplan.
-            switches = sorted(k for k in _LIMIT_KEYS if k.startswith("has_") or k == "angle_wraparound")
-            near = difflib.get_close_matches(str(key), switches, n=1)
-            logger.warning("%s: unknown switch '%s' ignored, as MoveIt ignores it%s", where, key,
-                           f" (did you mean '{near[0]}'?)" if near else "")
+            ignored.setdefault(str(key), []).append(str(joint))
             entry = {k: v for k, v in entry.items() if k != key}
         check_keys(entry, _LIMIT_KEYS, where)  # an unknown number would change a limit: a typo must not pass
         overrides[joint] = entry
+    switches = sorted(k for k in _LIMIT_KEYS if k.startswith("has_") or k == "angle_wraparound")
+    for key, joints in ignored.items():  # one line a switch, not one a joint
+        near = difflib.get_close_matches(key, switches, n=1)
+        logger.warning("%s: joint_limits: unknown switch '%s' ignored (joints %s), as MoveIt ignores it%s", path, key,
+                       ", ".join(joints), f" (did you mean '{near[0]}'?)" if near else "")
     return overrides, scales[0], scales[1]
 
 

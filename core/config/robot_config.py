@@ -264,7 +264,8 @@ def _locate(
     launch: str | None = None, launch_args: Mapping[str, str] | None = None,
 ) -> _Located:
     """Return where the config's files are: named by its moveplan.yaml, or found in its folder or beside a file."""
-    path = resolve_config_path(robot, srdf_given=srdf is not None)
+    # Absolute: files found in the folder and files found through packages print the same way.
+    path = resolve_config_path(robot, srdf_given=srdf is not None).absolute()
     manifest = path if robot_file_kind(path) == "moveplan" else None
     root = path if path.is_dir() else path.parent
     top: dict[str, Any] = {}
