@@ -96,6 +96,7 @@ class _Found:
     needs: dict[str, None] = field(default_factory=dict)
     unset: dict[str, int] = field(default_factory=dict)  # urdf, srdf -> xacro args left to xacro's default
     required: dict[str, tuple[str, ...]] = field(default_factory=dict)  # read without value, declared with choices
+    undeclared: dict[str, None] = field(default_factory=dict)  # read without value, declared nowhere
 
 
 def launch_arguments(words: Sequence[str]) -> dict[str, str]:
@@ -104,7 +105,29 @@ def launch_arguments(words: Sequence[str]) -> dict[str, str]:
 
 
 def read_launch(root: Path, packages: PackagePath, given: Mapping[str, str], launch: str | None = None) -> LaunchFiles:
-    """Return what the launch files of the package at `root` name (with `launch`: that file only)."""
+    """Return what the launch files of the package at `root` name (with `launch`: that file only).
+
+    An argument the launch files read but never declare (a helper of a package outside the
+    workspace declares it: PAL's get_arm) takes the default the URDF they name gives its xacro
+    arg of the same name, with a warning: the SRDF and controllers chosen by it then describe
+    the hardware the URDF does.
+    """
+    result, undeclared = _read_all(root, packages, dict(given), launch)
+    if result.urdf is None or not undeclared:
+        return result
+    defaults = _xacro_defaults(result.urdf.path)
+    taken = {name: defaults[name] for name in undeclared if name in defaults}
+    if not taken:
+        return result
+    logger.warning("%s: launch arguments %s have no value and no declaration moveplan can read; using the defaults "
+                   "%s gives its xacro args (pass --launch-arg NAME:=VALUE for others)", root,
+                   ", ".join(f"{name}:={value}" for name, value in taken.items()), result.urdf.path.name)
+    return _read_all(root, packages, {**given, **taken}, launch)[0]
+
+
+def _read_all(root: Path, packages: PackagePath, given: dict[str, str],
+              launch: str | None) -> tuple[LaunchFiles, list[str]]:
+    """Return what the launch files name, and the arguments they read without declaring or being given them."""
     files = [_launch_file(launch, root, packages)] if launch else _package_launch_files(root)
     found = []
     for file in files:
@@ -114,7 +137,26 @@ def read_launch(root: Path, packages: PackagePath, given: Mapping[str, str], lau
             if launch:
                 raise
             logger.info("%s; not read", exc)  # one unreadable launch file among many must not stop a run
-    return _combine(root, found, dict(given))
+    undeclared = list(dict.fromkeys(name for item in found for name in item.undeclared))
+    return _combine(root, found, given), undeclared
+
+
+_XACRO_ARG = re.compile(r"<xacro:arg\b([^>]*)/?>")
+_ATTRIBUTE = re.compile(r"""\b(name|default)\s*=\s*(?:"([^"]*)"|'([^']*)')""")
+
+
+def _xacro_defaults(path: Path) -> dict[str, str]:
+    """Return the plain defaults (no substitution in them) of the xacro args a xacro file declares."""
+    try:
+        source = read_input_text(path)
+    except ConfigError:
+        return {}
+    defaults: dict[str, str] = {}
+    for attributes in _XACRO_ARG.findall(source):
+        values = {key: double or single for key, double, single in _ATTRIBUTE.findall(attributes)}
+        if "name" in values and "default" in values and "$" not in values["default"]:
+            defaults.setdefault(values["name"], values["default"])
+    return defaults
 
 
 def _launch_file(value: str, root: Path, packages: PackagePath) -> Path:
@@ -152,6 +194,8 @@ def _read_one(file: Path, root: Path, packages: PackagePath, given: dict[str, st
             found.needs.setdefault(name)
             if declared is not None and declared.choices is not None:
                 found.required.setdefault(name, declared.choices)
+            if declared is None:
+                found.undeclared.setdefault(name)
     return found
 
 

@@ -518,15 +518,16 @@ def test_interbotix_asks_for_its_robot_model_and_lists_its_srdfs(cli: Cli) -> No
 
 
 @pytest.mark.realworld
-def test_tiago_names_the_launch_arguments_and_srdfs_to_choose_from(cli: Cli) -> None:
-    """move_group.launch.py: 'config/srdf/tiago' + get_tiago_hw_suffix(arm, end_effector, ft_sensor) + '.srdf'."""
-    result = cli("robot", real(TIAGO))
-    assert result.exit_code == 3 and result.stderr.count("moveplan: error") == 1, result.stderr
-    assert "config/srdf/tiago_pal-hey5_schunk-ft.srdf" in result.stderr
-    assert "launch arguments without a value: arm, " in result.stderr and "end_effector" in result.stderr
-    args = ("--launch-arg", "arm:=tiago-arm", "--launch-arg", "end_effector:=pal-hey5", "--launch-arg",
-            "ft_sensor:=schunk-ft")
-    code, document = cli.json("robot", real(TIAGO), *args)
+def test_tiago_loads_as_given_with_the_hardware_its_urdf_defaults_to(
+        cli: Cli, caplog: pytest.LogCaptureFixture) -> None:
+    """move_group.launch.py: 'config/srdf/tiago' + get_tiago_hw_suffix(arm, end_effector, ft_sensor) + '.srdf',
+    the arguments declared by launch_pal (not in the workspace): tiago.urdf.xacro's defaults stand in."""
+    code, document = cli.json("robot", real(TIAGO))
     assert code == 0, document
     assert document["sources"]["srdf"] == str(real(TIAGO) / "config/srdf/tiago_pal-hey5_schunk-ft.srdf")
-    assert document["xacro_args"]["end_effector"] == "pal-hey5"  # the URDF of the same hardware
+    assert "using the defaults tiago.urdf.xacro gives its xacro args" in caplog.text
+    assert "arm:=tiago-arm, end_effector:=pal-hey5, ft_sensor:=schunk-ft" in caplog.text
+    # The gripper variant's meshes are not in the workspace: its files are checked, not its geometry.
+    config = load_robot_config(real(TIAGO), launch_args={"end_effector": "pal-gripper"})
+    assert config.sources["srdf"] == real(TIAGO) / "config/srdf/tiago_pal-gripper_schunk-ft.srdf"
+    assert config.xacro_args["end_effector"] == "pal-gripper"  # the URDF of the same hardware

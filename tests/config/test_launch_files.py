@@ -231,6 +231,41 @@ def test_a_helper_of_another_workspace_package_is_followed(workspace: Path) -> N
     assert load_robot_config(package).sources["srdf"] == package / "config" / "srdf" / "ur10e_tool.srdf"
 
 
+UNDECLARED = '''
+import os
+from ament_index_python.packages import get_package_share_directory
+from launch import LaunchDescription
+from launch.substitutions import Command, LaunchConfiguration
+from launch_pal.robot_utils import get_mount
+from launch_ros.actions import Node
+
+
+def generate_launch_description():
+    share = get_package_share_directory('acme_moveit_config')
+    xacro_file = os.path.join(get_package_share_directory('ur10e_moveit_config'), 'config', 'ur10e.urdf.xacro')
+    srdf = [share, '/config/srdf/ur10e_', LaunchConfiguration('mount_height'), '.srdf']
+    node = Node(package='moveit_ros_move_group', executable='move_group', parameters=[
+        {'robot_description': Command(['xacro ', xacro_file]), 'robot_description_semantic': Command(['cat ', srdf])}])
+    return LaunchDescription([get_mount('acme'), node])
+'''
+
+
+def test_an_argument_no_launch_file_declares_takes_the_default_the_urdf_gives_it(
+        workspace: Path, caplog: pytest.LogCaptureFixture) -> None:
+    """PAL's launch_pal declares arm and end_effector outside the workspace; tiago.urdf.xacro gives their defaults."""
+    package = workspace / "acme_moveit_config"
+    srdf = package / "config" / "srdf"
+    shutil.copy(srdf / "ur10e_tool.srdf", srdf / "ur10e_0.0.srdf")
+    shutil.copy(srdf / "ur10e.srdf", srdf / "ur10e_1.5.srdf")
+    (package / "launch" / "moveit.launch.py").write_text(UNDECLARED)
+    config = load_robot_config(package)
+    assert config.sources["srdf"] == srdf / "ur10e_0.0.srdf"
+    assert "launch arguments mount_height:=0.0 have no value" in caplog.text
+    assert "the defaults ur10e.urdf.xacro gives its xacro args" in caplog.text
+    config = load_robot_config(package, launch_args={"mount_height": "1.5"})
+    assert config.sources["srdf"] == srdf / "ur10e_1.5.srdf" and config.xacro_args["mount_height"] == "1.5"
+
+
 def test_a_launch_file_is_read_never_run(workspace: Path, tmp_path: Path) -> None:
     """Reading a package must not start processes or write files, whatever its launch files say."""
     marker = tmp_path / "ran"

@@ -54,8 +54,7 @@ PACKAGES = {
     "wx250s": Package("interbotix_ros_manipulators/interbotix_ros_xsarms/interbotix_xsarm_moveit", "interbotix_arm",
                       launch_args=("robot_model:=wx250s",)),
     "tiago": Package("tiago_moveit_config", "arm",
-                     controllers="tiago_robot/tiago_controller_configuration/config/arm_controller.yaml",
-                     launch_args=("arm:=tiago-arm", "end_effector:=pal-hey5", "ft_sensor:=schunk-ft")),
+                     controllers="tiago_robot/tiago_controller_configuration/config/arm_controller.yaml"),
 }
 
 
