@@ -82,8 +82,9 @@ def sample(
     Args:
         trajectory: The trajectory as sent to the controller.
         times_s: Sample times on the controller's timeline in [s].
-        has_velocities: False if the points carry no velocities (an empty field in the message).
-        has_accelerations: False if the points carry no accelerations.
+        has_velocities: False to sample as if the points carried no velocities; a trajectory whose
+            points carry none (`trajectory.has_velocities` False) is sampled so anyway.
+        has_accelerations: Likewise for accelerations.
         point_before: The state the controller read at its first sample (time 0), blended
             from if the first point's time is > 0; without it, times before the first point
             give the first point.
@@ -95,6 +96,8 @@ def sample(
     knots = trajectory.times_s
     positions = trajectory.positions
     count, n = positions.shape
+    has_velocities = has_velocities and trajectory.has_velocities
+    has_accelerations = has_accelerations and trajectory.has_accelerations
     velocities = trajectory.velocities if has_velocities else np.zeros((count, n))
     accelerations = trajectory.accelerations if has_accelerations else np.zeros((count, n))
     has_v = np.full(count, has_velocities)
@@ -112,7 +115,7 @@ def sample(
 
 
 def sampler(trajectory: JointTrajectory) -> Callable[[NDArray[np.float64], int], Samples]:
-    """Return `sample` of `trajectory` (every field present, no point before) as a function of times and derivatives.
+    """Return `sample` of `trajectory` (no point before) as a function of times and derivatives.
 
     The segments' coefficients are computed once: a certification samples one trajectory twice.
     """
@@ -121,8 +124,9 @@ def sampler(trajectory: JointTrajectory) -> Callable[[NDArray[np.float64], int],
         def held(t: NDArray[np.float64], derivatives: int = 2) -> Samples:
             return _hold(p[0], v[0], a[0], len(t))
         return held
-    every = np.ones(len(knots), dtype=bool)
-    coefficients = _coefficients(knots, p, v, a, every, every)
+    has_v = np.full(len(knots), trajectory.has_velocities)
+    has_a = np.full(len(knots), trajectory.has_velocities and trajectory.has_accelerations)
+    coefficients = _coefficients(knots, p, v, a, has_v, has_a)
 
     def evaluated(t: NDArray[np.float64], derivatives: int = 2) -> Samples:
         return _evaluate(knots, coefficients, p, v, a, t, derivatives)

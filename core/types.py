@@ -53,8 +53,11 @@ class JointTrajectory:
         joint_names: Joint order of the columns.
         times_s: Time from start of each point in [s], strictly increasing, first 0.
         positions: Joint positions in [rad] or [m], shape (N, n).
-        velocities: In [rad]/[s], shape (N, n).
-        accelerations: In [rad]/[s]^2, shape (N, n).
+        velocities: In [rad]/[s], shape (N, n); zeros where `has_velocities` is False.
+        accelerations: In [rad]/[s]^2, shape (N, n); zeros where `has_accelerations` is False.
+        has_velocities: False for a message whose points carry no velocities (JTC then
+            interpolates linearly).
+        has_accelerations: False for points without accelerations (JTC: cubic with velocities).
     """
 
     joint_names: tuple[str, ...]
@@ -62,6 +65,8 @@ class JointTrajectory:
     positions: NDArray[np.float64]
     velocities: NDArray[np.float64]
     accelerations: NDArray[np.float64]
+    has_velocities: bool = field(default=True, kw_only=True)
+    has_accelerations: bool = field(default=True, kw_only=True)
 
     def __post_init__(self) -> None:
         n = len(self.joint_names)

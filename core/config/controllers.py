@@ -83,6 +83,8 @@ class ControllerConfig:
     trajectory_tolerance: dict[str, float]
     goal_tolerance: dict[str, float]
     gains: dict[str, dict[str, float]]
+    allow_nonzero_velocity_at_trajectory_end: bool = False
+    """Jazzy's default (false): JTC refuses a goal whose last point still moves."""
 
 
 @dataclass(frozen=True)
@@ -309,6 +311,9 @@ def _joint_trajectory_controller(
         trajectory_tolerance=trajectory,
         goal_tolerance=goal,
         gains=_gains(params.get("gains"), joints, f"{where}.gains"),
+        allow_nonzero_velocity_at_trajectory_end=boolean(
+            params.get("allow_nonzero_velocity_at_trajectory_end", False),
+            f"{where}.allow_nonzero_velocity_at_trajectory_end"),
     )
 
 

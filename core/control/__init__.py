@@ -16,7 +16,7 @@ if TYPE_CHECKING:
         uses_velocities,
     )
     from .controller import Disturbance, ExecutionReport, simulate
-    from .goal_validation import validate_goal
+    from .goal_validation import validate_goal, validate_goal_end
     from .margins import merged_margins
     from .plants import (
         PLANTS,
@@ -74,6 +74,7 @@ __all__ = [
     "tune_joint",
     "uses_velocities",
     "validate_goal",
+    "validate_goal_end",
 ]
 
 __getattr__ = lazy_exports(__name__, {
@@ -114,4 +115,5 @@ __getattr__ = lazy_exports(__name__, {
     "tune_joint": "tuning",
     "uses_velocities": "check",
     "validate_goal": "goal_validation",
+    "validate_goal_end": "goal_validation",
 })

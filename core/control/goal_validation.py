@@ -15,7 +15,10 @@ import numpy as np
 from ..errors import InputError
 from ..types import JointTrajectory
 
-__all__ = ["validate_goal"]
+__all__ = ["FLT_EPSILON", "validate_goal", "validate_goal_end"]
+
+FLT_EPSILON = float(np.finfo(np.float32).eps)
+"""What JTC compares the last point's velocities with (std::numeric_limits<float>::epsilon())."""
 
 
 def validate_goal(trajectory: JointTrajectory, where: str) -> None:
@@ -49,6 +52,25 @@ def validate_goal(trajectory: JointTrajectory, where: str) -> None:
         raise InputError(
             f"{where}: invalid goal, the controller would reject it: Time between points {i} and "
             f"{i + 1} is not strictly increasing, it is {times[i]:f} and {times[i + 1]:f} respectively")
+
+
+def validate_goal_end(trajectory: JointTrajectory, allow_nonzero_velocity: bool, where: str) -> None:
+    """Raise InputError if JTC with `allow_nonzero_velocity_at_trajectory_end: false` would refuse `trajectory`.
+
+    ros2_controllers' validate_trajectory_msg refuses a goal whose last point has a velocity
+    above FLT_EPSILON (test_trajectory_actions.cpp, test_allow_nonzero_velocity_at_trajectory_end_false);
+    a point without velocities passes.
+    """
+    if allow_nonzero_velocity or not trajectory.has_velocities:
+        return
+    last = trajectory.velocities[-1]
+    moving = np.flatnonzero(np.abs(last) > FLT_EPSILON)
+    if moving.size:
+        i = int(moving[0])
+        raise InputError(
+            f"{where}: invalid goal, the controller would reject it: Velocity of last trajectory point of joint "
+            f"{trajectory.joint_names[i]} is not zero: {last[i]:.15f} (allow_nonzero_velocity_at_trajectory_end "
+            "is false, Jazzy's default)")
 
 
 def _time(times: np.ndarray, point: int) -> str:

@@ -22,7 +22,7 @@ from ..config import (
     load_robot_config,
     parse_controllers,
 )
-from ..control import validate_goal
+from ..control import validate_goal, validate_goal_end
 from ..errors import ConfigError, InputError
 
 __all__ = ["MAX_PLAN_S", "pick_controller", "plan_config", "plan_controller", "read_valid_plan"]
@@ -127,7 +127,21 @@ def plan_controller(
 
     `substitute` False reads `override` as data: launch substitutions are left as text. `strict`
     (--strict) refuses a parameter `override`'s controller does not declare.
+
+    Raises:
+        InputError: A step the controller would refuse as a goal (a last point that still moves).
     """
+    controller = _plan_controller(config, plan, path, override, substitute, strict)
+    for step in plan.steps:
+        validate_goal_end(step.trajectory, controller.allow_nonzero_velocity_at_trajectory_end,
+                          f"{path}: step '{step.name}' for {controller.name}")
+    return controller
+
+
+def _plan_controller(
+    config: RobotConfig, plan: recording.PlanFile, path: Path, override: Path | None, substitute: bool,
+    strict: bool,
+) -> ControllerConfig:
     joints = plan.steps[0].trajectory.joint_names
     if override is not None:
         # MoveIt's preference comes from its own controllers file, whichever file ros2_control reads.

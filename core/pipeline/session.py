@@ -30,7 +30,7 @@ from ..config import (
     first_repeated,
     parse_controllers,
 )
-from ..control import ExecutionReport, make_plant, simulate, validate_goal
+from ..control import ExecutionReport, make_plant, simulate, validate_goal, validate_goal_end
 from ..errors import ConfigError, NoPlan, StartInCollision, StartOutsideLimits
 from ..model import Robot, Scene, resolve_frames
 from ..planning import check_limits, seed_planner
@@ -211,6 +211,7 @@ def execute_motion(
     """
     validate_goal(trajectory, where)
     controller = _controller(config, trajectory.joint_names, settings.controllers)
+    validate_goal_end(trajectory, controller.allow_nonzero_velocity_at_trajectory_end, where)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
     plant = make_plant(settings.plant, dict(settings.plant_params), controller, continuous)
     positions = np.array([start[j] for j in controller.joints if j in start])

@@ -28,9 +28,10 @@ def jtc(joints=JOINTS, commands=("position",), states=("position", "velocity"), 
 
 
 def points(times, positions, joints=JOINTS):
+    """A goal as ros2_controllers' action tests send it: positions only (JTC interpolates linearly)."""
     positions = np.atleast_2d(np.asarray(positions, dtype=float))
     zeros = np.zeros_like(positions)
-    return JointTrajectory(joints, times, positions, zeros, zeros)
+    return JointTrajectory(joints, times, positions, zeros, zeros, has_velocities=False, has_accelerations=False)
 
 
 def minimum_jerk(start, delta, duration, joints, step=0.05):
@@ -359,3 +360,31 @@ def test_plant_classes_start_at_rest_where_reset():
         positions, velocities = plant.reset([0.5, -0.5])
         np.testing.assert_array_equal(positions, [0.5, -0.5])
         np.testing.assert_array_equal(velocities, [0.0, 0.0])
+
+
+def test_a_last_point_that_still_moves_is_refused_unless_the_controller_allows_it(tmp_path) -> None:
+    """A12 (test_trajectory_actions.cpp test_allow_nonzero_velocity_at_trajectory_end_{false,true})."""
+    from dataclasses import replace
+
+    from moveplan.core.control import validate_goal_end
+
+    moving = JointTrajectory(JOINTS, [0.25, 0.5], [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]],
+                             [[0.0] * 3, [4.0, 5.0, 6.0]], np.zeros((2, 3)))
+    with pytest.raises(InputError, match=r"invalid goal, the controller would reject it: Velocity of last trajectory "
+                                         r"point of joint joint1 is not zero: 4.000000000000000"):
+        validate_goal_end(moving, jtc().allow_nonzero_velocity_at_trajectory_end, "goal")
+    stopped = replace(moving, velocities=np.zeros((2, 3)))
+    validate_goal_end(stopped, False, "goal")  # the same trajectory ending at rest is accepted
+    validate_goal_end(moving, True, "goal")
+    report = simulate(moving, replace(jtc(stopped_velocity=0.0), allow_nonzero_velocity_at_trajectory_end=True),
+                      NO_START_CHECK, MirrorPlant(3), start_positions=INITIAL)
+    assert report.ok and report.result.name == "SUCCESSFUL"
+
+
+def test_a_positions_only_goal_is_interpolated_linearly_from_the_state_read() -> None:
+    """Every goal of test_trajectory_actions.cpp carries positions only; JTC interpolates linearly (A1)."""
+    report = simulate(points([1.0], [2.1, 3.1, 4.1]), jtc(), NO_START_CHECK, MirrorPlant(3), start_positions=INITIAL)
+    assert report.ok
+    middle = int(np.searchsorted(report.times_s, 0.5))
+    np.testing.assert_allclose(report.reference_velocities[middle], [1.0, 1.0, 1.0], atol=1e-9)
+    np.testing.assert_allclose(report.reference_positions[middle], INITIAL + report.times_s[middle], atol=1e-9)

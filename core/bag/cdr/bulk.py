@@ -130,7 +130,10 @@ def _write_joint_trajectory(writer: CdrWriter, trajectory: JointTrajectory, fram
     writer.string(frame_id)
     writer.strings(trajectory.joint_names)
     times_ns = [seconds_to_ns(t) for t in trajectory.times_s.tolist()]
-    motion = (trajectory.positions, trajectory.velocities, trajectory.accelerations)
+    # A field the points do not carry is written empty, as the message came (JTC's degree follows it).
+    none = np.empty((len(trajectory.times_s), 0))
+    motion = (trajectory.positions, trajectory.velocities if trajectory.has_velocities else none,
+              trajectory.accelerations if trajectory.has_accelerations else none)
     arrays = [values.astype("<f8", copy=False) for values in motion]
 
     def write_point(i: int) -> list[int]:

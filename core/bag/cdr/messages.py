@@ -72,8 +72,8 @@ def joint_trajectory(trajectory: JointTrajectory, frame_id: str) -> Message:
     points = [
         {
             "positions": trajectory.positions[i].tolist(),
-            "velocities": trajectory.velocities[i].tolist(),
-            "accelerations": trajectory.accelerations[i].tolist(),
+            "velocities": trajectory.velocities[i].tolist() if trajectory.has_velocities else [],
+            "accelerations": trajectory.accelerations[i].tolist() if trajectory.has_accelerations else [],
             "effort": [],
             "time_from_start": time_msg(seconds_to_ns(float(t))),
         }
@@ -238,6 +238,10 @@ def trajectory_from_message(message: Any) -> JointTrajectory:
     points = message.points
     times_ns = [p.time_from_start.sec * 1_000_000_000 + p.time_from_start.nanosec for p in points]
     names = tuple(message.joint_names)
+    # JTC takes velocities and accelerations empty or full at each point; empty at every point,
+    # it interpolates with a lower degree (linear with positions only, cubic without accelerations).
+    has_velocities = any(len(p.velocities) for p in points)
+    has_accelerations = any(len(p.accelerations) for p in points)
     for name in names:
         if not name or any(ord(c) < 0x20 or ord(c) == 0x7F for c in name):
             raise ValueError(f"joint name {name[:40]!r} is empty or holds a control character")
@@ -247,6 +251,13 @@ def trajectory_from_message(message: Any) -> JointTrajectory:
         joint_names=names,
         times_s=np.array(times_ns, dtype=np.float64) / 1e9,
         positions=np.array([list(p.positions) for p in points], dtype=np.float64),
-        velocities=np.array([list(p.velocities) for p in points], dtype=np.float64),
-        accelerations=np.array([list(p.accelerations) for p in points], dtype=np.float64),
+        velocities=_field([list(p.velocities) for p in points], has_velocities, len(names)),
+        accelerations=_field([list(p.accelerations) for p in points], has_accelerations, len(names)),
+        has_velocities=has_velocities,
+        has_accelerations=has_accelerations,
     )
+
+
+def _field(rows: list[list[float]], present: bool, joints: int) -> NDArray[np.float64]:
+    """Return a point field's values, zeros where no point has it (a mix is left to the shape check)."""
+    return np.array(rows, dtype=np.float64) if present else np.zeros((len(rows), joints))
