@@ -16,6 +16,7 @@ function in turn (with the launch context, so `.perform(context)` resolves argum
 from __future__ import annotations
 
 import ast
+import functools
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -111,6 +112,20 @@ class _Budget:
     depth: int = 0
 
 
+def parsed(path: Path) -> ast.Module:
+    """Return a Python file's syntax tree, parsed once per version of the file.
+
+    A family's launch files share helpers: xArm's 40 launch files import the same modules.
+    """
+    stat = path.stat()
+    return _parse(str(path), stat.st_mtime_ns, stat.st_size)
+
+
+@functools.lru_cache(maxsize=512)
+def _parse(path: str, mtime_ns: int, size: int) -> ast.Module:
+    return ast.parse(read_input_text(Path(path)), path)
+
+
 def evaluate_python_launch(
     path: Path, context: LaunchContext, find_module: Callable[[str], Path | None],
     include: Callable[[Any, Any, Any, LaunchRecord], None],
@@ -125,7 +140,7 @@ def evaluate_python_launch(
     """
     record = LaunchRecord(path, context)
     try:
-        tree = ast.parse(read_input_text(path), str(path))
+        tree = parsed(path)
     except SyntaxError as exc:
         raise ConfigError(f"{path}: not a Python launch file moveplan can read "
                           f"(line {exc.lineno}: {exc.msg})") from None
@@ -264,15 +279,16 @@ class _Interpreter:
         loaded = self._load_module(source) if source is not None else None
         for alias in node.names:
             name = alias.asname or alias.name
-            if loaded is not None and alias.name in loaded:
-                scope[name] = loaded[alias.name]
+            if loaded is not None:
+                # A workspace module's class (xArm's own MoveItConfigsBuilder) is not the launch API's namesake.
+                scope[name] = loaded.get(alias.name, _UNKNOWN)
             else:
                 scope[name] = _Module(f"{module}.{alias.name}")
 
     def _load_module(self, source: Path) -> dict[str, Any] | None:
         """Return the top-level names of a workspace Python module (its functions, constants), followed the same way."""
         try:
-            tree = ast.parse(read_input_text(source), str(source))
+            tree = parsed(source)
         except (SyntaxError, ConfigError, ValueError):
             return None
         other = _Interpreter(source, self.record, self.queue, self.find_module, self.budget)

@@ -95,6 +95,7 @@ class LaunchContext:
     find_package: Callable[[str], str | None]
     declared: dict[str, Declared] = field(default_factory=dict)
     missing: dict[str, None] = field(default_factory=dict)  # arguments read without a value, in order
+    computed: frozenset[str] = frozenset()  # arguments the including file computes in a way not followed
 
     def argument(self, name: str, fallback: Any = None) -> Any:
         """Return a launch argument's value: given, declared default, `fallback` (the substitution's), else Unknown."""
@@ -105,6 +106,8 @@ class LaunchContext:
             return declared.default
         if fallback is not None:
             return fallback
+        if name in self.computed:
+            return Unknown()  # not the user's to give: the including launch file computes it
         self.missing[name] = None
         return Unknown(frozenset({name}))
 

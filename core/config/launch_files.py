@@ -24,8 +24,11 @@ different URDFs, SRDFs or joint limits, --launch chooses.
 
 from __future__ import annotations
 
+import functools
+import glob
 import logging
 import re
+import shlex
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,6 +39,7 @@ from ._launch_markup import evaluate_markup_launch
 from ._launch_python import evaluate_python_launch
 from ._launch_values import Builder, LaunchContext, LaunchRecord, Lazy, Unknown, XacroFile, YamlFile, text
 from ._setup_assistant import builder_srdf, builder_urdf, read_setup_assistant
+from ._workspace import package_name, packages_under
 from .fields import load_yaml, read_input_text
 from .xacro import PackagePath, parse_xacro_args
 
@@ -97,6 +101,7 @@ class _Found:
     unset: dict[str, int] = field(default_factory=dict)  # urdf, srdf -> xacro args left to xacro's default
     required: dict[str, tuple[str, ...]] = field(default_factory=dict)  # read without value, declared with choices
     undeclared: dict[str, None] = field(default_factory=dict)  # read without value, declared nowhere
+    blocking: dict[str, tuple[str, ...]] = field(default_factory=dict)  # a file's name waits for it -> values on disk
 
 
 def launch_arguments(words: Sequence[str]) -> dict[str, str]:
@@ -112,7 +117,16 @@ def read_launch(root: Path, packages: PackagePath, given: Mapping[str, str], lau
     arg of the same name, with a warning: the SRDF and controllers chosen by it then describe
     the hardware the URDF does.
     """
-    result, undeclared = _read_all(root, packages, dict(given), launch)
+    files = [_launch_file(launch, root, packages)] if launch else _package_launch_files(root)
+    result, undeclared = _read_all(root, packages, dict(given), files, strict=bool(launch))
+    if not launch and result.urdf is None and result.srdf is None:
+        # Denso and TM keep the MoveIt launch file in a bringup or demo package that names this one.
+        elsewhere = _naming_launch_files(root, packages)
+        if elsewhere:
+            result, undeclared = _read_all(root, packages, dict(given), elsewhere, strict=False)
+            if result.source is not None:
+                logger.info("%s: its robot comes from %s, a launch file of the workspace that names the package",
+                            root, result.source)
     if result.urdf is None or not undeclared:
         return result
     defaults = _xacro_defaults(result.urdf.path)
@@ -122,19 +136,21 @@ def read_launch(root: Path, packages: PackagePath, given: Mapping[str, str], lau
     logger.warning("%s: launch arguments %s have no value and no declaration moveplan can read; using the defaults "
                    "%s gives its xacro args (pass --launch-arg NAME:=VALUE for others)", root,
                    ", ".join(f"{name}:={value}" for name, value in taken.items()), result.urdf.path.name)
-    return _read_all(root, packages, {**given, **taken}, launch)[0]
+    return _read_all(root, packages, {**given, **taken}, list(result.launch), strict=bool(launch))[0]
 
 
-def _read_all(root: Path, packages: PackagePath, given: dict[str, str],
-              launch: str | None) -> tuple[LaunchFiles, list[str]]:
-    """Return what the launch files name, and the arguments they read without declaring or being given them."""
-    files = [_launch_file(launch, root, packages)] if launch else _package_launch_files(root)
+def _read_all(root: Path, packages: PackagePath, given: dict[str, str], files: list[Path],
+              strict: bool) -> tuple[LaunchFiles, list[str]]:
+    """Return what the launch files name, and the arguments they read without declaring or being given them.
+
+    With `strict` (the one file --launch names), a file that cannot be read is an error.
+    """
     found = []
     for file in files:
         try:
             found.append(_read_one(file, root, packages, dict(given)))
         except ConfigError as exc:
-            if launch:
+            if strict:
                 raise
             logger.info("%s; not read", exc)  # one unreadable launch file among many must not stop a run
     undeclared = list(dict.fromkeys(name for item in found for name in item.undeclared))
@@ -173,6 +189,29 @@ def _launch_file(value: str, root: Path, packages: PackagePath) -> Path:
     return path
 
 
+def _naming_launch_files(root: Path, packages: PackagePath) -> list[Path]:
+    """Return the launch files of the workspace's other packages whose text names the package at `root`."""
+    name = package_name(root) or root.name
+    quoted = (f"'{name}'", f'"{name}"', f"/{name}/", f"({name})", f"find-pkg-share {name}")
+    found: list[Path] = []
+    for folder in packages.folders:
+        if not folder.is_dir() or folder == root:
+            continue
+        for package in packages_under(folder).values():
+            if package.resolve() == root.resolve():
+                continue
+            for file in _package_launch_files(package):
+                try:
+                    text_ = read_input_text(file)
+                except ConfigError:
+                    continue
+                if any(q in text_ for q in quoted):
+                    found.append(file)
+                if len(found) >= MAX_LAUNCH_FILES:
+                    return found
+    return found
+
+
 def _package_launch_files(root: Path) -> list[Path]:
     folder = root / "launch"
     if not folder.is_dir():
@@ -192,17 +231,18 @@ def _read_one(file: Path, root: Path, packages: PackagePath, given: dict[str, st
         for name in item.context.missing:
             declared = item.context.declared.get(name)
             found.needs.setdefault(name)
-            if declared is not None and declared.choices is not None:
-                found.required.setdefault(name, declared.choices)
+            # Declared without a default, it must be given when it has choices or a file's name waits for it.
+            if declared is not None and (declared.choices is not None or name in found.blocking):
+                found.required.setdefault(name, declared.choices or found.blocking.get(name, ()))
             if declared is None:
                 found.undeclared.setdefault(name)
     return found
 
 
 def _evaluate(file: Path, given: dict[str, str], packages: PackagePath, depth: int,
-              stack: tuple[Path, ...]) -> LaunchRecord:
+              stack: tuple[Path, ...], computed: frozenset[str] = frozenset()) -> LaunchRecord:
     """Return one launch file's record, its includes followed (bounded, without cycles)."""
-    context = LaunchContext(given, lambda name: _find(packages, name))
+    context = LaunchContext(given, lambda name: _find(packages, name), computed=computed)
 
     def include(source: Any, arguments: Any, condition: Any, record: LaunchRecord) -> None:
         if condition is not None and hasattr(condition, "holds") and not condition.holds(record.context):
@@ -214,6 +254,7 @@ def _evaluate(file: Path, given: dict[str, str], packages: PackagePath, depth: i
         if not target.is_file() or target.resolve() in stack:
             return  # a package not in the workspace, or a launch file including itself
         passed: dict[str, str] = {}
+        unknown: set[str] = set()
         pairs = arguments if isinstance(arguments, list | tuple) else list(arguments.items()) \
             if isinstance(arguments, dict) else []
         for pair in pairs:
@@ -221,8 +262,11 @@ def _evaluate(file: Path, given: dict[str, str], packages: PackagePath, depth: i
                 name, value = text(pair[0], record.context), text(pair[1], record.context)
                 if isinstance(name, str) and isinstance(value, str):
                     passed[name] = value
+                elif isinstance(name, str) and not (isinstance(value, Unknown) and value.needs):
+                    unknown.add(name)  # computed by the includer (xArm's yaml.dump(...)): no one can pass it
         try:
-            record.included.append(_evaluate(target, passed, packages, depth + 1, (*stack, file.resolve())))
+            record.included.append(_evaluate(target, passed, packages, depth + 1, (*stack, file.resolve()),
+                                             frozenset(unknown)))
         except ConfigError as exc:
             record.notes.append(str(exc))
 
@@ -237,16 +281,27 @@ def _walk(record: LaunchRecord) -> list[LaunchRecord]:
 
 def _find(packages: PackagePath, name: str) -> str | None:
     """Return a package's folder (its share folder, in an unbuilt workspace its source), None if not found."""
+    return _found(packages.folders, name)
+
+
+@functools.lru_cache(maxsize=4096)
+def _found(folders: tuple[Path, ...], name: str) -> str | None:
+    # A launch file asks for launch, launch_ros, yaml...: not found, every time, without this.
     try:
-        return str(packages.find(name, "launch file"))
+        return str(PackagePath(folders).find(name, "launch file"))
     except ConfigError:
         return None
 
 
 def _find_module(packages: PackagePath, module: str) -> Path | None:
     """Return the .py file of a Python module a workspace package installs (pkg/pkg/mod.py), None if none."""
+    return _module_file(packages.folders, module)
+
+
+@functools.lru_cache(maxsize=4096)
+def _module_file(folders: tuple[Path, ...], module: str) -> Path | None:
     parts = module.split(".")
-    folder = _find(packages, parts[0]) if parts[0] and parts[0].isidentifier() else None
+    folder = _found(folders, parts[0]) if parts[0] and parts[0].isidentifier() else None
     if folder is None:
         return None
     for base in (Path(folder), Path(folder) / "module", Path(folder) / "src"):
@@ -330,9 +385,13 @@ def _parameter(value: Any, context: LaunchContext, found: _Found, packages: Pack
     elif isinstance(value, YamlFile):
         _parameter_file(Path(value.path), found, control)
     else:
-        path = text(value, context)
-        if isinstance(path, str) and path.endswith((".yaml", ".yml")):
-            _parameter_file(Path(path), found, control)
+        words, holes = _words(value, context)
+        if len(words) == 1 and not holes and words[0].endswith((".yaml", ".yml")):
+            _parameter_file(Path(words[0]), found, control)
+        elif holes and len(words) == 1 and words[0].endswith((".yaml", ".yml")):
+            for hole in holes:
+                _need(found, hole, context)
+            _blocked(words, holes, found)
 
 
 _KEYED = {"robot_description_planning": "joint_limits", "robot_description_kinematics": "kinematics",
@@ -351,7 +410,7 @@ def _parameter_file(path: Path, found: _Found, control: bool) -> None:
     except ConfigError:
         return
     keys = _keys(top)
-    if "joint_limits" in keys and "robot_description_planning" in keys:
+    if "joint_limits" in keys:  # MoveIt's joint_limits.yaml, bare or as move_group's node parameters
         found.files.setdefault("joint_limits", path)
     elif "controller_manager" in keys:
         found.files.setdefault("controllers", path)
@@ -391,6 +450,8 @@ def _description(setting: str, value: Any, mappings: Any, context: LaunchContext
     for hole in holes:
         # A hole in the file's name leaves the file unknown; in an arg's value, xacro's default serves.
         _need(found, hole, context, xacro=path is not None)
+    if path is None:
+        _blocked(words, holes, found)
     if path is None or getattr(found, setting) is not None:
         return
     found.unset[setting] = len(holes)
@@ -440,12 +501,26 @@ def _words(value: Any, context: LaunchContext) -> tuple[list[str], list[Unknown]
             pieces.append(_HOLE)
         else:
             pieces.append(resolved)
-    return "".join(pieces).split(), holes
+    return _split("".join(pieces)), holes
+
+
+def _split(line: str) -> list[str]:
+    """Return a command line's words as launch's Command splits them (shlex: `prefix:=""` is `prefix:=`)."""
+    try:
+        return shlex.split(line)
+    except ValueError:  # an unbalanced quote: launch would fail too; whitespace words name what can be named
+        return line.split()
 
 
 def _flatten(value: Any) -> list[Any]:
+    """Return a substitution's parts, a path's with its separators, so that an unknown part leaves a gap in place."""
     if isinstance(value, Lazy) and value.kind == "concat":
         return [inner for part in value.parts for inner in _flatten(part)]
+    if isinstance(value, Lazy) and value.kind == "path" and value.parts:
+        joined: list[Any] = []
+        for index, part in enumerate(value.parts):
+            joined.extend(([] if index == 0 else ["/"]) + _flatten(part))
+        return joined
     if isinstance(value, list | tuple):
         return [inner for part in value for inner in _flatten(part)]
     return [value]
@@ -466,6 +541,28 @@ def _command(words: list[str]) -> tuple[str | None, dict[str, str]]:
         if sep and _HOLE not in word:
             args[name] = value
     return files[0], args
+
+
+def _blocked(words: list[str], holes: list[Unknown], found: _Found) -> None:
+    """Note the arguments a file's name waits for, with the values the files on disk give the gap."""
+    names = {name for hole in holes for name in hole.needs}
+    word = next((w for w in words if _HOLE in w), "")
+    values = _hole_values(word) if len(names) == 1 and word.count(_HOLE) == 1 else ()
+    for name in names:
+        found.blocking.setdefault(name, values)
+
+
+def _hole_values(word: str) -> tuple[str, ...]:
+    """Return what a path with one gap (a launch argument without value) can be, by the files that exist."""
+    before, after = word.split(_HOLE)
+    if "/" in after.split("/", 1)[0] or not before:
+        return ()
+    matches = sorted(glob.glob(glob.escape(before) + "*" + glob.escape(after)))[:_MAX_HOLE_VALUES]
+    values = [m[len(before):len(m) - len(after)] for m in matches]
+    return tuple(v for v in values if v and "/" not in v)
+
+
+_MAX_HOLE_VALUES = 200
 
 
 def _need(found: _Found, unknown: Unknown, context: LaunchContext, xacro: bool = False) -> None:

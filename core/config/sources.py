@@ -97,8 +97,8 @@ def resolve_config_path(robot: str | Path, srdf_given: bool = False) -> Path:
 
     A bare name such as `ur10e` names a config shipped with moveplan. A folder holding a
     moveplan.yaml means that file; a folder without one is read as a MoveIt config package
-    (or a plain folder holding a URDF and an SRDF) if it holds an SRDF, a .setup_assistant or
-    a launch/ folder, or if `srdf_given` (--srdf names the SRDF).
+    (or a plain folder holding a URDF and an SRDF) if it holds an SRDF, a .setup_assistant, a
+    launch/ folder or a package.xml, or if `srdf_given` (--srdf names the SRDF).
     """
     path = Path(robot)
     shipped = shipped_config(str(robot))
@@ -107,11 +107,12 @@ def resolve_config_path(robot: str | Path, srdf_given: bool = False) -> Path:
     if path.is_dir():
         if (path / CONFIG_FILE).is_file():
             return path / CONFIG_FILE
-        if srdf_given or (path / SETUP_ASSISTANT_FILE).is_file() or (path / "launch").is_dir() or any(
+        if srdf_given or (path / SETUP_ASSISTANT_FILE).is_file() or (path / "launch").is_dir() or (
+                path / "package.xml").is_file() or any(
                 _candidates(path / sub, _SRDF_SUFFIXES) for sub in _SRDF_FOLDERS):
             return path
         raise ConfigError(f"{robot}: no robot config: no {CONFIG_FILE}, and no *.srdf in config/, srdf/ "
-                          "or the folder itself, and no launch/ folder (a MoveIt config package); "
+                          "or the folder itself, and no launch/ folder or package.xml (a MoveIt config package); "
                           "pass --srdf FILE to name one")
     if not path.is_file():
         raise ConfigError(f"{robot}: robot config not found (expected {_ACCEPTED}, or a shipped config: "
@@ -245,7 +246,10 @@ def discover(
 
 
 def _check_required(root: Path, launched: LaunchFiles) -> None:
-    """Raise for a launch argument declared with choices and given no value: ros2 launch asks for it too."""
+    """Raise for a launch argument without default or value that picks the hardware: ros2 launch asks for it too.
+
+    It picks the hardware when it has choices or a file's name waits for it.
+    """
     missing = {name: choices for name, choices in launched.required.items() if name not in launched.given}
     if not missing:
         return
@@ -254,8 +258,8 @@ def _check_required(root: Path, launched: LaunchFiles) -> None:
     below = _below_candidates(root)
     srdfs = f"; SRDFs in the package: {', '.join(stem(p) for p in below)}" if below else ""
     launch = ", ".join(p.name for p in launched.launch)
-    raise ConfigError(f"{root}: launch argument '{name}' has no value ({launch}: declared with choices and no "
-                      f"default{listed}){srdfs}; pass --launch-arg {name}:=VALUE")
+    raise ConfigError(f"{root}: launch argument '{name}' has no value ({launch}: declared without a default"
+                      f"{listed}){srdfs}; pass --launch-arg {name}:=VALUE")
 
 
 def _below(root: Path, launched: LaunchFiles) -> Path | None:
@@ -278,7 +282,7 @@ def _below_candidates(root: Path) -> list[Path]:
 
 
 def _robot_urdf(root: Path, srdf: Path, names: Sequence[str], packages: PackagePath) -> Path | None:
-    """Return the URDF of the SRDF's robot in a package of the search path (urdf/ or robots/ <name>.urdf[.xacro]).
+    """Return the URDF of the SRDF's robot in a package of the search path (see _robot_files).
 
     MoveIt packages whose launch files take the URDF from the robot's driver (robot_description
     on a topic) do not name it; the description package of the workspace holds it.
@@ -291,8 +295,7 @@ def _robot_urdf(root: Path, srdf: Path, names: Sequence[str], packages: PackageP
         for package in dict.fromkeys((*(([folder]) if (folder / "package.xml").is_file() else []),
                                       *packages_under(folder).values())):
             for name in wanted:
-                hits.extend(package / sub / f"{name}{suffix}" for sub in _XACRO_URDF_FOLDERS
-                            for suffix in (".urdf.xacro", ".urdf") if (package / sub / f"{name}{suffix}").is_file())
+                hits.extend(candidate for candidate in _robot_files(package, name) if candidate.is_file())
         if hits:
             break
     hits = list(dict.fromkeys(hits))
@@ -305,6 +308,16 @@ def _robot_urdf(root: Path, srdf: Path, names: Sequence[str], packages: PackageP
     return hits[0] if hits else None
 
 
+def _robot_files(package: Path, name: str) -> list[Path]:
+    """Return where a description package keeps robot `name`'s URDF: urdf/, robots/ or xacro/, or a folder of its name.
+
+    ROBOTIS keeps `urdf/<robot>/<robot>.urdf.xacro`, TM and Doosan `xacro/<robot>.urdf.xacro`.
+    """
+    folders = [package / sub for sub in _ROBOT_FOLDERS] + [package / sub / name for sub in _ROBOT_FOLDERS]
+    return [folder / f"{name}{suffix}" for folder in folders for suffix in (".urdf.xacro", ".urdf")]
+
+
+_ROBOT_FOLDERS = ("urdf", "robots", "xacro")
 _ROBOT_NAME = re.compile(r"<robot\b[^>]*?\bname\s*=\s*[\"']([A-Za-z0-9_.-]+)[\"']")
 
 

@@ -331,3 +331,71 @@ def test_plan_and_robot_take_launch_and_launch_arg(workspace: Path, cli: Cli, tm
                  "-o", tmp_path / "bad.mcap")
     assert result.exit_code == 2 and "expected name:=value" in result.stderr
     assert not (tmp_path / "bad.mcap").exists()
+
+
+# Denso's: the MoveIt launch file lives in a bringup package, the model is a launch argument without
+# default or choices, and the limits are per model (robots/<model>/config/joint_limits.yaml).
+BRINGUP_LIKE = '''
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument
+from launch.substitutions import Command, FindExecutable, LaunchConfiguration, PathJoinSubstitution
+from launch_ros.actions import Node
+from launch_ros.substitutions import FindPackageShare
+
+
+def generate_launch_description():
+    model = LaunchConfiguration('model')
+    moveit_config_package = LaunchConfiguration('moveit_config_package')
+    prefix = LaunchConfiguration('prefix')
+    robot_description = {'robot_description': Command([
+        PathJoinSubstitution([FindExecutable(name='xacro')]), ' ',
+        PathJoinSubstitution([FindPackageShare('ur10e_moveit_config'), 'config', 'ur10e.urdf.xacro']), ' ',
+        'mount_height:=', prefix, ' ', 'model:=', model])}
+    semantic = {'robot_description_semantic': Command(['cat ', PathJoinSubstitution(
+        [FindPackageShare(moveit_config_package), 'config', 'srdf', 'ur10e.srdf'])])}
+    limits = PathJoinSubstitution([FindPackageShare(moveit_config_package), 'robots', model,
+                                   'config/joint_limits.yaml'])
+    return LaunchDescription([
+        DeclareLaunchArgument('model', description='Type of the robot.'),
+        DeclareLaunchArgument('moveit_config_package', default_value='acme_moveit_config'),
+        DeclareLaunchArgument('prefix', default_value='""'),
+        Node(package='moveit_ros_move_group', executable='move_group',
+             parameters=[robot_description, semantic, limits]),
+    ])
+'''
+
+
+def test_a_moveit_launch_file_in_a_bringup_package_names_the_robot_and_asks_for_its_model(workspace: Path) -> None:
+    """Denso's denso_robot_bringup.launch.py names denso_robot_moveit_config, which has no launch/ folder."""
+    package = workspace / "acme_moveit_config"
+    shutil.rmtree(package / "launch")
+    for model in ("alpha", "beta"):
+        write(package, {f"robots/{model}/config/joint_limits.yaml": (package / "config/limits/ur10e.yaml").read_text()})
+    write(workspace / "acme_bringup", {"package.xml": PACKAGE_XML.format(name="acme_bringup"),
+                                       "launch/acme_bringup.launch.py": BRINGUP_LIKE})
+    with pytest.raises(ConfigError, match=r"launch argument 'model' has no value \(acme_bringup.launch.py: "
+                                          r"declared without a default; choices: alpha, beta\).*; "
+                                          r"pass --launch-arg model:=VALUE"):
+        load_robot_config(package)
+    config = load_robot_config(package, launch_args={"model": "beta"})
+    assert config.sources["launch"] == workspace / "acme_bringup" / "launch" / "acme_bringup.launch.py"
+    assert config.sources["joint_limits"] == package / "robots" / "beta" / "config" / "joint_limits.yaml"
+    # `prefix:=""` is an empty value, as launch's Command splits it with shlex: xacro's 0.0 would be "".
+    assert config.xacro_args.get("mount_height", "") == ""
+
+
+def test_the_urdf_of_the_srdfs_robot_is_found_one_folder_down_or_in_xacro(workspace: Path) -> None:
+    """ROBOTIS keeps urdf/<robot>/<robot>.urdf.xacro, TM and Doosan xacro/<robot>.urdf.xacro."""
+    package = workspace / "acme_moveit_config"
+    launch = package / "launch" / "moveit.launch.py"
+    launch.write_text(launch.read_text().replace("robot_description, robot_description_semantic, joint_limits",
+                                                 "robot_description_semantic, joint_limits").replace(
+        "parameters=[robot_description, controllers]", "parameters=[controllers]"))
+    description = workspace / "ur10e_moveit_config" / "config" / "ur10e.urdf.xacro"
+    for where in ("urdf/ur10e/ur10e.urdf.xacro", "xacro/ur10e.urdf.xacro"):
+        target = workspace / "ur10e_description" / where
+        target.parent.mkdir(parents=True, exist_ok=True)
+        control = "$(find ur10e_moveit_config)/config/ur10e.ros2_control.xacro"
+        target.write_text(description.read_text().replace("ur10e.ros2_control.xacro", control))
+        assert load_robot_config(package).sources["urdf"] == target
+        target.unlink()
