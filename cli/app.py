@@ -188,6 +188,9 @@ def execute(
     strict: StrictOpt = False,
     seed: Annotated[int, typer.Option(min=0, max=MAX_SEED, help="Seed for plant noise.")] = 0,
     ros_distro: Annotated[str, typer.Option(help="Controller-state layout to write: jazzy or humble.")] = "jazzy",
+    ros2_controllers: Annotated[str, typer.Option(metavar="RELEASE", help=(
+        "ros2_controllers release whose JointTrajectoryController is simulated: a distro (its newest "
+        "release) or a version such as 4.35.0 (the blend before a late first point changed in 4.36.0)."))] = "jazzy",
     plot: Annotated[Path | None, typer.Option(metavar="FILE.png", help=(
         "Write a PNG: per joint reference and actual, the error against the tolerances, violations."))] = None,
     as_json: JsonOpt = False,
@@ -215,7 +218,7 @@ def execute(
             plan=plan_file, plant=plant, plant_params=parse_params(plant_param or [], "--plant-param"),
             disturbances=tuple(parse_disturbance(d) for d in disturb or []),
             start_joints=parse_joint_values(start_joints, "--start-joints") if start_joints else None,
-            controllers=controllers, seed=seed, strict=strict,
+            controllers=controllers, seed=seed, strict=strict, ros2_controllers=ros2_controllers,
         )
         if plot is not None:
             outcome = execute_plotted(request, plot, output, ros_distro)

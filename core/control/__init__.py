@@ -31,12 +31,16 @@ if TYPE_CHECKING:
     )
     from .published import controller_states
     from .quality import JointTracking, merged_tracking
+    from .releases import DEFAULT_RELEASE, fills_point_before
     from .results import ExecutionResult, ExecutionSummary, Violation
     from .step_tracking import recorded_tracking, sample_index, simulated_tracking
     from .tolerances import in_controller_order, position_error
     from .tuning import Gains, JointSetup, JointTuning, tune_joint
 
 __all__ = [
+    "DEFAULT_RELEASE",
+    "PLANTS",
+    "SCAN_ROWS",
     "CheckReport",
     "CycleCheck",
     "Disturbance",
@@ -47,17 +51,16 @@ __all__ = [
     "JointSetup",
     "JointTracking",
     "JointTuning",
-    "PLANTS",
     "Plant",
     "PlantFit",
     "RecordedStep",
     "RecordingStart",
-    "SCAN_ROWS",
     "SampleSource",
     "StepCheck",
     "Violation",
     "check_recording",
     "controller_states",
+    "fills_point_before",
     "fit_plant",
     "in_controller_order",
     "make_plant",
@@ -78,6 +81,9 @@ __all__ = [
 ]
 
 __getattr__ = lazy_exports(__name__, {
+    "DEFAULT_RELEASE": "releases",
+    "PLANTS": "plants",
+    "SCAN_ROWS": "check",
     "CheckReport": "check",
     "CycleCheck": "check",
     "Disturbance": "controller",
@@ -88,17 +94,16 @@ __getattr__ = lazy_exports(__name__, {
     "JointSetup": "tuning",
     "JointTracking": "quality",
     "JointTuning": "tuning",
-    "PLANTS": "plants",
     "Plant": "plants",
     "PlantFit": "plants",
     "RecordedStep": "plants",
     "RecordingStart": "check",
-    "SCAN_ROWS": "check",
     "SampleSource": "check",
     "StepCheck": "check",
     "Violation": "results",
     "check_recording": "check",
     "controller_states": "published",
+    "fills_point_before": "releases",
     "fit_plant": "plants",
     "in_controller_order": "tolerances",
     "make_plant": "plants",

@@ -146,6 +146,7 @@ def simulate(
     start_positions: npt.ArrayLike | None = None,
     disturbances: Sequence[Disturbance] = (),
     seed: int = 0,
+    fill_point_before: bool = True,
 ) -> ExecutionReport:
     """Return the report of executing `trajectory` through the controller on `plant`.
 
@@ -159,6 +160,8 @@ def simulate(
             order; None = exactly at the trajectory's first point.
         disturbances: Bumps applied to the actual positions during the execution.
         seed: Seeds the plant's randomness (measurement noise).
+        fill_point_before: The blend before a first point after time 0 has the trajectory's spline
+            degree, as ros2_controllers has done since PR #2043 (releases.py); False: as before it.
     """
     trajectory = in_controller_order(trajectory, controller)
     joints = trajectory.joint_names
@@ -187,7 +190,8 @@ def simulate(
     if np.any(bumps[0]):
         p0, v0 = plant.displace(bumps[0])
     initial_output = plant.last_output.copy()
-    reference = _reference(trajectory, grid, _point_before(controller, p0, v0), continuous)
+    before = _point_before(controller, p0, v0, trajectory if fill_point_before else None)
+    reference = _reference(trajectory, grid, before, continuous)
     verdict_of = _judge_cycles(trajectory, controller, grid, reference, timeout, continuous)
     actual_p, actual_v, output, verdict = _run(plant, reference, bumps, (p0, v0), dt, verdict_of)
     return _executed(verdict, joints, grid, reference, (actual_p, actual_v, output), initial_output, continuous,
@@ -380,16 +384,23 @@ def _bumps(
 
 
 def _point_before(controller: ControllerConfig, positions: NDArray[np.float64],
-                  velocities: NDArray[np.float64]) -> PointBefore:
-    """Return the state JTC blends from: the fields it reads are those of its state interfaces."""
+                  velocities: NDArray[np.float64], filled_like: JointTrajectory | None = None) -> PointBefore:
+    """Return the state JTC blends from: the fields it reads are those of its state interfaces.
+
+    With `filled_like` (ros2_controllers' trajectory.cpp set_point_before_trajectory_msg, since
+    PR #2043), a field the state lacks but the trajectory's points carry is zero.
+    """
     has_velocity = "velocity" in controller.state_interfaces
     has_acceleration = has_velocity and "acceleration" in controller.state_interfaces
+    zeros = np.zeros_like(positions)
+    if filled_like is not None:
+        return PointBefore(
+            positions,
+            velocities if has_velocity else zeros if filled_like.has_velocities else None,
+            zeros if has_acceleration or filled_like.has_accelerations else None,
+        )
     # The plants start at rest and model no acceleration state: read as 0.
-    return PointBefore(
-        positions,
-        velocities if has_velocity else None,
-        np.zeros_like(positions) if has_acceleration else None,
-    )
+    return PointBefore(positions, velocities if has_velocity else None, zeros if has_acceleration else None)
 
 
 def _hold_on_abort(

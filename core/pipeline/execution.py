@@ -21,6 +21,7 @@ from .. import bag as recording
 from ..bag import open_joint_states
 from ..config import ControllerConfig, ExecutionConfig, JointGoal, check_joint_units
 from ..control import (
+    DEFAULT_RELEASE,
     CheckReport,
     ExecutionResult,
     ExecutionSummary,
@@ -29,6 +30,7 @@ from ..control import (
     SampleSource,
     Violation,
     check_recording,
+    fills_point_before,
     merged_margins,
     merged_tracking,
     recorded_tracking,
@@ -65,6 +67,8 @@ class ExecuteRequest:
     seed: int = 0
     strict: bool = False
     """--strict: a parameter the `controllers` file's controller does not declare is an error."""
+    ros2_controllers: str = DEFAULT_RELEASE
+    """--ros2-controllers: the release whose JointTrajectoryController is simulated (control/releases.py)."""
     controllers_as_data: bool = False
     """The `controllers` file is a plan's own (tune-pid's gains written into it): read without launch substitutions."""
 
@@ -245,7 +249,8 @@ def _simulated_steps(
                  for d in request.disturbances if step.start_s <= d.time_s < end or (d.time_s >= end and last)]
         try:
             report = simulate(step.trajectory, controller, execution, plant, continuous_joints=continuous,
-                              start_positions=start, disturbances=bumps, seed=request.seed)
+                              start_positions=start, disturbances=bumps, seed=request.seed,
+                              fill_point_before=fills_point_before(request.ros2_controllers))
         except InputError as exc:
             raise InputError(f"{request.plan}: step '{step.name}': {exc}") from None
         ok = report.ok

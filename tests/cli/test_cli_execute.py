@@ -181,3 +181,12 @@ def test_execution_with_nan_prints_strict_json_with_null(cli: Cli, monkeypatch: 
     text = cli("execute", SHIPPED_PLAN, "--fake")
     assert text.exit_code == 5 and "Traceback" not in text.stderr
     assert "inf/nan" in text.stdout
+
+
+def test_ros2_controllers_names_the_release_simulated(cli: Cli, tmp_path: Path) -> None:
+    code, document = cli.json("execute", SHIPPED_PLAN, "--fake", "--ros2-controllers", "4.35.0")
+    assert code == 0 and document["ok"] is True  # a MoveIt plan starts at 0 s: no blend, same verdict
+    result = cli("execute", SHIPPED_PLAN, "--fake", "--ros2-controllers", "newest", "-o", tmp_path / "run.mcap")
+    assert result.exit_code == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert "--ros2-controllers 'newest': expected a distro (humble, jazzy, kilted, rolling)" in result.stderr
+    assert not (tmp_path / "run.mcap").exists()

@@ -388,3 +388,31 @@ def test_a_positions_only_goal_is_interpolated_linearly_from_the_state_read() ->
     middle = int(np.searchsorted(report.times_s, 0.5))
     np.testing.assert_allclose(report.reference_velocities[middle], [1.0, 1.0, 1.0], atol=1e-9)
     np.testing.assert_allclose(report.reference_positions[middle], INITIAL + report.times_s[middle], atol=1e-9)
+
+
+@pytest.mark.parametrize(("release", "velocity"), [("jazzy", 1.875), ("4.35.0", 1.0)])
+def test_the_blend_before_a_late_first_point_has_the_trajectorys_degree_since_4_36(release, velocity) -> None:
+    """test_trajectory.cpp fill_point_before_with_same_degree_as_traj (PR #2043): a position-only state gets zero
+    velocity and acceleration, so the blend to a first point at 1 s is quintic; before 4.36.0 it was linear."""
+    from moveplan.core.control import fills_point_before
+
+    trajectory = JointTrajectory(("joint1",), [1.0, 2.0], [[1.0], [2.0]], np.zeros((2, 1)), np.zeros((2, 1)))
+    controller = jtc(joints=("joint1",), states=("position",))
+    report = simulate(trajectory, controller, NO_START_CHECK, MirrorPlant(1), start_positions=[0.0],
+                      fill_point_before=fills_point_before(release))
+    first = 0
+    np.testing.assert_allclose(report.reference_positions[first], [0.0], atol=1e-12)
+    middle = int(np.searchsorted(report.times_s, 0.5))
+    assert report.times_s[middle] == pytest.approx(0.5)
+    np.testing.assert_allclose(report.reference_positions[middle], [0.5], atol=1e-9)
+    np.testing.assert_allclose(report.reference_velocities[middle], [velocity], atol=1e-9)
+
+
+def test_ros2_controllers_releases_are_named_by_distro_or_version() -> None:
+    from moveplan.core.control import fills_point_before
+
+    assert fills_point_before("humble") and fills_point_before("Jazzy") and fills_point_before("2.52.0")
+    assert not fills_point_before("2.51.3") and not fills_point_before("4.35") and not fills_point_before("3.29.0")
+    assert fills_point_before("4.36.0") and fills_point_before("5.11.0") and not fills_point_before("5.10.0")
+    with pytest.raises(UsageError, match=r"--ros2-controllers 'iron-ish': expected a distro \(humble, jazzy"):
+        fills_point_before("iron-ish")
