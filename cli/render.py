@@ -186,6 +186,7 @@ def execution_summary(outcome: PlanExecution, output: Path | None, as_json: bool
         _failure_line("execute", document)
         return
     _verdict(document, f"smallest margin to tolerance ({document['controller']})")
+    _steps(document)
     _tracking(document)
     _console.print(f"executed {len(document['steps'])} of {len(outcome.plan.steps)} steps in "
                    f"{_number(document['duration_s'], '.3f')} s")
@@ -211,6 +212,7 @@ def check_summary(report: CheckReport, recording: Path, as_json: bool, quiet: bo
             _failure_line("check-tolerances", document)
         return
     _verdict(document, "smallest margin to tolerance")
+    _steps(document)
     _tracking(document)
     if "cycles" in document:
         _cycles(document)
@@ -255,11 +257,11 @@ def _verdict(document: dict[str, Any], margins_title: str) -> None:
     colour = "green" if document["ok"] else "yellow" if result["name"] == "INCOMPLETE" else "red"
     _console.print(f"[{colour}]{result['name']}[/{colour}] ({result['code']}): {result['message']}")
     if document["violations"]:
-        rows = table("violations; positions in rad or m", ("step", "check", "joint", "time [s]", "reference",
-                                                           "actual", "error", "tolerance"), left=3)
+        rows = table("violations", ("step", "check", "joint", "time [s]", "reference", "actual", "error",
+                                    "tolerance", "unit"), left=3)
         for v in document["violations"]:
             rows.add_row(v["step"], v["check"], v["joint"], _number(v["time_s"], ".3f"),
-                         *(_number(v[key], ".4f") for key in ("reference", "actual", "error", "tolerance")))
+                         *(_number(v[key], ".4f") for key in ("reference", "actual", "error", "tolerance")), v["unit"])
         show(rows)
     if document["margins"]:
         rows = table(margins_title, ("joint", "margin [rad]"))
@@ -267,6 +269,36 @@ def _verdict(document: dict[str, Any], margins_title: str) -> None:
             colour = "red" if margin is None or margin < 0 else "green"
             rows.add_row(joint, f"[{colour}]{_number(margin, '.4f')}[/]")
         show(rows)
+    _unchecked(document)
+
+
+def _unchecked(document: dict[str, Any]) -> None:
+    """Print which joints the controller checks nothing for: a tolerance of 0 is JTC's "not checked"."""
+    unchecked = document.get("unchecked") or {}
+    joints = set(document["margins"]) | {j for names in unchecked.values() for j in names}
+    parts = []
+    for check in ("path", "goal"):
+        names = unchecked.get(check) or []
+        if names:
+            parts.append(f"{check} {'of every joint' if set(names) == joints else 'of ' + ', '.join(names)}")
+    if parts:
+        nothing = " (nothing is checked)" if all(set(unchecked.get(c) or []) == joints for c in ("path", "goal")) \
+            else ""
+        _console.print(f"[yellow]not checked[/yellow]{nothing}: {'; '.join(parts)}: its tolerance is 0, "
+                       "which the controller does not check")
+
+
+def _steps(document: dict[str, Any]) -> None:
+    """Print each step's verdict: its result and duration (INCOMPLETE where a recording cuts it off)."""
+    steps = document.get("steps") or []
+    if not steps:
+        return
+    rows = table("steps", ("step", "result", "start [s]", "duration [s]"))
+    for step in steps:
+        colour = "green" if step["ok"] else "yellow" if step["ok"] is None else "red"
+        rows.add_row(step["name"], f"[{colour}]{step['result']}[/]", _number(step["start_s"], ".3f"),
+                     _number(step["duration_s"], ".3f"))
+    show(rows)
 
 
 def _tracking(document: dict[str, Any]) -> None:

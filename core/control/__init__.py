@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     from .releases import DEFAULT_RELEASE, fills_point_before
     from .results import ExecutionResult, ExecutionSummary, Violation
     from .step_tracking import recorded_tracking, sample_index, simulated_tracking
-    from .tolerances import in_controller_order, position_error
+    from .tolerances import in_controller_order, position_error, unchecked_joints
     from .tuning import Gains, JointSetup, JointTuning, tune_joint
 
 __all__ = [
@@ -75,6 +75,7 @@ __all__ = [
     "simulate",
     "simulated_tracking",
     "tune_joint",
+    "unchecked_joints",
     "uses_velocities",
     "validate_goal",
     "validate_goal_end",
@@ -118,6 +119,7 @@ __getattr__ = lazy_exports(__name__, {
     "simulate": "controller",
     "simulated_tracking": "step_tracking",
     "tune_joint": "tuning",
+    "unchecked_joints": "tolerances",
     "uses_velocities": "check",
     "validate_goal": "goal_validation",
     "validate_goal_end": "goal_validation",

@@ -27,6 +27,7 @@ __all__ = [
     "position_error",
     "segment_tolerances",
     "tolerance_limits",
+    "unchecked_joints",
     "velocity_error_computable",
 ]
 
@@ -139,3 +140,11 @@ def in_controller_order(
         controller.joints, trajectory.times_s, trajectory.positions[:, order],
         trajectory.velocities[:, order], trajectory.accelerations[:, order],
     )
+
+
+def unchecked_joints(controller: ControllerConfig) -> dict[str, tuple[str, ...]]:
+    """Return per check (path, goal) the joints whose tolerance is 0, which JTC does not check."""
+    return {
+        "path": tuple(j for j in controller.joints if not controller.trajectory_tolerance.get(j, 0.0) > 0.0),
+        "goal": tuple(j for j in controller.joints if not controller.goal_tolerance.get(j, 0.0) > 0.0),
+    }

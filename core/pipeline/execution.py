@@ -35,6 +35,7 @@ from ..control import (
     merged_tracking,
     recorded_tracking,
     simulated_tracking,
+    unchecked_joints,
     uses_velocities,
 )
 from ..errors import InputError, UnknownName
@@ -308,7 +309,8 @@ def check(request: CheckRequest, then: Callable[[CheckedRecording], None] | None
                            time_source=request.time_source, velocities=uses_velocities(plan, controller),
                            skip_damaged=request.skip_damaged) as recorded:
         report = check_recording(plan, recorded, controller, config.execution, continuous, request.start)
-        report = replace(report, skipped=recorded.skipped)
+        report = replace(report, skipped=recorded.skipped, unchecked=unchecked_joints(controller),
+                         prismatic=plan.prismatic_joints())
         report = recorded_tracking(report, [s.trajectory for s in plan.steps], recorded, controller,
                                    np.array([j in continuous for j in controller.joints]))
         if then is not None:

@@ -16,7 +16,14 @@ from typing import TYPE_CHECKING, Any, cast
 from .. import bag as recording
 from ..bag import ExecutedStep, ExecutionWriter, execution_writer, seconds_to_ns, stamps_ns
 from ..config import ControllerConfig
-from ..control import ExecutionReport, ExecutionSummary, JointTracking, controller_states, merged_tracking
+from ..control import (
+    ExecutionReport,
+    ExecutionSummary,
+    JointTracking,
+    controller_states,
+    merged_tracking,
+    unchecked_joints,
+)
 from ..errors import InputError
 from ..types import TfSamples
 
@@ -141,8 +148,9 @@ def execution_document(execution: PlanExecution, output: Path | None = None) -> 
     """Return the result document of an execution: the executed file's, and `execute --json`'s.
 
     Keys: ok, result {code, name, message}, violations (each with its step: step, check,
-    joint, time_s, reference, actual, error, tolerance; times from the step's start),
-    margins {joint: margin}, then controller, duration_s and steps (name, ok, result,
+    joint, time_s, reference, actual, error, tolerance, unit of those four; times from the
+    step's start), margins {joint: margin}, unchecked {path: [joints], goal: [joints]} (a
+    tolerance of 0, which JTC does not check), then controller, duration_s and steps (name, ok, result,
     start_s and duration_s on the execution's timeline, tracking) and tracking (per joint, the
     worst over the steps: core.control.quality); last output, the executed file written, if
     `output` is given (the file's own document has none). Non-finite numbers are null.
@@ -162,7 +170,9 @@ def execution_document(execution: PlanExecution, output: Path | None = None) -> 
         )
         start_ns += seconds_to_ns(report.duration_s)
     document: dict[str, Any] = {
-        **_verdict(execution.ok, execution.result, execution.violations, execution.margins),
+        **_verdict(execution.ok, execution.result, execution.violations, execution.margins,
+                   execution.plan.prismatic_joints()),
+        "unchecked": {check: list(joints) for check, joints in unchecked_joints(execution.controller).items()},
         "controller": execution.controller.name,
         "duration_s": start_ns / 1e9,
         "steps": steps,
@@ -176,7 +186,7 @@ def execution_document(execution: PlanExecution, output: Path | None = None) -> 
 def check_document(report: CheckReport, recording: Path) -> dict[str, Any]:
     """Return the result document of a check of `recording`: `check-tolerances --json`'s.
 
-    Keys: ok, result, violations and margins as in `execution_document`; duration_s and
+    Keys: ok, result, violations, margins and unchecked as in `execution_document`; duration_s and
     start_s (the first execution's start, from the recording's first sample); steps (name,
     ok, result, start_s, duration_s, aligned_by); gaps [{start_s, length_s}]; warnings;
     skipped [{file, offset, part, reason}], the damaged parts of the recording left out (--skip-damaged);
@@ -192,7 +202,8 @@ def check_document(report: CheckReport, recording: Path) -> dict[str, Any]:
         cut = InputError(f"{recording}: {report.result.message}")
         error = {"exit_code": cut.exit_code, "kind": cut.kind, "message": str(cut)}
     document: dict[str, Any] = {
-        **_verdict(report.ok, report.result, report.violations, report.margins),
+        **_verdict(report.ok, report.result, report.violations, report.margins, report.prismatic),
+        "unchecked": {check: list(joints) for check, joints in report.unchecked.items()},
         "duration_s": report.duration_s,
         "start_s": report.start_s,
         "steps": [{"name": s.name, "ok": s.ok if s.complete else None, "result": s.report.result.name,
@@ -229,9 +240,11 @@ def finite(value: float) -> float | None:
 
 
 def _verdict(
-    ok: bool, result: ExecutionResult, violations: Iterable[tuple[str, Violation]], margins: Mapping[str, float]
+    ok: bool, result: ExecutionResult, violations: Iterable[tuple[str, Violation]], margins: Mapping[str, float],
+    prismatic: Iterable[str] = (),
 ) -> dict[str, Any]:
-    """Return the head both documents share: ok, result, violations (with their step), margins."""
+    """Return the head both documents share: ok, result, violations (with their step and unit), margins."""
+    linear = frozenset(prismatic)
     return {
         "ok": ok,
         "result": _result(result),
@@ -245,11 +258,20 @@ def _verdict(
                 "actual": v.actual,
                 "error": v.error,
                 "tolerance": v.tolerance,
+                "unit": _unit(v, linear),
             }
             for step, v in violations
         ],
         "margins": dict(margins),
     }
+
+
+def _unit(violation: Violation, prismatic: frozenset[str]) -> str:
+    """Return the unit of a violation's numbers: s for the time checks, else the joint's position or velocity unit."""
+    if violation.check in ("goal_time", "timeout"):
+        return "s"
+    length = "m" if violation.joint in prismatic else "rad"
+    return f"{length}/s" if violation.check == "stopped_velocity" else length
 
 
 def _result(result: ExecutionResult) -> dict[str, Any]:

@@ -190,3 +190,28 @@ def test_ros2_controllers_names_the_release_simulated(cli: Cli, tmp_path: Path) 
     assert result.exit_code == 2 and result.stderr.count("\n") == 1, result.stderr
     assert "--ros2-controllers 'newest': expected a distro (humble, jazzy, kilted, rolling)" in result.stderr
     assert not (tmp_path / "run.mcap").exists()
+
+
+def test_a_controller_that_checks_nothing_says_so_and_each_step_has_its_verdict(cli: Cli, tmp_path: Path) -> None:
+    """A tolerance of 0 is JTC's "not checked": a run through a 1 s lag passes, and the report says why."""
+    import yaml
+
+    controllers = yaml.safe_load((SAMPLES / "ur10e_mistuned_controllers.yaml").read_text())
+    for value in controllers.values():
+        constraints = value.get("ros__parameters", {}).get("constraints") if isinstance(value, dict) else None
+        if isinstance(constraints, dict):
+            for joint, entry in constraints.items():
+                if isinstance(entry, dict):
+                    constraints[joint] = {"trajectory": 0.0, "goal": 0.0}
+    path = tmp_path / "unchecked.yaml"
+    path.write_text(yaml.safe_dump(controllers))
+    args = ("execute", SHIPPED_PLAN, "--fake", "--controllers", path)
+    code, document = cli.json(*args)
+    assert code == 0
+    joints = {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
+              "wrist_3_joint"}
+    assert set(document["unchecked"]["path"]) == set(document["unchecked"]["goal"]) == joints
+    assert document["margins"] == {}
+    text = cli(*args).stdout
+    assert "not checked (nothing is checked): path of every joint; goal of every joint: its tolerance is 0" in text
+    assert "up: result SUCCESSFUL" in text

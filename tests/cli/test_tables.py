@@ -84,4 +84,4 @@ def test_piped_verdict_and_violations_are_one_line_each_whatever_the_width() -> 
     for v in document["violations"]:
         assert (f"{v['step']}: check {v['check']}  joint {v['joint']}  time [s] {v['time_s']:.3f}  reference "
                 f"{v['reference']:.4f}  actual {v['actual']:.4f}  error {v['error']:.4f}  tolerance "
-                f"{v['tolerance']:.4f}") in lines
+                f"{v['tolerance']:.4f}  unit {v['unit']}") in lines

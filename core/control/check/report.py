@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ...types import SkippedData
 from ..margins import merged_margins
@@ -115,6 +115,8 @@ class CheckReport:
         warnings: Things the user should know: gaps, sparse samples, alignment fallbacks.
         recording_start_ns: Time of the recording's first sample in [ns].
         skipped: The damaged parts of the recording its read skipped, as asked (--skip-damaged).
+        unchecked: Per check (path, goal), the joints the controller does not check (tolerance 0).
+        prismatic: The plan's prismatic joints (their positions are in [m]).
 
     """
 
@@ -132,6 +134,8 @@ class CheckReport:
     warnings: tuple[str, ...]
     recording_start_ns: int
     skipped: tuple[SkippedData, ...] = ()
+    unchecked: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    prismatic: frozenset[str] = frozenset()
 
     @property
     def complete(self) -> bool:
