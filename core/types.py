@@ -20,7 +20,9 @@ __all__ = [
     "PointSeries",
     "CollisionObject",
     "Frame",
+    "GoalTolerances",
     "JointStateSeries",
+    "JointTolerance",
     "JointTrajectory",
     "LinkPose",
     "Plan",
@@ -232,6 +234,42 @@ class TfSamples:
 
 
 @dataclass(frozen=True)
+class JointTolerance:
+    """A control_msgs/JointTolerance: 0 = the controller's own, -1 = erased (not checked), > 0 = this one.
+
+    In [rad] (or [m]), [rad]/[s] and [rad]/[s]^2.
+    """
+
+    name: str
+    position: float = 0.0
+    velocity: float = 0.0
+    acceleration: float = 0.0
+
+
+@dataclass(frozen=True)
+class GoalTolerances:
+    """The tolerances a FollowJointTrajectory goal carries, replacing the controller's for that goal.
+
+    Attributes:
+        path: path_tolerance, per joint.
+        goal: goal_tolerance, per joint.
+        goal_time_s: goal_time_tolerance in [s]: 0 = the controller's, -1 = erased.
+    """
+
+    path: tuple[JointTolerance, ...] = ()
+    goal: tuple[JointTolerance, ...] = ()
+    goal_time_s: float = 0.0
+
+    def as_dict(self) -> dict[str, Any]:
+        """Return the tolerances as a FollowJointTrajectory goal's fields (a task file's `tolerances`)."""
+        def joints(items: tuple[JointTolerance, ...]) -> list[dict[str, Any]]:
+            return [{"name": t.name, "position": t.position, "velocity": t.velocity, "acceleration": t.acceleration}
+                    for t in items]
+        return {"path_tolerance": joints(self.path), "goal_tolerance": joints(self.goal),
+                "goal_time_tolerance": self.goal_time_s}
+
+
+@dataclass(frozen=True)
 class StepResult:
     """One planned motion: its goal as requested, how it was planned, and its trajectory."""
 
@@ -243,6 +281,7 @@ class StepResult:
     fraction: float = 1.0
     residual: dict[str, float] | None = None
     stats: dict[str, float] = field(default_factory=dict)
+    tolerances: GoalTolerances | None = None  # sent with the goal, replacing the controller's
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ import json
 import math
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -23,7 +23,7 @@ from mcap_ros2._vendor.rosidl_adapter.parser import InvalidSpecification, Invali
 from mcap_ros2.decoder import DecoderFactory
 
 from ..errors import InputError
-from ..types import JointTrajectory
+from ..types import GoalTolerances, JointTolerance, JointTrajectory
 from .cdr import trajectory_from_message
 from .container import DAMAGE, Contents, Kept, Skips, open_mcap, scan, verify_mcap
 
@@ -70,11 +70,12 @@ _BAD_SCHEMA = (*_UNREADABLE, InvalidSpecification, InvalidValue)
 
 @dataclass(frozen=True)
 class PlanStepRecord:
-    """One step read back from a plan file: name, start on the plan's timeline in [s], motion."""
+    """One step read back from a plan file: name, start on the plan's timeline in [s], motion, goal tolerances."""
 
     name: str
     start_s: float
     trajectory: JointTrajectory
+    tolerances: GoalTolerances | None = None
 
 
 @dataclass(frozen=True)
@@ -126,7 +127,8 @@ def read_plan(path: Path) -> PlanFile:
     try:
         step_names = [str(name) for name in json.loads(info["step_names"])]
         limits = _limits(json.loads(info["limits"]))
-    except (ValueError, TypeError, AttributeError) as exc:
+        tolerances = _tolerances(info.get("step_tolerances"), len(step_names))
+    except (ValueError, TypeError, AttributeError, KeyError) as exc:
         raise InputError(f"{path}: 'moveplan' metadata is malformed: {exc}") from exc
     factory = DecoderFactory()
     descriptions = [item for item in contents.kept if item[0].topic == ROBOT_DESCRIPTION]
@@ -135,7 +137,8 @@ def read_plan(path: Path) -> PlanFile:
         group=info["group"],
         planning_frame=info["planning_frame"],
         distro=info["distro"],
-        steps=_steps(path, factory, contents, step_names),
+        steps=tuple(replace(step, tolerances=tolerance) for step, tolerance
+                    in zip(_steps(path, factory, contents, step_names), tolerances, strict=True)),
         attachments={attachment.name: attachment.data for attachment in contents.attachments},
         metadata={key: value for key, value in info.items() if key not in PLAN_KEYS},
         limits=limits,
@@ -207,6 +210,24 @@ def _steps(
             raise InputError(f"{path}: step '{name}' on {TRAJECTORY} is unreadable: {exc}") from exc
         steps.append(PlanStepRecord(name, message.log_time / 1e9, trajectory))
     return tuple(steps)
+
+
+def _tolerances(text: str | None, count: int) -> list[GoalTolerances | None]:
+    """Return each step's goal tolerances from the metadata's step_tolerances (JSON; absent: none)."""
+    if text is None:
+        return [None] * count
+    entries = json.loads(text)
+    if not isinstance(entries, list) or len(entries) != count:
+        raise ValueError(f"step_tolerances: expected {count} entries, one per step")
+    return [None if entry is None else _goal_tolerances(entry) for entry in entries]
+
+
+def _goal_tolerances(entry: dict[str, Any]) -> GoalTolerances:
+    def joints(items: list[dict[str, Any]]) -> tuple[JointTolerance, ...]:
+        return tuple(JointTolerance(str(t["name"]), *(float(t[key]) for key in ("position", "velocity",
+                                                                                 "acceleration"))) for t in items)
+    return GoalTolerances(joints(entry["path_tolerance"]), joints(entry["goal_tolerance"]),
+                          float(entry["goal_time_tolerance"]))
 
 
 def _robot_description(path: Path, factory: DecoderFactory, kept: list[Kept]) -> str:

@@ -42,6 +42,9 @@ def write_plan(path: Path, plan: Plan, distro: str = "jazzy") -> None:
         "group": plan.group,
         "planning_frame": plan.planning_frame,
         "step_names": json.dumps([step.name for step in plan.steps]),
+        # The tolerances each step's goal carries (control_msgs/FollowJointTrajectory's fields), null: none.
+        **({"step_tolerances": json.dumps([s.tolerances.as_dict() if s.tolerances else None for s in plan.steps])}
+           if any(step.tolerances for step in plan.steps) else {}),
         "limits": json.dumps(plan.limits, sort_keys=True),
         "distro": distro,
     }

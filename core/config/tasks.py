@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
+from ..types import GoalTolerances
 from .constraints import ArcPoint, PathConstraints, path_constraints
 from .fields import (
     MAX_MAGNITUDE,
@@ -24,6 +25,7 @@ from .fields import (
     pose_angle,
     read_input,
 )
+from .goal_tolerances import parse_goal_tolerances
 from .goals import GOAL_KINDS, SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
 from .motion import MIN_SCALING, MotionSettings, is_scaling
 from .poses import vector
@@ -39,7 +41,8 @@ MAX_SEED = 2**32 - 1
 
 _TASK_KEYS = {"robot", "scene", "group", "start", "defaults", "steps", "seed"}
 _DEFAULT_KEYS = {f.name for f in fields(MotionSettings)}
-_STEP_KEYS = {"name", "linear", "min_fraction", "path_constraints", "arc", *GOAL_KINDS, *_DEFAULT_KEYS}
+_STEP_KEYS = {"name", "linear", "min_fraction", "path_constraints", "arc", "tolerances", *GOAL_KINDS,
+              *_DEFAULT_KEYS}
 _POSE_KEYS = {"frame", "xyz", "rpy", "quat", "link"}
 
 
@@ -58,6 +61,7 @@ class StepSpec:
     motion: MotionSettings = MotionSettings()
     constraints: PathConstraints | None = None
     arc: ArcPoint | None = None  # Pilz's CIRC: the point the arc passes through or turns about
+    tolerances: GoalTolerances | None = None  # sent with the step's FollowJointTrajectory goal
 
 
 @dataclass(frozen=True)
@@ -239,8 +243,11 @@ def load_task(path: Path) -> TaskFile:
         constraints = (path_constraints(entry["path_constraints"], f"{where}.path_constraints")
                        if "path_constraints" in entry else None)
         arc = _arc(entry["arc"], f"{where}.arc") if "arc" in entry else None
+        tolerances = (parse_goal_tolerances(entry["tolerances"], f"{where}.tolerances")
+                      if "tolerances" in entry else None)
         steps.append(StepSpec(name=name, goal=goal, linear=linear, min_fraction=min_fraction,
-                              motion=_motion(entry, where), constraints=constraints, arc=arc))
+                              motion=_motion(entry, where), constraints=constraints, arc=arc,
+                              tolerances=tolerances))
     names = [s.name for s in steps]
     for name in names:
         if names.count(name) > 1:

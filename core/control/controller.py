@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from ..config import ControllerConfig, ExecutionConfig
 from ..errors import InputError, UsageError, known
 from ..trajectory import PointBefore, sample
-from ..types import JointTrajectory, frozen_array
+from ..types import GoalTolerances, JointTrajectory, frozen_array
 from ._judging import judge
 from ._moveit_checks import Timeout, check_start_state, expected_duration_s
 from .plants import Plant
@@ -37,7 +37,14 @@ from .results import (
     ToleranceReport,
     Violation,
 )
-from .tolerances import in_controller_order, position_error, segment_tolerances, velocity_error_computable
+from .tolerances import (
+    SegmentTolerances,
+    goal_segment_tolerances,
+    in_controller_order,
+    position_error,
+    segment_tolerances,
+    velocity_error_computable,
+)
 
 __all__ = [
     "DEFAULT_MAX_CYCLES", "MAX_CYCLES_ENV", "WAIT_LIMIT_S", "Disturbance", "ExecutionReport", "max_control_cycles",
@@ -147,6 +154,7 @@ def simulate(
     disturbances: Sequence[Disturbance] = (),
     seed: int = 0,
     fill_point_before: bool = True,
+    goal_tolerances: GoalTolerances | None = None,
 ) -> ExecutionReport:
     """Return the report of executing `trajectory` through the controller on `plant`.
 
@@ -162,6 +170,8 @@ def simulate(
         seed: Seeds the plant's randomness (measurement noise).
         fill_point_before: The blend before a first point after time 0 has the trajectory's spline
             degree, as ros2_controllers has done since PR #2043 (releases.py); False: as before it.
+        goal_tolerances: Tolerances the goal carries, replacing the controller's for it
+            (tolerances.goal_segment_tolerances).
     """
     trajectory = in_controller_order(trajectory, controller)
     joints = trajectory.joint_names
@@ -176,8 +186,9 @@ def simulate(
         return _not_started(refused, joints, plant.interface)
 
     dt = 1.0 / controller.update_rate_hz
-    timeout = _timeout(trajectory.duration_s, controller, execution)
-    horizon_s = _horizon_s(trajectory.duration_s, controller.goal_time_s, timeout)
+    tolerances = goal_segment_tolerances(segment_tolerances(controller), goal_tolerances)
+    timeout = _timeout(trajectory.duration_s, tolerances.goal_time_s, execution)
+    horizon_s = _horizon_s(trajectory.duration_s, tolerances.goal_time_s, timeout)
     cycles, limit = horizon_s / dt, max_control_cycles()
     if not cycles <= limit:  # counted before the grid is built: a margin of 1e12 s would ask for terabytes
         raise InputError(f"a {trajectory.duration_s:.6g} s trajectory watched for up to {horizon_s:.6g} s (goal time, "
@@ -192,7 +203,7 @@ def simulate(
     initial_output = plant.last_output.copy()
     before = _point_before(controller, p0, v0, trajectory if fill_point_before else None)
     reference = _reference(trajectory, grid, before, continuous)
-    verdict_of = _judge_cycles(trajectory, controller, grid, reference, timeout, continuous)
+    verdict_of = _judge_cycles(trajectory, controller, tolerances, grid, reference, timeout, continuous)
     actual_p, actual_v, output, verdict = _run(plant, reference, bumps, (p0, v0), dt, verdict_of)
     return _executed(verdict, joints, grid, reference, (actual_p, actual_v, output), initial_output, continuous,
                      plant.interface)
@@ -252,6 +263,7 @@ def _reference(
 def _judge_cycles(
     trajectory: JointTrajectory,
     controller: ControllerConfig,
+    tolerances: SegmentTolerances,
     grid: NDArray[np.float64],
     reference: _PerCycle,
     timeout: Timeout,
@@ -259,7 +271,6 @@ def _judge_cycles(
 ) -> Callable[[NDArray[np.float64], NDArray[np.float64]], ToleranceReport]:
     """Return the verdict on the first K cycles of `grid`, given the K states read so far."""
     ref_p, ref_v, _ = reference
-    tolerances = segment_tolerances(controller)
     velocities = velocity_error_computable(controller)
 
     def verdict_of(actual_p: NDArray[np.float64], actual_v: NDArray[np.float64]) -> ToleranceReport:
@@ -341,9 +352,7 @@ def _time_grid(horizon_s: float, dt: float) -> NDArray[np.float64]:
     return np.asarray(np.arange(math.floor(horizon_s / dt) + 3) * dt, dtype=np.float64)
 
 
-def _timeout(
-    duration_s: float, controller: ControllerConfig, execution: ExecutionConfig
-) -> Timeout:
+def _timeout(duration_s: float, goal_time_s: float, execution: ExecutionConfig) -> Timeout:
     """Return when to give up: at MoveIt's duration monitor, else at the simulation's hard stop."""
     expected = expected_duration_s(duration_s, execution)
     if execution.execution_duration_monitoring:
@@ -352,11 +361,11 @@ def _timeout(
             f"the trajectory execution was {expected:.6f} seconds). Stopping trajectory."
         ))
     hard_stop = max(expected, duration_s + WAIT_LIMIT_S)
-    waits = "forever" if controller.goal_time_s == 0.0 else f"{controller.goal_time_s:g} s"
+    waits = "forever" if goal_time_s == 0.0 else f"{goal_time_s:g} s"
     return Timeout(hard_stop, (
         f"simulation stopped at {hard_stop:.6f} s without a result: the controller was still "
-        f"waiting for the goal tolerance (constraints.goal_time {controller.goal_time_s:g}: it "
-        f"waits {waits}) and MoveIt's execution_duration_monitoring is off"
+        f"waiting for the goal tolerance (goal time {goal_time_s:g}: it waits {waits}) and MoveIt's "
+        "execution_duration_monitoring is off"
     ))
 
 

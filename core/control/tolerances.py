@@ -7,6 +7,7 @@ and a tolerance of 0 that is not checked. `judging` applies them to time series.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -17,12 +18,14 @@ from numpy.typing import NDArray
 from ..config import ControllerConfig
 from ..errors import InputError, UnknownName
 from ..trajectory import shortest_angular_distance
-from ..types import JointTrajectory
+from ..types import GoalTolerances, JointTolerance, JointTrajectory
 
 __all__ = [
+    "ERASE",
     "SegmentTolerances",
     "StateTolerance",
     "check_state_tolerance_per_joint",
+    "goal_segment_tolerances",
     "in_controller_order",
     "position_error",
     "segment_tolerances",
@@ -30,6 +33,8 @@ __all__ = [
     "unchecked_joints",
     "velocity_error_computable",
 ]
+
+_log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -148,3 +153,57 @@ def unchecked_joints(controller: ControllerConfig) -> dict[str, tuple[str, ...]]
         "path": tuple(j for j in controller.joints if not controller.trajectory_tolerance.get(j, 0.0) > 0.0),
         "goal": tuple(j for j in controller.joints if not controller.goal_tolerance.get(j, 0.0) > 0.0),
     }
+
+
+ERASE = -1.0
+"""A goal's tolerance of -1 erases the controller's: nothing is checked (control_msgs/JointTolerance)."""
+
+_FLT_EPSILON = float(np.finfo(np.float32).eps)
+
+
+def goal_segment_tolerances(defaults: SegmentTolerances, goal: GoalTolerances | None) -> SegmentTolerances:
+    """Return the tolerances of one goal: the controller's, replaced by those the goal carries.
+
+    As JTC's get_segment_tolerances (tolerances.hpp; test_tolerances.cpp): a value > 0 replaces
+    the default, 0 keeps it, -1 erases it (0: not checked); any other negative value, or a joint
+    the controller does not drive, makes the whole goal use the defaults, with a warning, as JTC
+    logs an error and goes on. Accelerations are kept but not checked: JTC computes no
+    acceleration error for a position or velocity command.
+    """
+    if goal is None:
+        return defaults
+    try:
+        goal_time = _resolved(defaults.goal_time_s, goal.goal_time_s, "goal_time_tolerance")
+        state = _joint_tolerances(defaults.state, goal.path, defaults.joint_names, "path_tolerance")
+        final = _joint_tolerances(defaults.goal, goal.goal, defaults.joint_names, "goal_tolerance")
+    except ValueError as exc:
+        _log.warning("%s; the controller's tolerances apply to this goal, as JTC applies them", exc)
+        return defaults
+    return SegmentTolerances(defaults.joint_names, state, final, goal_time)
+
+
+def _joint_tolerances(defaults: tuple[StateTolerance, ...], given: Sequence[JointTolerance],
+                      joints: tuple[str, ...], field_name: str) -> tuple[StateTolerance, ...]:
+    active = list(defaults)
+    for tolerance in given:
+        if tolerance.name not in joints:
+            raise ValueError(f"joint '{tolerance.name}' specified in goal.{field_name} does not exist")
+        i = joints.index(tolerance.name)
+        where = f"joint '{tolerance.name}' specified in goal.{field_name}"
+        active[i] = StateTolerance(
+            _resolved(defaults[i].position, tolerance.position, f"{where} position"),
+            _resolved(defaults[i].velocity, tolerance.velocity, f"{where} velocity"),
+            _resolved(defaults[i].acceleration, tolerance.acceleration, f"{where} acceleration"),
+        )
+    return tuple(active)
+
+
+def _resolved(default: float, given: float, what: str) -> float:
+    """Return a tolerance a goal gives: > 0 it, -1 erased (0), 0 the default; ValueError for another negative."""
+    if given > 0.0:
+        return given
+    if abs(given - ERASE) < _FLT_EPSILON:
+        return 0.0
+    if given < 0.0 or not np.isfinite(given):
+        raise ValueError(f"{what} is invalid ({given:g}; > 0, 0 for the controller's or -1 to erase it)")
+    return default

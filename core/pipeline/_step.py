@@ -124,6 +124,7 @@ def plan_step(
         fraction=fraction,
         residual=residual,
         stats=stats,
+        tolerances=spec.tolerances,
     )
 
 

@@ -251,7 +251,8 @@ def _simulated_steps(
         try:
             report = simulate(step.trajectory, controller, execution, plant, continuous_joints=continuous,
                               start_positions=start, disturbances=bumps, seed=request.seed,
-                              fill_point_before=fills_point_before(request.ros2_controllers))
+                              fill_point_before=fills_point_before(request.ros2_controllers),
+                              goal_tolerances=step.tolerances)
         except InputError as exc:
             raise InputError(f"{request.plan}: step '{step.name}': {exc}") from None
         ok = report.ok

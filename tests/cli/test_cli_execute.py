@@ -215,3 +215,37 @@ def test_a_controller_that_checks_nothing_says_so_and_each_step_has_its_verdict(
     text = cli(*args).stdout
     assert "not checked (nothing is checked): path of every joint; goal of every joint: its tolerance is 0" in text
     assert "up: result SUCCESSFUL" in text
+
+
+def test_tolerances_a_task_step_sends_with_its_goal_are_honoured_by_execute_and_check(
+        cli: Cli, tmp_path: Path) -> None:
+    """A step's `tolerances` (control_msgs/FollowJointTrajectory's fields) replace the controller's for that goal."""
+    task = tmp_path / "task.yaml"
+    task.write_text(
+        "robot: ur10e\nstart: {named: home}\n"
+        "steps:\n"
+        "  - name: tight\n"
+        "    joints: [0.6, -1.3, -1.6, 0.0, 1.3, 0.0]\n"
+        "    tolerances:\n"
+        "      goal_tolerance: [{name: shoulder_pan_joint, position: 1.0e-6}]\n"
+        "      goal_time_tolerance: 1.0e-3\n"
+        "  - {name: loose, joints: [0.3, -1.4, -1.5, 0.0, 1.2, 0.0]}\n")
+    plan = tmp_path / "plan.mcap"
+    assert cli("plan", task, "--seed", 0, "-o", plan).exit_code == 0
+    from rosbags.highlevel import AnyReader  # the tolerances travel in the plan's metadata
+
+    with AnyReader([plan]):
+        pass
+    lag = ("--plant", "lag", "--plant-param", "tau=0.05")
+    code, document = cli.json("execute", plan, "--fake", *lag, "-o", tmp_path / "run.mcap")
+    assert code == 5 and document["result"]["name"] == "GOAL_TOLERANCE_VIOLATED", document
+    assert [s["ok"] for s in document["steps"]] == [False]  # the first failing step ends the execution
+    assert {v["step"] for v in document["violations"]} == {"tight"}
+    code, checked = cli.json("check-tolerances", plan, tmp_path / "run.mcap", "--start", "0")
+    assert code == 5 and checked["result"]["name"] == "GOAL_TOLERANCE_VIOLATED", checked
+    # Erased (-1), the goal tolerance of that joint is not checked: the same run passes.
+    task.write_text(task.read_text().replace("position: 1.0e-6", "position: -1").replace(
+        "goal_time_tolerance: 1.0e-3", "goal_time_tolerance: 0"))
+    assert cli("plan", task, "--seed", 0, "-o", plan).exit_code == 0
+    code, document = cli.json("execute", plan, "--fake", *lag)
+    assert code == 0, document

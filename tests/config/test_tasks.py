@@ -77,10 +77,25 @@ def test_task_without_start_starts_at_the_initial_positions(tmp_path: Path) -> N
     ("{shift: {frame: base}}", "give at least one of x, y, z, roll, pitch, yaw"),
     ("{shift: {up: 1}}", "unknown key 'up'"),
     ("{joints: 3}", "expected a list of values or a mapping"),
+    ("{named: home, tolerances: {goal_tolerance: {elbow_joint: 0.1}}}",
+     r"steps\[0\].tolerances.goal_tolerance: expected a list of \{name, position, velocity, acceleration\}"),
+    ("{named: home, tolerances: {goal_tolerance: [{name: elbow_joint, position: .nan}]}}",
+     r"steps\[0\].tolerances.goal_tolerance\[0\].position"),
+    ("{named: home, tolerances: {goal_time: 1}}", r"steps\[0\].tolerances: unknown key 'goal_time'"),
 ])
 def test_malformed_goal_is_a_config_error_naming_the_step(tmp_path: Path, step: str, message: str) -> None:
     with pytest.raises(ConfigError, match=message):
         load_task(write_task(tmp_path, f"robot: r\nsteps:\n  - {step}\n"))
+
+
+def test_a_steps_goal_tolerances_are_read_as_a_follow_joint_trajectory_goal_gives_them(tmp_path: Path) -> None:
+    task = load_task(write_task(tmp_path, "robot: r\nsteps:\n  - named: home\n    tolerances:\n"
+                                          "      path_tolerance: [{name: elbow_joint, position: 0.05, velocity: -1}]\n"
+                                          "      goal_time_tolerance: 0.5\n"))
+    tolerances = task.steps[0].tolerances
+    assert tolerances is not None and tolerances.goal_time_s == 0.5 and tolerances.goal == ()
+    assert (tolerances.path[0].name, tolerances.path[0].position, tolerances.path[0].velocity) == \
+        ("elbow_joint", 0.05, -1.0)
 
 
 def test_task_robot_by_bare_name_plans_with_the_shipped_config(tmp_path: Path) -> None:

@@ -205,3 +205,60 @@ def test_series_ending_without_verdict_times_out_at_its_last_cycle():
     assert report.result.code == TIMED_OUT
     assert report.result.message.startswith("recording ended")
     assert report.end_index == 2
+
+
+# --- tolerances a FollowJointTrajectory goal carries (test_tolerances.cpp) ------------------------
+
+THREE = ("joint1", "joint2", "joint3")
+
+
+def _defaults():
+    # test_tolerances.cpp's fixture: goal 0.1, trajectory 0.1, stopped_velocity 0.1, goal_time 0.1.
+    config = controller(joints=THREE, goal_time_s=0.1, stopped_velocity_tolerance=0.1,
+                        trajectory_tolerance=dict.fromkeys(THREE, 0.1), goal_tolerance=dict.fromkeys(THREE, 0.1))
+    return segment_tolerances(config)
+
+
+def test_get_segment_tolerances_from_goal_maps_them_by_joint_name():
+    """test_tolerances.cpp test_get_segment_tolerances_from_goal: path (0.2, 0.3, 0.4) for every joint, goal
+    tolerances in jumbled order, goal_time 2.0."""
+    from moveplan.core.control.tolerances import goal_segment_tolerances
+    from moveplan.core.types import GoalTolerances, JointTolerance
+
+    goal = GoalTolerances(
+        path=tuple(JointTolerance(j, 0.2, 0.3, 0.4) for j in THREE),
+        goal=(JointTolerance("joint2", 1.2, 2.2, 3.2), JointTolerance("joint3", 1.3, 2.3, 3.3),
+              JointTolerance("joint1", 1.1, 2.1, 3.1)),
+        goal_time_s=2.0)
+    active = goal_segment_tolerances(_defaults(), goal)
+    assert active.goal_time_s == 2.0
+    assert active.state == (StateTolerance(0.2, 0.3, 0.4),) * 3
+    assert active.goal == (StateTolerance(1.1, 2.1, 3.1), StateTolerance(1.2, 2.2, 3.2), StateTolerance(1.3, 2.3, 3.3))
+    assert goal_segment_tolerances(_defaults(), None) == _defaults()  # the next goal without: the defaults
+
+
+def test_deactivate_tolerances_with_minus_one_erases_them():
+    """test_tolerances.cpp test_deactivate_tolerances: -1 everywhere leaves nothing checked, goal_time 0."""
+    from moveplan.core.control.tolerances import goal_segment_tolerances
+    from moveplan.core.types import GoalTolerances, JointTolerance
+
+    erase = tuple(JointTolerance(j, -1.0, -1.0, -1.0) for j in THREE)
+    active = goal_segment_tolerances(_defaults(), GoalTolerances(erase, erase, -1.0))
+    assert active.goal_time_s == 0.0
+    assert active.state == active.goal == (StateTolerance(0.0, 0.0, 0.0),) * 3
+
+
+@pytest.mark.parametrize("goal", ["invalid", "unknown_path_joint", "unknown_goal_joint"])
+def test_invalid_tolerances_or_joints_fall_back_to_the_controllers(goal, caplog):
+    """test_tolerances.cpp test_invalid_tolerances, test_invalid_joints_path_tolerance,
+    test_invalid_joints_goal_tolerance: the whole default set applies."""
+    from moveplan.core.control.tolerances import goal_segment_tolerances
+    from moveplan.core.types import GoalTolerances, JointTolerance
+
+    goals = {
+        "invalid": GoalTolerances(tuple(JointTolerance(j, -123.0) for j in THREE), (), 2.0),
+        "unknown_path_joint": GoalTolerances((JointTolerance("joint123", 0.2),), (), 2.0),
+        "unknown_goal_joint": GoalTolerances((), (JointTolerance("joint123", 0.2),), 2.0),
+    }
+    assert goal_segment_tolerances(_defaults(), goals[goal]) == _defaults()
+    assert "the controller's tolerances apply to this goal" in caplog.text

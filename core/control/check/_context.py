@@ -3,12 +3,18 @@
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 from ...config import ControllerConfig, ExecutionConfig
 from ...types import JointTrajectory
-from ..tolerances import SegmentTolerances, in_controller_order, segment_tolerances, velocity_error_computable
+from ..tolerances import (
+    SegmentTolerances,
+    goal_segment_tolerances,
+    in_controller_order,
+    segment_tolerances,
+    velocity_error_computable,
+)
 from ._alignment import ZONE_RAD, StepProfile
 from .samples import Samples, SampleSource
 
@@ -63,6 +69,11 @@ class CheckContext:
     execution: ExecutionConfig
     tolerances: SegmentTolerances
     warnings: tuple[str, ...]
+    goal_tolerances: dict[str, SegmentTolerances] = field(default_factory=dict)
+
+    def tolerances_of(self, step: str) -> SegmentTolerances:
+        """Return the tolerances of a step's goal: the controller's, or those its goal carries."""
+        return self.goal_tolerances.get(step, self.tolerances)
 
     @staticmethod
     def build(
@@ -92,8 +103,11 @@ class CheckContext:
         if not samples.has_velocities and computable:
             warnings.append("the recording carries no velocities: the stopped velocity "
                             "tolerance is not checked")
+        defaults = segment_tolerances(controller)
+        goals = {step.name: goal_segment_tolerances(defaults, getattr(step, "tolerances", None))
+                 for step in plan.steps}
         return CheckContext(samples, profiles, computable and samples.has_velocities, controller,
-                            execution, segment_tolerances(controller), tuple(warnings))
+                            execution, defaults, tuple(warnings), goals)
 
     def before_recording(self, start: float) -> bool:
         """Return True if a goal started at `start` [s] was sent before the recording's first sample.

@@ -18,6 +18,7 @@ from .._judging import judge_spans
 from .._moveit_checks import Timeout, check_start_state, expected_duration_s
 from ..controller import WAIT_LIMIT_S
 from ..results import INCOMPLETE, TIMED_OUT, ExecutionResult, ToleranceReport
+from ..tolerances import SegmentTolerances
 from ._alignment import StepProfile
 from ._context import CheckContext
 
@@ -102,7 +103,7 @@ def _open(
             ExecutionResult(TIMED_OUT, "TIMED_OUT", message)
         return ToleranceReport(result, (), {}, 0), 0.0
     last_s = samples.time(end - 1) - start
-    timeout = _timeout(context, trajectory.duration_s, last_s, end_reason)
+    timeout = _timeout(context, trajectory.duration_s, last_s, end_reason, context.tolerances_of(profile.name))
     # The recording ends before MoveIt would give up: its end cannot be a real timeout.
     runs_out = cut and last_s <= timeout.time_s
     return _Window(start, first, end, at_send, current, timeout, runs_out)
@@ -161,7 +162,7 @@ def _judge_stacked(
     else:
         reference, reference_v, _ = sample(trajectory, since, derivatives=derivatives)
     reports = judge_spans(
-        context.tolerances, since, reference, samples.spans(begins, ends),
+        context.tolerances_of(profile.name), since, reference, samples.spans(begins, ends),
         # As the simulation: JTC takes the segment from the command's time, one period on.
         before_last_point=since + 1.0 / context.controller.update_rate_hz < duration,
         last_point_s=duration,
@@ -191,7 +192,8 @@ def _velocities(
     return context.samples.velocity_spans(begins, ends)
 
 
-def _timeout(context: CheckContext, duration: float, last_s: float, end_reason: str) -> Timeout:
+def _timeout(context: CheckContext, duration: float, last_s: float, end_reason: str,
+             tolerances: SegmentTolerances) -> Timeout:
     """Return when MoveIt gives up, with the message for a recording that ends undecided.
 
     Without MoveIt's duration monitor, a controller with goal_time 0 never gives up: the
@@ -209,7 +211,7 @@ def _timeout(context: CheckContext, duration: float, last_s: float, end_reason: 
                  f"is off (checked up to {WAIT_LIMIT_S:g} s after the last point, as execute does)")
     if last_s > limit:
         return Timeout(limit, stops)
-    goal_time = context.controller.goal_time_s
+    goal_time = tolerances.goal_time_s
     waits = "forever" if goal_time == 0.0 else f"{goal_time:g} s after the last point"
     return Timeout(limit, (
         f"the {end_reason} ends {last_s:.3f} s after the step's start, before the controller "
