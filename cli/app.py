@@ -180,7 +180,8 @@ def execute(
     plan_file: Annotated[Path, typer.Argument(metavar="PLAN", help="Plan file written by moveplan plan.")],
     fake: Annotated[bool, typer.Option("--fake", help="Replay through a simulated controller (required).")] = False,
     output: Annotated[Path | None, typer.Option("--output", "-o", help="Write what happened to this .mcap.")] = None,
-    plant: Annotated[str, typer.Option(help="Hardware model: mirror, lag or pid.")] = "mirror",
+    plant: Annotated[str | None, typer.Option(help=(
+        "Hardware model: mirror, lag or pid (default: the robot config's plant, else mirror)."))] = None,
     plant_param: Annotated[list[str] | None, typer.Option(help="Plant parameter k=v, e.g. tau=0.05.")] = None,
     disturb: Annotated[list[str] | None, typer.Option(help="Fault: 't=1.2,joint=elbow_joint,delta=0.05'.")] = None,
     start_joints: Annotated[str | None, typer.Option(help="Robot away from the plan start: 'joint=value'.")] = None,

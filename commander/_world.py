@@ -215,7 +215,8 @@ class World:
         while name in names:
             k += 1
             name = f"{step.name}_{k}"
-        self.executed.append(Executed(group, replace(step, name=name), summary, self.execution.plant))
+        plant = self.execution.plant or (self.config.plant.model if self.config.plant else "mirror")
+        self.executed.append(Executed(group, replace(step, name=name), summary, plant))
 
     def save(self, path: Path, distro: str) -> None:
         """Write every executed motion, in order, as one plan file at `path`.

@@ -128,7 +128,7 @@ class RobotCommander:
         strict_limits: bool = False,
         launch: str | None = None,
         launch_args: Mapping[str, str] | None = None,
-        plant: str = "mirror",
+        plant: str | None = None,
         plant_params: Mapping[str, float] | None = None,
         controllers: str | Path | None = None,
         seed: int = 0,

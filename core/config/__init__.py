@@ -55,6 +55,7 @@ if TYPE_CHECKING:
         allowed_collisions,
         parse_planning_scene,
     )
+    from .plant import PLANT_MODELS, PlantSettings
     from .poses import pose_matrix
     from .robot_config import RobotConfig, load_robot_config
     from .scene_text import parse_scene_text
@@ -75,6 +76,7 @@ __all__ = [
     "PILZ_PLANNERS",
     "PLANNERS",
     "PLANNING_SCENE_KEYS",
+    "PLANT_MODELS",
     "SHIFT_AXES",
     "AllowedCollisions",
     "ArcPoint",
@@ -96,6 +98,7 @@ __all__ = [
     "PackagePath",
     "PathConstraints",
     "PlanningSceneFile",
+    "PlantSettings",
     "PoseGoal",
     "PositionBound",
     "PositionGoal",
@@ -159,6 +162,7 @@ __getattr__ = lazy_exports(__name__, {
     "PILZ_PLANNERS": "planners",
     "PLANNERS": "planners",
     "PLANNING_SCENE_KEYS": "planning_scene_yaml",
+    "PLANT_MODELS": "plant",
     "SHIFT_AXES": "goals",
     "AllowedCollisions": "planning_scene_yaml",
     "ArcPoint": "constraints",
@@ -180,6 +184,7 @@ __getattr__ = lazy_exports(__name__, {
     "PackagePath": "xacro",
     "PathConstraints": "constraints",
     "PlanningSceneFile": "planning_scene_yaml",
+    "PlantSettings": "plant",
     "PoseGoal": "goals",
     "PositionBound": "constraints",
     "PositionGoal": "moveit_request",

@@ -31,6 +31,7 @@ from .fields import load_yaml, read_input
 from .launch_files import LaunchFiles, RobotFile, read_launch
 from .limits import DEFAULT_SOURCE, JointLimit, is_moveit_joint_limits, merge_limits, parse_joint_limits
 from .motion import Resolved
+from .plant import PlantSettings, parse_plant
 from .sources import (
     CONFIG_FILE,
     discover,
@@ -83,6 +84,7 @@ class RobotConfig:
         xacro_args: The xacro args the URDF and SRDF were expanded with.
         initial_sources: Joint -> where its initial position comes from (initial_state.py).
         srdf_text: The SRDF as read (xacro expanded): what MoveIt holds as robot_description_semantic.
+        plant: moveplan.yaml's `plant`, the simulated hardware (core/config/plant.py); None: mirror.
     """
 
     name: str
@@ -106,6 +108,7 @@ class RobotConfig:
     xacro_args: dict[str, str] = field(default_factory=dict)
     initial_sources: dict[str, str] = field(default_factory=dict)
     srdf_text: str = ""
+    plant: PlantSettings | None = None
 
     def group(self, name: str | None = None) -> Group:
         """Return the named planning group, or the config's default one."""
@@ -228,6 +231,7 @@ def load_robot_config(
         found.manifest, found.top, paths.get("ompl_planning"), model.srdf, paths["srdf"]
     )
     name = str(found.top.get("name") or model.srdf.name)
+    plant = parse_plant(found.top.get("plant"), f"{found.manifest}: plant")
     texts = {"urdf": model.urdf_text, "srdf": model.srdf_text}
     # A plan carries controller files with their launch substitutions made: execute reads them without args.
     texts.update({key: read_substituted(paths[key], model.xacro_args) for key in ("controllers", "moveit_controllers")
@@ -246,7 +250,8 @@ def load_robot_config(
         execution=execution,
         initial_positions=initial.positions,
         planning=planning,
-        files=embedded_files(found.manifest, found.top, found.root, paths, texts, name, planning),
+        files=embedded_files(found.manifest, found.top, found.root, paths, texts, name, planning,
+                             plant.as_dict() if plant else None),
         package_paths=found.packages.folders,
         sources=_sources(found, planning_source),
         urdf_includes=model.urdf_includes,
@@ -254,6 +259,7 @@ def load_robot_config(
         xacro_args=model.xacro_args,
         initial_sources=initial.sources,
         srdf_text=model.srdf_text,
+        plant=plant,
     )
     config.group()  # an unknown default group is a config error, found at load time
     return config

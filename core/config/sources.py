@@ -51,7 +51,7 @@ logger = logging.getLogger(__name__)
 
 CONFIG_FILE = "moveplan.yaml"
 FILE_KEYS = ("urdf", "srdf", "joint_limits", "kinematics", "controllers", "moveit_controllers", "initial_positions")
-_MOVEPLAN_KEYS = {*FILE_KEYS, "name", "planning", "package_paths", "xacro_args"}
+_MOVEPLAN_KEYS = {*FILE_KEYS, "name", "planning", "package_paths", "xacro_args", "plant"}
 # A folder without moveplan.yaml: a MoveIt config package keeps these in config/, a plain folder
 # beside the URDF; config/ is searched first.
 _PACKAGE_FILES = {

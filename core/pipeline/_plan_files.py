@@ -11,6 +11,7 @@ import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .. import bag as recording
 from ..config import (
@@ -23,9 +24,15 @@ from ..config import (
     parse_controllers,
 )
 from ..control import validate_goal, validate_goal_end
-from ..errors import ConfigError, InputError
+from ..errors import ConfigError, InputError, UsageError
 
-__all__ = ["MAX_PLAN_S", "pick_controller", "plan_config", "plan_controller", "read_valid_plan"]
+if TYPE_CHECKING:
+    from ..control import Plant
+
+__all__ = [
+    "MAX_PLAN_S", "configured_plant", "pick_controller", "plan_config", "plan_controller", "plant_settings",
+    "read_valid_plan",
+]
 
 MAX_PLAN_S = 86_400.0
 """The longest plan read, in [s] from its first step's start to its last step's end: a day."""
@@ -156,3 +163,35 @@ def _plan_controller(
         return default_controller(joints)
     return pick_controller(config.controllers, joints, f"{path}: embedded {config.sources['controllers'].name}",
                            config.execution.default_controllers)
+
+
+def plant_settings(config: RobotConfig, model: str | None,
+                   params: Mapping[str, float] | None) -> tuple[str, dict[str, float]]:
+    """Return the plant to execute on and its parameters: the flags', over the robot config's plant.
+
+    The config's parameters apply when its model is the one used; --plant-param overrides them.
+    """
+    configured = config.plant
+    chosen = model or (configured.model if configured is not None else "mirror")
+    base = dict(configured.params) if configured is not None and configured.model == chosen else {}
+    return chosen, {**base, **dict(params or {})}
+
+
+def configured_plant(config: RobotConfig, model: str | None, params: Mapping[str, float] | None,
+                     controller: ControllerConfig, continuous: Sequence[str]) -> Plant:
+    """Return the plant to execute on (plant_settings), built for `controller`.
+
+    Raises:
+        ConfigError: The robot config's plant has a parameter its model does not take, or a bad value.
+        UsageError: Likewise for the flags' (--plant, --plant-param).
+    """
+    from ..control import make_plant  # here: check-tolerances reads plan files and simulates nothing
+
+    chosen, values = plant_settings(config, model, params)
+    try:
+        return make_plant(chosen, values, controller, continuous)
+    except UsageError as exc:
+        given = params or {}
+        if config.plant is None or config.plant.model != chosen or all(k in given for k in config.plant.params):
+            raise
+        raise ConfigError(f"{config.name}: moveplan.yaml: plant: {exc}") from None

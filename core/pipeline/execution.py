@@ -40,7 +40,7 @@ from ..control import (
 )
 from ..errors import InputError, UnknownName
 from ..types import TfSamples, TimeSource
-from ._plan_files import plan_config, plan_controller, read_valid_plan
+from ._plan_files import configured_plant, plan_config, plan_controller, read_valid_plan
 
 if TYPE_CHECKING:
     from ..control import Disturbance, ExecutionReport, Plant
@@ -60,7 +60,8 @@ class ExecuteRequest:
     """What `moveplan execute --fake` was asked to do."""
 
     plan: Path
-    plant: str = "mirror"
+    plant: str | None = None
+    """--plant; None: the robot config's plant (moveplan.yaml `plant`), else mirror."""
     plant_params: Mapping[str, float] | None = None
     disturbances: Sequence[Disturbance] = ()
     start_joints: JointGoal | None = None
@@ -185,7 +186,6 @@ def execute(
 
     """
     # Imported here: check-tolerances shares this module and simulates nothing.
-    from ..control import make_plant
 
     plan = read_valid_plan(request.plan)
     config = plan_config(plan, request.plan)
@@ -194,7 +194,7 @@ def execute(
     controller = plan_controller(config, plan, request.plan, request.controllers, not request.controllers_as_data,
                                  request.strict)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
-    plant = make_plant(request.plant, dict(request.plant_params or {}), controller, continuous)
+    plant = configured_plant(config, request.plant, request.plant_params, controller, continuous)
     reports = _simulated_steps(request, plan, controller, config.execution, plant, continuous)
     robot = None
     if record is not None and link_poses:

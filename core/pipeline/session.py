@@ -30,13 +30,13 @@ from ..config import (
     first_repeated,
     parse_controllers,
 )
-from ..control import ExecutionReport, make_plant, simulate, validate_goal, validate_goal_end
+from ..control import ExecutionReport, simulate, validate_goal, validate_goal_end
 from ..errors import ConfigError, NoPlan, StartInCollision, StartOutsideLimits
 from ..model import Robot, Scene, resolve_frames
 from ..planning import check_limits, seed_planner
 from ..types import CollisionObject, Frame, JointTrajectory, Plan, StepResult
 from ._checks import Problem, build_problem, filter_threshold
-from ._plan_files import pick_controller
+from ._plan_files import configured_plant, pick_controller
 from ._step import plan_step
 from .plan import assemble
 from .request import PlanRequest
@@ -54,13 +54,13 @@ class ExecutionSettings:
     """The simulated hardware and controller a motion is executed on: `execute --fake`'s options.
 
     Attributes:
-        plant: mirror, lag or pid.
-        plant_params: Its parameters (`--plant-param k=v`).
+        plant: mirror, lag or pid; None: the robot config's plant, else mirror.
+        plant_params: Its parameters (`--plant-param k=v`), over the config's.
         controllers: A ros2_controllers.yaml replacing the robot config's (`--controllers`).
         seed: Seeds the plant's measurement noise.
     """
 
-    plant: str = "mirror"
+    plant: str | None = None
     plant_params: Mapping[str, float] = field(default_factory=dict)
     controllers: Path | None = None
     seed: int = 0
@@ -213,7 +213,7 @@ def execute_motion(
     controller = _controller(config, trajectory.joint_names, settings.controllers)
     validate_goal_end(trajectory, controller.allow_nonzero_velocity_at_trajectory_end, where)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
-    plant = make_plant(settings.plant, dict(settings.plant_params), controller, continuous)
+    plant = configured_plant(config, settings.plant, settings.plant_params, controller, continuous)
     positions = np.array([start[j] for j in controller.joints if j in start])
     return simulate(trajectory, controller, config.execution, plant, continuous_joints=continuous,
                     start_positions=positions, seed=settings.seed)
@@ -227,7 +227,7 @@ def check_execution(config: RobotConfig, joints: Sequence[str], settings: Execut
         UsageError: An unknown plant or plant parameter.
     """
     controller = _controller(config, joints, settings.controllers)
-    make_plant(settings.plant, dict(settings.plant_params), controller,
+    configured_plant(config, settings.plant, settings.plant_params, controller,
                [j for j, lim in config.limits.items() if lim.continuous])
 
 

@@ -33,7 +33,7 @@ from ..control import (
     tune_joint,
 )
 from ..errors import ConfigError, InputError, UsageError, known
-from ._plan_files import plan_config, plan_controller, read_valid_plan
+from ._plan_files import plan_config, plan_controller, plant_settings, read_valid_plan
 from .execution import (
     CheckedRecording,
     CheckRequest,
@@ -125,7 +125,7 @@ def tune(request: TuneRequest, draw: Callable[[TuneResult, Path], None] | None =
     except UsageError as exc:
         raise ConfigError(f"{source}: {exc}") from None
     joints = _joints(request.joints, controller)
-    params = dict(request.plant_params or {})
+    params = plant_settings(config, "pid", request.plant_params)[1]  # the config's pid plant, if it has one
     values = pid_parameters(params, controller.joints)
     fit = None
     if request.recording is not None:

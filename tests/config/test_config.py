@@ -288,3 +288,41 @@ def test_plan_on_the_panda_reaches_a_named_state_around_its_meshes(cli: Cli, tmp
     assert code == 0, document
     assert document["group"] == "panda_arm" and document["steps"][0]["duration_s"] > 0
     assert "panda.urdf" in recording.read_plan(out).attachments
+
+
+# --- the simulated hardware a config carries (moveplan.yaml `plant`) ----------------------------
+
+def _excavator(tmp_path: Path, plant: str) -> Path:
+    folder = tmp_path / "excavator"
+    shutil.copytree(ROOT / "configs" / "excavator", folder)
+    manifest = folder / "moveplan.yaml"
+    text = "\n".join(line for line in manifest.read_text().splitlines() if not line.startswith("plant:"))
+    manifest.write_text(f"{text}\n{plant}\n")
+    return folder
+
+
+def test_a_configs_plant_is_read_and_embedded_with_the_plan(tmp_path: Path) -> None:
+    config = load_robot_config(ROOT / "configs" / "excavator")
+    assert config.plant is not None and config.plant.model == "pid"
+    assert config.plant.params == {"drive_tau": 0.06, "load": 0.03, "noise": 0.0002}
+    assert b"plant:" in config.files["moveplan.yaml"]
+
+
+@pytest.mark.parametrize(("plant", "message"), [
+    ("plant: {model: hydraulic}", r"plant.model: unknown plant 'hydraulic'; known: lag, mirror, pid"),
+    ("plant: {model: pid, drive_tau: fast}", r"plant.drive_tau: expected a finite number"),
+    ("plant: [pid]", r"plant: expected a mapping"),
+])
+def test_a_malformed_plant_is_a_config_error_naming_the_key(tmp_path: Path, plant: str, message: str) -> None:
+    with pytest.raises(ConfigError, match=message):
+        load_robot_config(_excavator(tmp_path, plant))
+
+
+def test_a_plant_parameter_its_model_does_not_take_names_the_config(tmp_path: Path, cli: Cli) -> None:
+    folder = _excavator(tmp_path, "plant: {model: pid, drive_lag: 0.1}")
+    plan = tmp_path / "plan.mcap"
+    assert cli("plan", "--robot", folder, "--named", "ready", "-o", plan, "-q").exit_code == 0
+    result = cli("execute", plan, "--fake")
+    assert result.exit_code == 3 and result.stderr.count("\n") == 1, result.stderr
+    assert "moveplan.yaml: plant: plant 'pid' has no parameter 'drive_lag'" in result.stderr
+    assert cli("execute", plan, "--fake", "--plant", "mirror").exit_code == 0  # another model: its params only

@@ -233,9 +233,35 @@ def test_mistuned_gains_fail_the_same_plan_with_a_path_violation_naming_a_joint(
 
 
 def test_mistuned_gains_on_a_slower_drive_never_settle_and_fail_the_goal_tolerance(cli: Cli, dig_file: Path) -> None:
+    # The slow drive alone: the config's hydraulic lag and droop make the same gains fail sooner, on the path.
+    ideal = ["--plant-param", "drive_tau=0", "--plant-param", "load=0", "--plant-param", "noise=0"]
     code, document = cli.json("execute", dig_file, "--fake", "--plant", "pid", "--controllers", MISTUNED,
-                              *REALISTIC_DRIVE)
+                              *REALISTIC_DRIVE, *ideal)
     assert code == 5
     assert document["result"]["name"] == "GOAL_TOLERANCE_VIOLATED"
     goal = [v for v in document["violations"] if v["check"] == "goal"]
     assert goal and goal[0]["joint"] in JOINTS and abs(goal[0]["error"]) > goal[0]["tolerance"]
+
+
+def test_the_excavators_hydraulic_plant_shows_the_pid_effect_by_default(
+        cli: Cli, dig_file: Path, tmp_path: Path) -> None:
+    """configs/excavator's `plant`: with the shipped gains every motion tracks; with zero gains the droop and
+    the drive's lag take a joint out of its path tolerance; tune-pid from zero raises P, then D."""
+    import yaml
+
+    code, document = cli.json("execute", dig_file, "--fake")
+    assert code == 0, document["violations"]
+    controllers = yaml.safe_load((ROOT / "configs" / "excavator" / "ros2_controllers.yaml").read_text())
+    for gains in controllers["excavation_controller"]["ros__parameters"]["gains"].values():
+        gains.update(p=0.0, i=0.0, d=0.0)
+    zero = tmp_path / "zero.yaml"
+    zero.write_text(yaml.safe_dump(controllers))
+    code, document = cli.json("execute", dig_file, "--fake", "--controllers", zero)
+    assert code == 5 and document["result"]["name"] == "PATH_TOLERANCE_VIOLATED"
+    code, tuned = cli.json("tune-pid", dig_file, "--controllers", zero, "-o", tmp_path / "tuned.yaml")
+    assert code == 0 and tuned["verification"]["ok"] is True
+    assert tuned["plant"]["drive_tau"] == 0.06  # the config's plant
+    for joint in tuned["joints"].values():
+        stages = [s for s in joint["stages"] if s["stage"] in ("P", "D") and s["chosen"]]
+        assert [s["stage"] for s in stages] == ["P", "D"]
+        assert stages[0]["gains"]["p"] > 0 and stages[1]["gains"]["d"] > 0

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 
-from ...config import ControllerConfig
+from ...config import PLANT_MODELS, ControllerConfig
 from ...errors import UsageError, known
 from .base import Plant
 from .lag import LagPlant
@@ -13,7 +13,7 @@ from .pid import PidPlant, pid_gains, pid_interface, pid_parameters
 
 __all__ = ["PLANTS", "make_plant"]
 
-PLANTS = ("mirror", "lag", "pid")
+PLANTS = PLANT_MODELS
 """Plant names `make_plant` knows, the default first."""
 
 
