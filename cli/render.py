@@ -308,7 +308,8 @@ def _tracking(document: dict[str, Any]) -> None:
         return
     cycle = document.get("tracking_cycle")
     of_cycle = f" of cycle {cycle}" if cycle is not None else ""
-    title = f"tracking [rad], worst over the steps{of_cycle}; osc: error sign changes after the stop"
+    title = (f"tracking [rad], worst over the steps{of_cycle}; osc: error sign changes after the stop "
+             "(over the step, for a step aborted in motion)")
     rows = table(title, ("joint", "peak err", "overshoot", "settle [s]", "osc", "final err"))
     for joint, t in tracking.items():
         settling = "-" if t["settling_time_s"] is None else f"{t['settling_time_s']:.3f}"

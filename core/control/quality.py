@@ -48,7 +48,8 @@ class JointTracking:
         settling_time_s: Time [s] from the last point until |error| stays within the goal
             tolerance (the band where that tolerance is 0); None if it does not within what
             was observed.
-        oscillations: Sign changes of the error beyond +-band once the reference stopped.
+        oscillations: Sign changes of the error beyond +-band once the reference stopped; for a
+            step that ended before its last point (aborted in motion), over the whole step.
         final_error: reference - actual at the last observed sample.
         band: The hysteresis band used.
         observed_s: How long [s] after the last point the joint was observed.
@@ -146,7 +147,8 @@ def _joint(
     # Past the goal in the direction of motion (actual - goal = -error once the reference stopped),
     # beyond what measurement noise alone reaches.
     overshoot = max(0.0, float(np.max(-direction * post)) - noise) if len(post) and direction else 0.0
-    oscillations = len(crossings(post, band)) if len(post) else 0
+    # An execution aborted in motion never stops: an oscillation growing to the limit shows over the step.
+    oscillations = len(crossings(post if len(post) else error, band))
     return JointTracking(
         peak_error=peak,
         overshoot=overshoot,

@@ -214,3 +214,13 @@ def test_tracking_of_a_joint_that_never_settles_and_of_a_diverged_one() -> None:
     broken = np.where(times[:, None] > 0.3, np.nan, 0.0)
     figures = tracking(["j"], times, still, broken, 0.5, [0.1])["j"]
     assert figures.peak_error == 0.0 and np.isnan(figures.final_error) and not figures.ringing
+
+
+def test_a_step_aborted_in_motion_counts_its_oscillation_over_the_step(cli: Cli) -> None:
+    """The mistuned UR10e aborts on a path violation while its error oscillates to the limit: the report shows it."""
+    code, document = cli.json("execute", SAMPLES / "recordings" / "tool_up_plan.mcap", "--fake", "--plant", "pid",
+                              "--controllers", SAMPLES / "ur10e_mistuned_controllers.yaml")
+    assert code == 5 and document["result"]["name"] == "PATH_TOLERANCE_VIOLATED"
+    violation = document["violations"][0]["joint"]
+    assert document["tracking"][violation]["oscillations"] >= RINGING_OSCILLATIONS
+    assert violation in ringing(document)
