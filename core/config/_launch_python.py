@@ -83,6 +83,39 @@ class _Function:
 
 
 @dataclass(frozen=True)
+class _Class:
+    """A class a workspace module defines (xArm's own MoveItConfigsBuilder): its bases and members."""
+
+    name: str
+    bases: tuple[Any, ...]
+    members: dict[str, Any]
+
+
+@dataclass
+class _Instance:
+    """An object of a `_Class`, with the attributes its methods set."""
+
+    cls: _Class
+    attributes: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class _Bound:
+    """A method of an instance: `function` called with `instance` first."""
+
+    function: _Function
+    instance: _Instance
+
+
+@dataclass(frozen=True)
+class _Super:
+    """`super()` in a method of `cls` on `instance`."""
+
+    instance: _Instance
+    cls: _Class
+
+
+@dataclass(frozen=True)
 class _Method:
     """An attribute of a value, called later: `target.name(...)`."""
 
@@ -210,6 +243,8 @@ class _Interpreter:
             self.loop(node, scope)
         elif isinstance(node, ast.FunctionDef):
             scope[node.name] = _Function(node, scope, self)
+        elif isinstance(node, ast.ClassDef):
+            scope[node.name] = self.class_def(node, scope)
         elif isinstance(node, ast.Import):
             for alias in node.names:
                 name = alias.asname or alias.name.split(".")[0]
@@ -262,6 +297,10 @@ class _Interpreter:
             for element, item in zip(target.elts, values + [_UNKNOWN] * (len(target.elts) - len(values)),
                                      strict=False):
                 self.assign(element, item, scope)
+        elif isinstance(target, ast.Attribute):
+            owner = self.expr(target.value, scope)
+            if isinstance(owner, _Instance):
+                owner.attributes[target.attr] = value
         elif isinstance(target, ast.Subscript):
             container = self.expr(target.value, scope)
             key = self.expr(target.slice, scope)
@@ -284,6 +323,27 @@ class _Interpreter:
                 scope[name] = loaded.get(alias.name, _UNKNOWN)
             else:
                 scope[name] = _Module(f"{module}.{alias.name}")
+
+    def class_def(self, node: ast.ClassDef, scope: dict[str, Any]) -> _Class:
+        """Return a class: its bases and its body's names (methods see the enclosing scope, as Python's do)."""
+        body: dict[str, Any] = {}
+        self.block(node.body, body)
+        made = _Class(node.name, tuple(self.expr(base, scope) for base in node.bases), {})
+        owners: dict[int, _Class] = scope.setdefault("__class_of__", {})
+        for name, value in body.items():
+            if isinstance(value, _Function):
+                owners[id(value.node)] = made
+                value = _Function(value.node, scope, value.interpreter)
+            made.members[name] = value
+        return made
+
+    def instantiate(self, cls: _Class, args: list[Any], kwargs: dict[str, Any]) -> _Instance:
+        """Return a new object of `cls`, its __init__ run (a dataclass's fields left as the class gives them)."""
+        instance = _Instance(cls)
+        init = _lookup(cls, "__init__")
+        if isinstance(init, _Function):
+            init.interpreter._run(init, [instance, *args], kwargs)
+        return instance
 
     def _load_module(self, source: Path) -> dict[str, Any] | None:
         """Return the top-level names of a workspace Python module (its functions, constants), followed the same way."""
@@ -347,6 +407,10 @@ class _Interpreter:
                 key_value = self.expr(key, scope)
                 if _hashable(key_value):
                     result[key_value] = self.expr(value, scope)
+            if self.path != self.record.file and any(key in _ROBOT_PARAMETERS for key in result):
+                # A builder of a workspace package (xArm's uf_ros_lib) may hand these to a node through
+                # yaml.dump, which moveplan does not follow: what it builds counts.
+                self.record.loose.append(result)
             return result
         if isinstance(node, ast.ListComp | ast.GeneratorExp | ast.SetComp):
             return self._comprehension(node.generators, lambda s: self.expr(node.elt, s), scope)
@@ -359,6 +423,10 @@ class _Interpreter:
         if isinstance(node, ast.Subscript):
             return _subscript(self.expr(node.value, scope), self.expr(node.slice, scope))
         if isinstance(node, ast.Call):
+            if isinstance(node.func, ast.Name) and node.func.id == "super" and not node.args:
+                owner, instance = scope.get("__class__"), scope.get("__self__")
+                return _Super(instance, owner) if isinstance(owner, _Class) and isinstance(instance, _Instance) \
+                    else _UNKNOWN
             function = self.expr(node.func, scope)
             args: list[Any] = []
             for arg in node.args:
@@ -400,10 +468,16 @@ class _Interpreter:
         left = self.expr(node.left, scope)
         for op, right_node in zip(node.ops, node.comparators, strict=True):
             right = self.expr(right_node, scope)
-            if not _plain(left) or not _plain(right):
+            opaque = _opaque(left) or _opaque(right)
+            if opaque and isinstance(op, ast.Eq | ast.NotEq | ast.Is | ast.IsNot):
+                # A launch object is equal only to itself, as a Python object is (`config == False`).
+                same = left is right
+                result: Any = same if isinstance(op, ast.Eq | ast.Is) else not same
+            elif not _plain(left) or not _plain(right):
                 return _unknown(left, right)
-            compare = _COMPARE.get(type(op))
-            result = compare(left, right) if compare is not None else _UNKNOWN
+            else:
+                compare = _COMPARE.get(type(op))
+                result = compare(left, right) if compare is not None else _UNKNOWN
             if result is not True:
                 return result
             left = right
@@ -468,6 +542,15 @@ class _Interpreter:
 
     def attribute(self, value: Any, name: str) -> Any:
         """Return `value.name`: a module's member, a path's parent or name, or a method to call."""
+        if isinstance(value, _Instance):
+            if name in value.attributes:
+                return value.attributes[name]
+            member = _lookup(value.cls, name)
+            return _Bound(member, value) if isinstance(member, _Function) else member
+        if isinstance(value, _Class):
+            return _lookup(value, name)
+        if isinstance(value, _Super):
+            return _super_member(value, name)
         if isinstance(value, _Module):
             return _Module(f"{value.name}.{name}")
         if isinstance(value, str) and name in ("parent", "name", "stem", "suffix"):
@@ -489,6 +572,16 @@ class _Interpreter:
         """Return the value of a call: a defined function run, the launch API followed, else Unknown."""
         if isinstance(function, _Function):
             return function.interpreter._run(function, args, kwargs)
+        if isinstance(function, _Bound):
+            return function.function.interpreter._run(function.function, [function.instance, *args], kwargs)
+        if isinstance(function, _Class):
+            return self.instantiate(function, args, kwargs)
+        if isinstance(function, _Object) and function.kind == "package_builder_init":
+            instance, package = function.value, _arg(args, kwargs, 0, "package_name")
+            # launch_param_builder's ParameterBuilder: its package's share folder, for the relative files.
+            found = self.record.context.find_package(package) if isinstance(package, str) else None
+            instance.attributes["_package_path"] = found if found is not None else _UNKNOWN
+            return None
         if isinstance(function, _Method):
             return self._method(function.target, function.name, args, kwargs)
         if isinstance(function, _Module):
@@ -503,6 +596,10 @@ class _Interpreter:
             return _UNKNOWN  # a recursion this deep names no file; the caller goes on
         local = dict(function.scope) if function.scope is not self.scope else {}
         _bind(function.node.args, args, kwargs, local, lambda e: self.expr(e, function.scope))
+        owner = function.scope.get("__class_of__", {}).get(id(function.node)) if "__class_of__" in function.scope \
+            else None
+        if owner is not None and args and isinstance(args[0], _Instance):
+            local["__class__"], local["__self__"] = owner, args[0]
         self.budget.depth += 1
         try:
             if isinstance(function.node, ast.Lambda):
@@ -609,6 +706,30 @@ class _Interpreter:
         return made
 
 
+def _lookup(cls: _Class, name: str, depth: int = 0) -> Any:
+    """Return a class's member by name, searched in its bases (depth first, as single inheritance has it)."""
+    if name in cls.members:
+        return cls.members[name]
+    for base in cls.bases:
+        if isinstance(base, _Class) and depth < 20:
+            found = _lookup(base, name, depth + 1)
+            if not isinstance(found, Unknown):
+                return found
+    return _UNKNOWN
+
+
+def _super_member(view: _Super, name: str) -> Any:
+    """Return `super().name`: a base's method bound to the instance; ParameterBuilder's __init__ as launch has it."""
+    for base in view.cls.bases:
+        if isinstance(base, _Class):
+            found = _lookup(base, name)
+            if isinstance(found, _Function):
+                return _Bound(found, view.instance)
+        elif isinstance(base, _Module) and base.name.endswith("ParameterBuilder") and name == "__init__":
+            return _Object("package_builder_init", view.instance)
+    return _UNKNOWN
+
+
 def _builder_method(builder: Builder, name: str, args: list[Any], kwargs: dict[str, Any]) -> Any:
     """Record a builder method's file and mappings; return the builder (the chain goes on) or its configs."""
     if name in ("to_moveit_configs", "to_dict"):
@@ -660,6 +781,8 @@ def _str_method(target: str, name: str, args: list[Any], kwargs: dict[str, Any])
             return _UNKNOWN
     return _UNKNOWN
 
+
+_ROBOT_PARAMETERS = frozenset({"robot_description", "robot_description_semantic", "robot_description_planning"})
 
 _STR_METHODS = frozenset({"replace", "strip", "lstrip", "rstrip", "split", "lower", "upper", "startswith", "endswith",
                           "removesuffix", "removeprefix", "rsplit", "capitalize"})
@@ -862,7 +985,36 @@ _BUILTINS: dict[str, Callable[[_Interpreter, list[Any], dict[str, Any]], Any]] =
     "bool": lambda i, a, k: bool(a[0]) if a and _plain(a[0]) else _UNKNOWN,
     "int": lambda i, a, k: _number(int, a),
     "float": lambda i, a, k: _number(float, a),
+    "all": lambda i, a, k: _all_any(all, a),
+    "any": lambda i, a, k: _all_any(any, a),
+    "isinstance": lambda i, a, k: _isinstance(a),
 }
+
+
+def _all_any(function: Callable[[Any], bool], args: list[Any]) -> Any:
+    items = args[0] if args else None
+    if not isinstance(items, list | tuple) or not all(_plain(item) for item in items):
+        return _unknown(*(items if isinstance(items, list | tuple) else []))
+    return function(items)
+
+
+def _isinstance(args: list[Any]) -> Any:
+    """Return isinstance for plain values and the launch API's LaunchConfiguration; Unknown otherwise."""
+    if len(args) != 2:
+        return _UNKNOWN
+    value, kinds = args[0], args[1] if isinstance(args[1], tuple) else (args[1],)
+    if isinstance(value, Unknown):
+        return value
+    results = []
+    for kind in kinds:
+        if isinstance(kind, _Module) and kind.name.endswith("LaunchConfiguration"):
+            results.append(isinstance(value, Lazy) and value.kind == "arg")
+        elif callable(kind) and kind in _PYTHON_TYPES:
+            expected = _PYTHON_TYPES[kind]
+            results.append(isinstance(value, expected) and not (expected is int and isinstance(value, bool)))
+        else:
+            return _UNKNOWN
+    return any(results)
 
 
 def _number(kind: type, args: list[Any]) -> Any:
@@ -892,6 +1044,11 @@ _COMPARE: dict[type, Callable[[Any, Any], Any]] = {
 def _unknown(*values: Any) -> Unknown:
     """Return an Unknown that waits for every launch argument the unknown `values` wait for."""
     return Unknown(frozenset().union(*(v.needs for v in values if isinstance(v, Unknown))))
+
+
+def _opaque(value: Any) -> bool:
+    """Return True for a launch or Python object moveplan models (not a plain value, not unknown)."""
+    return isinstance(value, Lazy | _Object | _Instance | _Class | _Module | Builder | YamlFile | XacroFile)
 
 
 def _plain(value: Any) -> bool:
@@ -952,3 +1109,9 @@ def _package_of(path: Path, level: int) -> list[str]:
     """Return the dotted package a relative import starts from: the launch file's folders, `level` up."""
     parts = list(path.parent.parts)
     return parts[len(parts) - (level - 1):] if level > 1 else [path.parent.name]
+
+
+_PYTHON_TYPES: dict[Any, type] = {
+    _BUILTINS["str"]: str, _BUILTINS["bool"]: bool, _BUILTINS["int"]: int, _BUILTINS["float"]: float,
+    _BUILTINS["list"]: list, _BUILTINS["dict"]: dict, _BUILTINS["tuple"]: tuple,
+}

@@ -142,6 +142,7 @@ class LaunchRecord:
     builders: list[Builder] = field(default_factory=list)
     included: list[LaunchRecord] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    loose: list[dict[Any, Any]] = field(default_factory=list)  # parameter dicts built but handed to no node seen
 
 
 def text(value: Any, context: LaunchContext, depth: int = 0) -> str | Unknown:

@@ -328,6 +328,8 @@ def _resolve(record: LaunchRecord, found: _Found, packages: PackagePath) -> None
         for parameter in node.parameters:
             _parameter(parameter, context, found, packages, control)
         _spawner(node.arguments, executable, context, found)
+    for parameters in record.loose:  # after the nodes': what a node is given comes first
+        _parameter(parameters, context, found, packages, control=False)
 
 
 def _builder(builder: Builder, context: LaunchContext, found: _Found, packages: PackagePath) -> None:
@@ -378,7 +380,7 @@ def _parameter(value: Any, context: LaunchContext, found: _Found, packages: Pack
         for key, item in value.items():
             if key in ("robot_description", "robot_description_semantic"):
                 _description("urdf" if key == "robot_description" else "srdf", item, None, context, found, packages)
-            elif key in _KEYED and isinstance(item, YamlFile):
+            elif key in _KEYED and isinstance(item, YamlFile) and _holds(Path(item.path), _KEYED[key]):
                 found.files.setdefault(_KEYED[key], Path(item.path))
             elif key in _KEYED and isinstance(item, dict) and isinstance(item.get("joint_limits"), YamlFile):
                 found.files.setdefault(_KEYED[key], Path(item["joint_limits"].path))
@@ -392,6 +394,16 @@ def _parameter(value: Any, context: LaunchContext, found: _Found, packages: Pack
             for hole in holes:
                 _need(found, hole, context)
             _blocked(words, holes, found)
+
+
+def _holds(path: Path, setting: str) -> bool:
+    """Return False for a file loaded under robot_description_planning that holds no joint limits (Pilz's)."""
+    if setting != "joint_limits":
+        return True
+    try:
+        return "joint_limits" in _keys(load_yaml(path))
+    except ConfigError:
+        return False
 
 
 _KEYED = {"robot_description_planning": "joint_limits", "robot_description_kinematics": "kinematics",

@@ -399,3 +399,84 @@ def test_the_urdf_of_the_srdfs_robot_is_found_one_folder_down_or_in_xacro(worksp
         target.write_text(description.read_text().replace("ur10e.ros2_control.xacro", control))
         assert load_robot_config(package).sources["urdf"] == target
         target.unlink()
+
+
+# xArm's: the launch file builds the config with its own MoveItConfigsBuilder class, from a workspace
+# package (uf_ros_lib), whose methods name the files; the result reaches move_group through yaml.dump.
+CLASS_BUILDER = '''
+from pathlib import Path
+from launch.substitutions import LaunchConfiguration
+from launch_param_builder import ParameterBuilder, load_xacro, load_yaml
+
+
+class AcmeConfigsBuilder(ParameterBuilder):
+    __urdf_args = None
+
+    def __init__(self, context=None, **kwargs):
+        super().__init__('acme_moveit_config')
+        def get_param_str(name, default_val):
+            val = kwargs.get(name, default_val)
+            return val if isinstance(val, str) else 'false' if val == False else \\
+                (val.perform(context) if context is not None else val) if isinstance(val, LaunchConfiguration) \\
+                else str(val)
+        self.__model = get_param_str('model', 'ur10e')
+        self.__urdf_args = {'mount_height': get_param_str('mount', 0.0)}
+        self.__configs = {}
+
+    def robot_description(self):
+        path = Path(self._package_path).parent / 'ur10e_moveit_config' / 'config' / 'ur10e.urdf.xacro'
+        self.__configs['robot_description'] = {'robot_description': load_xacro(path, mappings=self.__urdf_args)}
+        return self
+
+    def robot_description_semantic(self):
+        path = self._package_path / 'config' / 'srdf' / '{}.srdf'.format(self.__model)
+        self.__configs['semantic'] = {'robot_description_semantic': load_xacro(path)}
+        return self
+
+    def joint_limits(self):
+        limits = load_yaml(self._package_path / 'config' / 'limits' / (self.__model + '.yaml'))
+        self.__configs['limits'] = {'robot_description_planning': limits if limits else {}}
+        return self
+
+    def to_moveit_configs(self):
+        return self.robot_description().robot_description_semantic().joint_limits()
+
+    def to_dict(self):
+        return self.__configs
+'''
+
+CLASS_LAUNCH = '''
+import yaml
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument, IncludeLaunchDescription, OpaqueFunction
+from launch.launch_description_sources import PythonLaunchDescriptionSource
+from launch.substitutions import LaunchConfiguration
+from acme_lib.builder import AcmeConfigsBuilder
+
+
+def launch_setup(context, *args, **kwargs):
+    config = AcmeConfigsBuilder(context=context, model=LaunchConfiguration('model'), mount='0.75')
+    config = config.to_moveit_configs()
+    return [IncludeLaunchDescription(PythonLaunchDescriptionSource(['common.launch.py']),
+                                     launch_arguments={'moveit_config_dump': yaml.dump(config.to_dict())}.items())]
+
+
+def generate_launch_description():
+    return LaunchDescription([DeclareLaunchArgument('model', default_value='ur10e_tool'),
+                              OpaqueFunction(function=launch_setup)])
+'''
+
+
+def test_a_builder_class_of_a_workspace_package_names_the_files_its_methods_load(workspace: Path) -> None:
+    """xArm's xarm6_moveit_fake.launch.py: uf_ros_lib's MoveItConfigsBuilder(context=..., dof=..., ...), a
+    launch_param_builder.ParameterBuilder whose methods load_xacro and load_yaml the robot's files."""
+    write(workspace / "acme_lib", {"package.xml": PACKAGE_XML.format(name="acme_lib"),
+                                   "acme_lib/__init__.py": "", "acme_lib/builder.py": CLASS_BUILDER})
+    package = workspace / "acme_moveit_config"
+    (package / "launch" / "moveit.launch.py").write_text(CLASS_LAUNCH)
+    config = load_robot_config(package)
+    assert config.sources["srdf"] == package / "config" / "srdf" / "ur10e_tool.srdf"
+    assert config.sources["joint_limits"] == package / "config" / "limits" / "ur10e_tool.yaml"
+    assert config.sources["urdf"] == workspace / "ur10e_moveit_config" / "config" / "ur10e.urdf.xacro"
+    assert config.xacro_args["mount_height"] == "0.75"
+    assert load_robot_config(package, launch_args={"model": "ur10e"}).sources["srdf"].name == "ur10e.srdf"
