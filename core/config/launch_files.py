@@ -633,6 +633,26 @@ def _calls(cmake: str, lists: dict[str, list[str]]) -> list[tuple[str, str, str]
 
 # -- several launch files -------------------------------------------------------------------------
 
+_MAX_LISTED = 6
+
+
+def _choose(root: Path, setting: str, named: dict[Path, list[Path]]) -> str:
+    """Return the error for launch files that name different robots: each file with a few of those naming it.
+
+    xArm's package has forty launch files: the message lists some of each, and counts the rest.
+    """
+    def shown(items: list[str]) -> str:
+        more = f", and {len(items) - _MAX_LISTED} more" if len(items) > _MAX_LISTED else ""
+        return ", ".join(items[:_MAX_LISTED]) + more
+
+    # Launch files a user starts come first: a leading underscore marks one others include.
+    listed = [f"{shown(sorted((f.name for f in files), key=lambda n: (n.startswith('_'), n)))}: {path.name}"
+              for path, files in list(named.items())[:_MAX_LISTED]]
+    more = f"; and {len(named) - _MAX_LISTED} more files" if len(named) > _MAX_LISTED else ""
+    return (f"{root}: its launch files name {len(named)} different {setting.replace('_', ' ')} files "
+            f"({'; '.join(listed)}{more}); pass --launch FILE to choose one")
+
+
 def _combine(root: Path, found: list[_Found], given: dict[str, str]) -> LaunchFiles:
     """Return what the launch files agree on; ConfigError naming them where they name different robots."""
     for setting in _CHOSEN:
@@ -643,9 +663,7 @@ def _combine(root: Path, found: list[_Found], given: dict[str, str]) -> LaunchFi
             if path is not None:
                 named.setdefault(path.resolve(), []).append(item.launch)
         if len(named) > 1:
-            listed = "; ".join(f"{', '.join(f.name for f in files)}: {path}" for path, files in named.items())
-            raise ConfigError(f"{root}: its launch files name different {setting.replace('_', ' ')} files ({listed}); "
-                              "pass --launch FILE to choose one")
+            raise ConfigError(_choose(root, setting, named))
     # Of launch files naming the same file, the one that leaves fewest xacro args unset says most.
     urdf = min((f for f in found if f.urdf is not None), key=lambda f: f.unset.get("urdf", 0), default=None)
     srdf = min((f for f in found if f.srdf is not None), key=lambda f: f.unset.get("srdf", 0), default=None)
