@@ -21,8 +21,9 @@ from .plants import Response, measure, simulate_responses
 
 __all__ = ["BANDWIDTH_PER_RATE", "Gains", "JointSetup", "JointTuning", "Stage", "tune_joint"]
 
-BANDWIDTH_PER_RATE = 0.1
-"""P is never raised past a loop bandwidth of this many [rad]/[s] per [Hz] of update rate."""
+BANDWIDTH_PER_RATE = 0.3
+"""P is never raised past a loop bandwidth of this many [rad]/[s] per [Hz] of update rate (about 5 % of the rate in
+Hz, within the rule of thumb of a tenth; 0.1 left 100-150 ms hydraulic drives too slow for MoveIt's start check)."""
 STEP = 1.5
 """Ratio between successive rungs of a gain ladder."""
 STEADY_DECAY = 0.8

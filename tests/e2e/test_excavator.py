@@ -265,3 +265,19 @@ def test_the_excavators_hydraulic_plant_shows_the_pid_effect_by_default(
         stages = [s for s in joint["stages"] if s["stage"] in ("P", "D") and s["chosen"]]
         assert [s["stage"] for s in stages] == ["P", "D"]
         assert stages[0]["gains"]["p"] > 0 and stages[1]["gains"]["d"] > 0
+
+
+@pytest.mark.parametrize("lag", [0.02, 0.15])
+def test_tune_pid_gains_pass_their_own_verification_on_slow_and_fast_drives(
+        cli: Cli, dig_file: Path, tmp_path: Path, lag: float) -> None:
+    """From zero gains, on drives lagging 20 to 150 ms under the excavator's droop: P, then D, verified."""
+    import yaml
+
+    controllers = yaml.safe_load((ROOT / "configs" / "excavator" / "ros2_controllers.yaml").read_text())
+    for gains in controllers["excavation_controller"]["ros__parameters"]["gains"].values():
+        gains.update(p=0.0, i=0.0, d=0.0)
+    zero = tmp_path / "zero.yaml"
+    zero.write_text(yaml.safe_dump(controllers))
+    code, tuned = cli.json("tune-pid", dig_file, "--controllers", zero, "--plant-param", f"drive_tau={lag}",
+                           "-o", tmp_path / "tuned.yaml")
+    assert code == 0 and tuned["verification"]["result"]["name"] == "SUCCESSFUL", tuned["verification"]["result"]
