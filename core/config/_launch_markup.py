@@ -411,10 +411,14 @@ class _Reader:
 
         Quotes are literal outside a substitution; a backslash makes the next character literal.
         """
+        return self.scan(index, quote, depth, "")
+
+    def scan(self, index: int, quote: str | None, depth: int, stops: str) -> tuple[list[Any], int]:
+        """Return the parts of the text from `index` up to `quote`, a character of `stops` or the end, and the index."""
         source = self.source
         parts: list[Any] = []
         literal: list[str] = []
-        while index < len(source) and source[index] != quote:
+        while index < len(source) and source[index] != quote and source[index] not in stops:
             if source.startswith("$(", index):
                 parts.append("".join(literal))
                 literal = []
@@ -461,22 +465,7 @@ class _Reader:
             if end >= len(source):
                 raise _Malformed  # a quote never closed
             return parts, end + 1
-        parts = []
-        literal: list[str] = []
-        while index < len(source) and source[index] not in " )" and source[index] != quote:
-            if source.startswith("$(", index):
-                parts.append("".join(literal))
-                literal = []
-                value, index = self.substitution(index, quote, depth + 1)
-                parts.append(value)
-            elif source[index] == "\\" and index + 1 < len(source):
-                literal.append(source[index + 1])
-                index += 2
-            else:
-                literal.append(source[index])
-                index += 1
-        parts.append("".join(literal))
-        return parts, index
+        return self.scan(index, quote, depth, " )")
 
 
 def _concat(parts: list[Any]) -> Any:

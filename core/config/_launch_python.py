@@ -229,7 +229,7 @@ class _Interpreter:
         elif isinstance(node, ast.AnnAssign) and node.value is not None:
             self.assign(node.target, self.expr(node.value, scope), scope)
         elif isinstance(node, ast.AugAssign):
-            current = self.expr(_load(node.target), scope)
+            current = self.expr(node.target, scope)  # its ctx is Store; read the same way as Load here
             self.assign(node.target, self.binary(node.op, current, self.expr(node.value, scope)), scope)
         elif isinstance(node, ast.Return):
             raise _Return(self.expr(node.value, scope) if node.value is not None else None)
@@ -1076,12 +1076,6 @@ def _subscript(container: Any, key: Any) -> Any:
     if isinstance(container, list | tuple | str) and isinstance(key, int):
         return container[key] if -len(container) <= key < len(container) else _UNKNOWN
     return _UNKNOWN
-
-
-def _load(target: ast.expr) -> ast.expr:
-    """Return an assignment target read as an expression (for +=)."""
-    copy = ast.parse(ast.unparse(target), mode="eval").body
-    return copy
 
 
 def _bind(arguments: ast.arguments, args: list[Any], kwargs: dict[str, Any], local: dict[str, Any],
