@@ -12,7 +12,6 @@ import contextlib
 import io
 import json
 import math
-import re
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -94,19 +93,6 @@ class PlanFile:
     metadata: dict[str, str]
     limits: dict[str, dict[str, float]]
     urdf: str = ""
-
-    def prismatic_joints(self) -> frozenset[str]:
-        """Return the names of the URDF's prismatic joints (positions in [m]), by its <joint> tags."""
-        found = set()
-        for tag in _JOINT_TAG.findall(self.urdf):
-            attributes = dict(_ATTRIBUTE.findall(tag))
-            if attributes.get("type") == "prismatic" and "name" in attributes:
-                found.add(attributes["name"])
-        return frozenset(found)
-
-
-_JOINT_TAG = re.compile(r"<joint\b[^>]*>")
-_ATTRIBUTE = re.compile(r"""\b(name|type)\s*=\s*["']([^"']*)["']""")
 
 
 def read_plan(path: Path) -> PlanFile:

@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 from .. import bag as recording
 from ..bag import open_joint_states
-from ..config import ControllerConfig, ExecutionConfig, JointGoal, check_joint_units
+from ..config import ControllerConfig, ExecutionConfig, JointGoal, RobotConfig, check_joint_units
 from ..control import (
     DEFAULT_RELEASE,
     CheckReport,
@@ -116,6 +116,8 @@ class PlanExecution:
     plan: recording.PlanFile
     tf: TfSamples | None = None
     request: ExecuteRequest | None = None
+    prismatic: frozenset[str] = frozenset()
+    """The robot's prismatic joints: their positions are in [m]."""
 
     @property
     def violations(self) -> tuple[tuple[str, Violation], ...]:
@@ -220,7 +222,8 @@ def execute(
             steps.append(StepExecution(name, replace(report.summary(), tracking=figures)))
             del report  # before the next step is simulated
         last = steps[-1].report
-        execution = PlanExecution(last.ok, last.result, tuple(steps), controller, plan, request=request)
+        execution = PlanExecution(last.ok, last.result, tuple(steps), controller, plan, request=request,
+                                  prismatic=prismatic_joints(config))
         if recorder is not None:
             recorder.finish(execution)
     return execution
@@ -295,6 +298,11 @@ def _start_positions(
     return np.array([start[j] for j in controller.joints if j in start])
 
 
+def prismatic_joints(config: RobotConfig) -> frozenset[str]:
+    """Return the names of the robot's prismatic joints (positions in [m])."""
+    return frozenset(name for name, joint in config.urdf_joints.items() if joint.type == "prismatic")
+
+
 def check(request: CheckRequest, then: Callable[[CheckedRecording], None] | None = None) -> CheckReport:
     """Return the verdict of the controller's and MoveIt's rules on a recorded execution of a plan.
 
@@ -311,7 +319,7 @@ def check(request: CheckRequest, then: Callable[[CheckedRecording], None] | None
                            skip_damaged=request.skip_damaged) as recorded:
         report = check_recording(plan, recorded, controller, config.execution, continuous, request.start)
         report = replace(report, skipped=recorded.skipped, unchecked=unchecked_joints(controller),
-                         prismatic=plan.prismatic_joints())
+                         prismatic=prismatic_joints(config))
         report = recorded_tracking(report, [s.trajectory for s in plan.steps], recorded, controller,
                                    np.array([j in continuous for j in controller.joints]))
         if then is not None:

@@ -171,7 +171,7 @@ def execution_document(execution: PlanExecution, output: Path | None = None) -> 
         start_ns += seconds_to_ns(report.duration_s)
     document: dict[str, Any] = {
         **_verdict(execution.ok, execution.result, execution.violations, execution.margins,
-                   execution.plan.prismatic_joints()),
+                   execution.prismatic),
         "unchecked": {check: list(joints) for check, joints in unchecked_joints(execution.controller).items()},
         "controller": execution.controller.name,
         "duration_s": start_ns / 1e9,
