@@ -286,3 +286,23 @@ def test_messages_of_two_layouts_in_stamp_order_are_not_reported_as_reordered(
     read_joint_states(mixed)
     [warning] = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
     assert "message 101" in warning
+
+
+def moving_end(message: Any) -> None:
+    """Leave the last point with a velocity, as a goal JTC's allow_nonzero_velocity_at_trajectory_end refuses."""
+    velocities = list(message.points[-1].velocities)
+    velocities[1] = 0.25
+    message.points[-1].velocities = velocities
+
+
+def test_execute_and_check_refuse_a_plan_whose_last_point_still_moves(cli: Cli, tmp_path: Path) -> None:
+    """test_trajectory_actions.cpp test_allow_nonzero_velocity_at_trajectory_end_false: the goal is rejected."""
+    plan = edited_plan(tmp_path / "moving.mcap", moving_end)
+    output = tmp_path / "executed.mcap"
+    result = cli("execute", plan, "--fake", "-o", output)
+    assert result.exit_code == 3 and not output.exists()
+    line = one_error_line(result)
+    assert "moving.mcap" in line and "step 'up'" in line
+    assert "Velocity of last trajectory point of joint shoulder_lift_joint is not zero: 0.250000000000000" in line
+    result = cli("check-tolerances", plan, RECORDINGS / "tool_up_ok.mcap")
+    assert result.exit_code == 3 and "is not zero" in one_error_line(result)
