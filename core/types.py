@@ -282,6 +282,8 @@ class StepResult:
     residual: dict[str, float] | None = None
     stats: dict[str, float] = field(default_factory=dict)
     tolerances: GoalTolerances | None = None  # sent with the goal, replacing the controller's
+    # The fractions of the velocity and acceleration limits its timing used; None: not timed by moveplan.
+    scaling: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)

@@ -75,6 +75,7 @@ class PlanStepRecord:
     start_s: float
     trajectory: JointTrajectory
     tolerances: GoalTolerances | None = None
+    scaling: tuple[float, float] | None = None  # the velocity and acceleration scaling its timing used
 
 
 @dataclass(frozen=True)
@@ -114,7 +115,8 @@ def read_plan(path: Path) -> PlanFile:
         step_names = [str(name) for name in json.loads(info["step_names"])]
         limits = _limits(json.loads(info["limits"]))
         tolerances = _tolerances(info.get("step_tolerances"), len(step_names))
-    except (ValueError, TypeError, AttributeError, KeyError) as exc:
+        scalings = _scalings(info.get("step_scaling"), len(step_names))
+    except (ValueError, TypeError, AttributeError, KeyError, IndexError) as exc:
         raise InputError(f"{path}: 'moveplan' metadata is malformed: {exc}") from exc
     factory = DecoderFactory()
     descriptions = [item for item in contents.kept if item[0].topic == ROBOT_DESCRIPTION]
@@ -123,8 +125,8 @@ def read_plan(path: Path) -> PlanFile:
         group=info["group"],
         planning_frame=info["planning_frame"],
         distro=info["distro"],
-        steps=tuple(replace(step, tolerances=tolerance) for step, tolerance
-                    in zip(_steps(path, factory, contents, step_names), tolerances, strict=True)),
+        steps=tuple(replace(step, tolerances=tolerance, scaling=scaling) for step, tolerance, scaling
+                    in zip(_steps(path, factory, contents, step_names), tolerances, scalings, strict=True)),
         attachments={attachment.name: attachment.data for attachment in contents.attachments},
         metadata={key: value for key, value in info.items() if key not in PLAN_KEYS},
         limits=limits,
@@ -206,6 +208,22 @@ def _tolerances(text: str | None, count: int) -> list[GoalTolerances | None]:
     if not isinstance(entries, list) or len(entries) != count:
         raise ValueError(f"step_tolerances: expected {count} entries, one per step")
     return [None if entry is None else _goal_tolerances(entry) for entry in entries]
+
+
+def _scalings(text: str | None, count: int) -> list[tuple[float, float] | None]:
+    """Return each step's (velocity, acceleration) scaling from the metadata's step_scaling (JSON; absent: none)."""
+    if text is None:
+        return [None] * count
+    entries = json.loads(text)
+    if not isinstance(entries, list) or len(entries) != count:
+        raise ValueError(f"step_scaling: expected {count} entries, one per step")
+    scalings: list[tuple[float, float] | None] = []
+    for entry in entries:
+        pair = None if entry is None else (float(entry[0]), float(entry[1]))
+        if pair is not None and not all(0.0 < value <= 1.0 for value in pair):
+            raise ValueError(f"step_scaling: {entry!r} is no pair of fractions in (0, 1]")
+        scalings.append(pair)
+    return scalings
 
 
 def _goal_tolerances(entry: dict[str, Any]) -> GoalTolerances:

@@ -45,6 +45,9 @@ def write_plan(path: Path, plan: Plan, distro: str = "jazzy") -> None:
         # The tolerances each step's goal carries (control_msgs/FollowJointTrajectory's fields), null: none.
         **({"step_tolerances": json.dumps([s.tolerances.as_dict() if s.tolerances else None for s in plan.steps])}
            if any(step.tolerances for step in plan.steps) else {}),
+        # The scaling factors each step was timed with, [velocity, acceleration], null: not timed by moveplan.
+        **({"step_scaling": json.dumps([list(s.scaling) if s.scaling else None for s in plan.steps])}
+           if any(step.scaling for step in plan.steps) else {}),
         "limits": json.dumps(plan.limits, sort_keys=True),
         "distro": distro,
     }

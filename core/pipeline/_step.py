@@ -70,6 +70,7 @@ class _Settings:
         timeout: Wall-clock safety limit of each search in [s]; None: the default for the budget.
         max_velocity: Scaled velocity limits per group joint in [rad]/[s] or [m]/[s].
         max_acceleration: Scaled acceleration limits per group joint in [rad]/[s]^2 or [m]/[s]^2.
+        scaling: The velocity and acceleration scaling factors those limits come from.
         min_fraction: Smallest fraction of a straight line that is a success.
     """
 
@@ -79,6 +80,7 @@ class _Settings:
     max_velocity: NDArray[np.float64]
     max_acceleration: NDArray[np.float64]
     min_fraction: float
+    scaling: tuple[float, float]
 
 
 @dataclass(frozen=True)
@@ -125,6 +127,7 @@ def plan_step(
         residual=residual,
         stats=stats,
         tolerances=spec.tolerances,
+        scaling=settings.scaling,
     )
 
 
@@ -137,6 +140,7 @@ def _settings(spec: StepSpec, request: PlanRequest, robot: Robot) -> _Settings:
         timeout=request.timeout,
         max_velocity=robot.max_velocity * motion.velocity_scaling,
         max_acceleration=robot.max_acceleration * motion.acceleration_scaling,
+        scaling=(motion.velocity_scaling, motion.acceleration_scaling),
         min_fraction=spec.min_fraction if spec.min_fraction is not None else request.min_fraction,
     )
 

@@ -34,7 +34,7 @@ from ..control import ExecutionReport, simulate, validate_goal, validate_goal_en
 from ..errors import ConfigError, NoPlan, StartInCollision, StartOutsideLimits
 from ..model import Robot, Scene, resolve_frames
 from ..planning import check_limits, seed_planner
-from ..types import CollisionObject, Frame, JointTrajectory, Plan, StepResult
+from ..types import CollisionObject, Frame, GoalTolerances, JointTrajectory, Plan, StepResult
 from ._checks import Problem, build_problem, filter_threshold
 from ._plan_files import configured_plant, pick_controller
 from ._step import plan_step
@@ -190,18 +190,19 @@ def _joined(legs: Sequence[StepResult], name: str, fraction: float) -> StepResul
         name=name, goal={"cartesian": [leg.goal["pose"] for leg in legs]}, planner="linear",
         planning_time_s=sum(leg.planning_time_s for leg in legs), trajectory=trajectory, fraction=fraction,
         residual=legs[-1].residual, stats={key: sum(leg.stats.get(key, 0.0) for leg in legs) for key in legs[0].stats},
+        scaling=legs[0].scaling,
     )
 
 
 def execute_motion(
     config: RobotConfig, trajectory: JointTrajectory, start: Mapping[str, float], settings: ExecutionSettings,
-    where: str = "execute",
+    where: str = "execute", tolerances: GoalTolerances | None = None,
 ) -> ExecutionReport:
     """Return what the simulated controller did with `trajectory`, sent with the robot at `start` (joint -> value).
 
     The controller is the robot config's JointTrajectoryController driving the trajectory's
     joints (or the one in `settings.controllers`), on the plant `settings` names: what
-    `moveplan execute --fake` runs for one step.
+    `moveplan execute --fake` runs for one step. `tolerances` are those the goal carries.
 
     Raises:
         InputError: The trajectory holds a non-finite value or times JTC refuses; the message
@@ -216,7 +217,7 @@ def execute_motion(
     plant = configured_plant(config, settings.plant, settings.plant_params, controller, continuous)
     positions = np.array([start[j] for j in controller.joints if j in start])
     return simulate(trajectory, controller, config.execution, plant, continuous_joints=continuous,
-                    start_positions=positions, seed=settings.seed)
+                    start_positions=positions, seed=settings.seed, goal_tolerances=tolerances)
 
 
 def check_execution(config: RobotConfig, joints: Sequence[str], settings: ExecutionSettings) -> None:

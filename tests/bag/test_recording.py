@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 import struct
+from dataclasses import replace
 from importlib.resources import files
 from pathlib import Path
 from typing import Any
@@ -444,6 +445,23 @@ def assert_same_plan(plan_file: PlanFile, plan: Plan) -> None:
 
 def test_read_plan_returns_what_write_plan_wrote(plan_path: Path, plan: Plan) -> None:
     assert_same_plan(read_plan(plan_path), plan)
+
+
+def test_each_step_keeps_the_scaling_it_was_timed_with(tmp_path: Path, plan: Plan) -> None:
+    """inspect --plot draws a step's limits as planned: the joint's limit times this scaling."""
+    scaled = (replace(plan.steps[0], scaling=(0.5, 0.25)), plan.steps[1])  # the second: not timed by moveplan
+    write_plan(tmp_path / "scaled.mcap", replace(plan, steps=scaled))
+    assert [s.scaling for s in read_plan(tmp_path / "scaled.mcap").steps] == [(0.5, 0.25), None]
+    write_plan(tmp_path / "plain.mcap", plan)
+    assert [s.scaling for s in read_plan(tmp_path / "plain.mcap").steps] == [None, None]
+
+
+@pytest.mark.parametrize("text", ["[[2.0, 0.5], null]", "[[0.5], null]", "[[0.5, 0.5]]", "{}"])
+def test_a_malformed_step_scaling_names_the_file_and_the_key(tmp_path: Path, plan: Plan, text: str) -> None:
+    path = tmp_path / "plan.mcap"
+    write_plan(path, replace(plan, metadata={**plan.metadata, "step_scaling": text}))
+    with pytest.raises(InputError, match=rf"^{re.escape(str(path))}: 'moveplan' metadata is malformed: .*"):
+        read_plan(path)
 
 
 def test_attachments_get_media_types_from_their_file_names(plan_path: Path) -> None:

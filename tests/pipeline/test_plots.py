@@ -13,7 +13,8 @@ from conftest import ROOT, SAMPLES, Cli, write_bag
 from PIL import Image
 
 from moveplan.core.bag.jointstates import encode_joint_states, read_joint_states
-from moveplan.core.pipeline.plots.commands import POINTS_PER_SERIES, thinned
+from moveplan.core.pipeline.plots._figures import POINTS_PER_SERIES
+from moveplan.core.pipeline.plots.commands import thinned
 
 RECORDINGS = SAMPLES / "recordings"
 PLAN = RECORDINGS / "tool_up_plan.mcap"

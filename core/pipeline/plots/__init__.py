@@ -1,9 +1,10 @@
 """The PNG plots of inspect, execute, check-tolerances and tune-pid: one file a command, written atomically.
 
-`commands` runs a command with its plot (a plan's curves, an execution's or a recording's
-tracking), `tracking` and `tuning` draw those figures, `figures` is what they share (figures
-sized per joint, step lines, notes, PNG files). matplotlib is imported inside the functions
-that draw, so importing these modules loads none of it.
+`_plan` draws a plan's curves, `commands` runs execute and check-tolerances with their plot
+(an execution's or a recording's tracking), `_tracking` and `tuning` draw those figures,
+`_figures` is what they share (figures sized per joint, axis ranges, step lines, notes, PNG
+files). matplotlib is imported inside the functions that draw, so importing these modules loads
+none of it.
 """
 
 from typing import TYPE_CHECKING
@@ -11,7 +12,9 @@ from typing import TYPE_CHECKING
 from ..._faces import lazy_exports
 
 if TYPE_CHECKING:
-    from .commands import check_plot_path, check_plotted, execute_plotted, write_plan_plot
+    from ._figures import check_plot_path
+    from ._plan import write_plan_plot
+    from .commands import check_plotted, execute_plotted
     from .tuning import write_tuning_plot
 
 __all__ = [
@@ -23,9 +26,9 @@ __all__ = [
 ]
 
 __getattr__ = lazy_exports(__name__, {
-    "check_plot_path": "commands",
+    "check_plot_path": "_figures",
     "check_plotted": "commands",
     "execute_plotted": "commands",
-    "write_plan_plot": "commands",
+    "write_plan_plot": "_plan",
     "write_tuning_plot": "tuning",
 })

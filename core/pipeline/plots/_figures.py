@@ -1,15 +1,14 @@
-"""What the plots of moveplan share: figures sized per joint, step lines, notes, and PNG files; a plan's figure.
+"""What the plots of moveplan share: figures sized per joint, axis ranges, step lines, notes, and PNG files.
 
 matplotlib is imported inside the functions: importing this module loads nothing of it. A
 figure is a matplotlib Figure built without pyplot (no global state, never a window), 12 in
-wide with a row of panels per joint, at 100 dpi. tracking_figure draws executions.
+wide with a row of panels per joint, at 100 dpi, its margins fixed in inches.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -17,56 +16,54 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...bag import atomic_file
-from ...types import frozen_array
+from ...errors import InputError, UsageError
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
+    from ...config import RobotConfig
+
 __all__ = [
-    "PlanCurves", "blended", "corner_note", "finite_or_nan", "grid", "legend_line", "plan_figure", "step_lines",
+    "IN_RANGE", "POINTS_PER_SERIES", "blended", "check_plot_path", "corner_note", "finite_or_nan", "grid", "legend",
+    "legend_line", "position_units", "prefixed", "step_budget", "step_lines", "symmetric_span", "time_axis",
     "write_png",
 ]
 
 _WIDTH_IN = 12.0
-_ROW_IN = 1.9
-_HEAD_IN = 1.4
+_ROW_IN = 1.9  # a joint's row of panels, with the gap below it
+_HEAD_IN = 1.4  # title, column titles, time axis and one legend row
+_TOP_IN = 0.7  # two title lines and the column titles
+_LEGEND_ROW_IN = 0.2
+_LEFT_IN, _RIGHT_IN = 1.1, 0.15  # the joint's name and the tick labels; the last panel's edge
+_COLUMN_GAP_IN, _ROW_GAP_IN = 0.78, 0.22  # tick labels and unit of the next column; a row's time ticks
 _DPI = 100
-_CURVE, _LIMIT = "C0", "C3"
+_LABEL_PX = 12.0  # the width of an upright step name at 7 pt (10 px), with a little air
+
+IN_RANGE = 3.0
+"""A tolerance or limit up to this many times what is drawn shares its panel's scale; a larger one is named
+in a note instead, so that a passing run's small errors are not drawn as a flat line."""
+
+POINTS_PER_SERIES = 5000
+"""About how many samples per joint a plot keeps of each series, whatever the length of the run."""
+
+_MIN_STEP_POINTS = 200
+_PREFIXES = ((0.1, 1.0, ""), (1e-4, 1e3, "m"), (1e-7, 1e6, "µ"), (0.0, 1e9, "n"))
+_LEAST_ERROR = 1e-9  # [rad] or [m]: a smaller error is rounding, drawn on a panel of about this height
 
 
-@dataclass(frozen=True)
-class PlanCurves:
-    """What `plan_figure` draws: a plan sampled as the controller interpolates it, on the plan's timeline.
+def check_plot_path(path: Path, flag: str = "--plot") -> None:
+    """Refuse a plot path before any work: it must name a .png file in an existing folder; return None.
 
-    Attributes:
-        title: The figure's title.
-        joints: Column order of the arrays; `units` their position units.
-        steps: (name, start [s], duration [s]) of each step.
-        times_s: Sample times [s], shape (m,); positions, velocities, accelerations (m, n).
-        knots_s: Times of the waypoints [s]; knot_positions their positions.
-        limits: Per joint lower, upper, max_velocity, max_acceleration (absent: not limited).
+    Raises:
+        UsageError: The name does not end in .png.
+        InputError: Its folder does not exist (as -o's "cannot write", exit 3).
 
     """
-
-    title: str
-    joints: tuple[str, ...]
-    units: tuple[str, ...]
-    steps: tuple[tuple[str, float, float], ...]
-    times_s: NDArray[np.float64]
-    positions: NDArray[np.float64]
-    velocities: NDArray[np.float64]
-    accelerations: NDArray[np.float64]
-    knots_s: NDArray[np.float64]
-    knot_positions: NDArray[np.float64]
-    limits: Mapping[str, Mapping[str, float]]
-
-    def __post_init__(self) -> None:
-        times = frozen_array(self.times_s, (None,), "times_s")
-        object.__setattr__(self, "times_s", times)
-        shape = (len(times), len(self.joints))
-        for name in ("positions", "velocities", "accelerations"):
-            object.__setattr__(self, name, frozen_array(getattr(self, name), shape, name))
+    if path.suffix.lower() != ".png":
+        raise UsageError(f"{flag} '{path}': expected a file name ending in .png (the plot is a PNG image)")
+    if not path.parent.is_dir():
+        raise InputError(f"{flag} '{path}': cannot write: folder '{path.parent}' does not exist")
 
 
 def write_png(figure: Figure, path: Path) -> None:
@@ -76,71 +73,133 @@ def write_png(figure: Figure, path: Path) -> None:
     """
     metadata = {"Title": figure.get_suptitle().replace("\n", " - "), "Software": "moveplan"}
     with atomic_file(path) as stream:
-        figure.savefig(stream, format="png", dpi=_DPI, metadata=metadata)
+        # zlib level 1: a tenth of the time of the default for a file a quarter larger.
+        figure.savefig(stream, format="png", dpi=_DPI, metadata=metadata, pil_kwargs={"compress_level": 1})
 
 
-def plan_figure(curves: PlanCurves) -> Figure:
-    """Return a figure of a plan: per joint, position, velocity and acceleration against their limits."""
-    figure, axes = grid(len(curves.joints), 3, curves.title)
-    columns = (("position", curves.positions, "lower", "upper", ""), ("velocity", curves.velocities,
-               "max_velocity", "max_velocity", "/s"), ("acceleration", curves.accelerations, "max_acceleration",
-               "max_acceleration", "/s²"))
-    for row, joint in enumerate(curves.joints):
-        limits = curves.limits.get(joint, {})
-        for col, (what, values, low_key, high_key, per) in enumerate(columns):
-            axis = axes[row, col]
-            axis.plot(curves.times_s, values[:, row], color=_CURVE, lw=1.2)
-            low = -limits[low_key] if low_key == high_key and low_key in limits else limits.get(low_key)
-            for bound in (low, limits.get(high_key)):
-                if bound is not None and math.isfinite(bound):
-                    axis.axhline(bound, color=_LIMIT, ls="--", lw=1.0)
-            if col:
-                _peak_note(axis, values[:, row], limits.get(high_key), f"{curves.units[row]}{per}")
-            axis.set_ylabel(f"[{curves.units[row]}{per}]")
-            if row == 0:
-                axis.set_title(what, fontsize=10)
-        axes[row, 0].plot(curves.knots_s, curves.knot_positions[:, row], "o", color=_CURVE, ms=3)
-        axes[row, 0].set_ylabel(f"{joint}\n[{curves.units[row]}]")
-    step_lines(axes, [(name, start) for name, start, _ in curves.steps])
-    handles = [legend_line(_CURVE, "-", "plan, as the controller interpolates it"),
-               legend_line(_CURVE, "", "waypoints", marker="o"),
-               legend_line(_LIMIT, "--", "joint limits (unscaled)"), legend_line("0.55", "-", "step start")]
-    figure.legend(handles=handles, loc="outside lower center", ncol=len(handles), fontsize=9, frameon=False)
-    return figure
+def grid(
+    rows: int, columns: int, title: str, widths: Sequence[float] | None = None, legend_rows: int = 1
+) -> tuple[Figure, Any]:
+    """Return a figure sized for `rows` joints and its (rows, columns) axes; time_axis then sets each column's time.
 
-
-def grid(rows: int, columns: int, title: str, widths: Sequence[float] | None = None) -> tuple[Figure, Any]:
-    """Return a figure sized for `rows` joints and its (rows, columns) axes, each column sharing its time axis."""
+    The margins are fixed in inches (title, column titles, tick labels, legend rows) rather
+    than found by a layout engine: that engine draws the whole figure once more to measure it.
+    """
     from matplotlib.figure import Figure
+    from matplotlib.ticker import MaxNLocator
 
-    figure = Figure(figsize=(_WIDTH_IN, _HEAD_IN + _ROW_IN * rows), layout="constrained")
-    axes = figure.subplots(rows, columns, sharex="col", squeeze=False, width_ratios=widths)
-    figure.suptitle(title, fontsize=10)
+    head = _HEAD_IN + _LEGEND_ROW_IN * (legend_rows - 1)
+    height = head + _ROW_IN * rows
+    panel_height = (_ROW_IN * rows - _ROW_GAP_IN * (rows - 1)) / rows
+    panel_width = (_WIDTH_IN - _LEFT_IN - _RIGHT_IN - _COLUMN_GAP_IN * (columns - 1)) / columns
+    figure = Figure(figsize=(_WIDTH_IN, height), dpi=_DPI)
+    axes = figure.subplots(rows, columns, squeeze=False, width_ratios=widths, gridspec_kw={
+        "left": _LEFT_IN / _WIDTH_IN, "right": 1.0 - _RIGHT_IN / _WIDTH_IN, "top": 1.0 - _TOP_IN / height,
+        "bottom": (head - _TOP_IN) / height, "wspace": _COLUMN_GAP_IN / panel_width,
+        "hspace": _ROW_GAP_IN / panel_height})
+    figure.suptitle(title, fontsize=10, y=1.0 - 0.06 / height, va="top")
     for axis in axes.ravel():
         axis.grid(True, alpha=0.3)
         axis.tick_params(labelsize=8)
+        axis.yaxis.set_major_locator(MaxNLocator(nbins=4))  # few ticks: see time_axis
     for axis in axes[-1]:
-        axis.set_xlabel("time [s]", fontsize=9)
+        axis.set_xlabel("time [s]", fontsize=9, labelpad=2)
     return figure, axes
 
 
+def time_axis(column: Sequence[Axes], low: float, high: float, bins: int = 7) -> None:
+    """Give a column of panels the time range [low, high] [s]: ticks on the bottom one, grid lines on all; return None.
+
+    The panels above get their vertical grid lines as one line collection, not as ticks:
+    a tick is a handful of artists, and drawing them is most of a figure's cost.
+    """
+    from matplotlib import rcParams
+    from matplotlib.ticker import MaxNLocator
+
+    times = [float(t) for t in MaxNLocator(nbins=bins).tick_values(low, high) if low <= t <= high]
+    for axis in column:
+        axis.set_xlim(low, high)
+    column[-1].set_xticks(times)
+    for axis in column[:-1]:
+        axis.set_xticks([])
+        axis.vlines(times, 0.0, 1.0, transform=axis.get_xaxis_transform(), color=rcParams["grid.color"],
+                    lw=rcParams["grid.linewidth"], alpha=0.3, zorder=0.5)
+
+
+def legend(figure: Figure, handles: Sequence[Any], columns: int) -> None:
+    """Draw the figure's legend centred along its bottom edge, in `columns` columns; return None."""
+    figure.legend(handles=handles, loc="lower center", bbox_to_anchor=(0.5, 0.0), ncol=columns, fontsize=9,
+                  frameon=False, borderaxespad=0.3)
+
+
 def step_lines(axes: Any, steps: Sequence[tuple[str, float]]) -> None:
-    """Draw a vertical line where each step starts, on every panel, named on the top row; return None."""
-    for index, (name, start) in enumerate(steps):
-        for axis in axes.ravel():
-            if index:  # the first step starts where the plot does
-                axis.axvline(start, color="0.55", lw=0.8)
-        for axis in axes[0]:
-            # Upright beside its line: the names of short steps do not run into each other.
-            axis.annotate(name, (start, 0.97), xycoords=blended(axis), xytext=(2, 0), textcoords="offset points",
-                          rotation=90, ha="left", va="top", fontsize=7, color="0.3", annotation_clip=True)
+    """Draw a vertical line where each step starts, on every panel, named on the top row; return None.
+
+    Call it once the time axis has its range. Names of steps closer than a name's width are
+    moved apart along the top and tied to their line, so that short steps stay legible.
+    """
+    starts = [start for _, start in steps[1:]]  # the first step starts where the plot does
+    for axis in axes.ravel():
+        if starts:
+            axis.vlines(starts, 0.0, 1.0, transform=blended(axis), color="0.55", lw=0.8)
+    for axis in axes[0]:
+        low, high = axis.get_xlim()
+        width_px = axis.get_position().width * axis.figure.get_figwidth() * _DPI
+        wanted = [(start - low) / (high - low) * width_px for _, start in steps]
+        for (name, start), at, x_px in zip(steps, wanted, _spread(wanted, _LABEL_PX, width_px), strict=True):
+            shift_pt = (x_px - at) * 72.0 / _DPI
+            arrow = {"arrowstyle": "-", "lw": 0.5, "color": "0.55", "relpos": (0.0, 1.0), "shrinkA": 0,
+                     "shrinkB": 0} if abs(shift_pt) > 1.0 else None
+            axis.annotate(name, (start, 1.0), xycoords=blended(axis), xytext=(shift_pt + 1.5, -4.0),
+                          textcoords="offset points", rotation=90, ha="left", va="top", fontsize=7, color="0.3",
+                          annotation_clip=True, arrowprops=arrow)
 
 
-def _peak_note(axis: Axes, values: NDArray[np.float64], limit: float | None, unit: str) -> None:
-    """Write the largest |value| and its share of the limit in a corner of the panel; return None."""
-    peak = float(np.max(np.abs(values), initial=0.0))
-    share = f" = {100.0 * peak / limit:.0f}% of limit" if limit and math.isfinite(limit) else ""
-    corner_note(axis, f"peak {peak:.3g} {unit}{share}")
+def _spread(wanted: Sequence[float], gap: float, width: float) -> list[float]:
+    """Return positions as near `wanted` (ascending) as keeps them `gap` apart, within [0, width] where they fit."""
+    placed: list[float] = []
+    for x in wanted:
+        placed.append(max(x, placed[-1] + gap) if placed else x)
+    overflow = placed[-1] - (width - gap) if placed else 0.0
+    if overflow > 0.0:  # pushed off the right edge: pull the crowded tail back left
+        for index in range(len(placed) - 1, -1, -1):
+            limit = width - gap if index == len(placed) - 1 else placed[index + 1] - gap
+            placed[index] = min(placed[index], limit)
+    return placed
+
+
+def symmetric_span(largest: float, bounds: Sequence[float]) -> tuple[float, list[float]]:
+    """Return the half-height of a panel centred on 0 and the positive `bounds` it leaves off-scale.
+
+    The panel holds `largest` (the biggest |value| drawn) and every bound up to IN_RANGE
+    times it; a bound beyond that is left off, for a note to name.
+    """
+    drawn = [b for b in bounds if b > 0.0 and math.isfinite(b)]
+    if not math.isfinite(largest):
+        return (1.15 * max(drawn) if drawn else 1.0), []
+    largest = max(largest, _LEAST_ERROR)
+    kept = [b for b in drawn if b <= IN_RANGE * largest]
+    return 1.15 * max([largest, *kept]), [b for b in drawn if b not in kept]
+
+
+def prefixed(span: float, unit: str) -> tuple[float, str]:
+    """Return the factor and unit to draw values of magnitude up to `span` in: rad, mrad or µrad (m, mm or µm)."""
+    for least, factor, prefix in _PREFIXES:
+        if span >= least:
+            return factor, prefix + unit
+    return 1.0, unit
+
+
+def step_budget(duration_s: float, total_s: float) -> int:
+    """Return the samples a step of `duration_s` [s] keeps: its share of POINTS_PER_SERIES, never very few."""
+    share = duration_s / total_s if total_s > 0.0 else 1.0
+    return max(_MIN_STEP_POINTS, int(POINTS_PER_SERIES * share))
+
+
+def position_units(config: RobotConfig, joints: Sequence[str]) -> tuple[str, ...]:
+    """Return per joint its position unit: m for a prismatic joint, else rad."""
+    kinds = config.urdf_joints
+    return tuple("m" if j in kinds and kinds[j].type == "prismatic" else "rad" for j in joints)
 
 
 def corner_note(axis: Axes, text: str) -> None:

@@ -16,7 +16,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...types import frozen_array
-from ._figures import blended, corner_note, finite_or_nan, grid, legend_line, step_lines
+from ._figures import (
+    blended,
+    corner_note,
+    finite_or_nan,
+    grid,
+    legend,
+    legend_line,
+    prefixed,
+    step_lines,
+    symmetric_span,
+    time_axis,
+)
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -97,9 +108,11 @@ def tracking_figure(tracking: Tracking) -> Figure:
     """Return a figure of an execution: per joint, reference and actual; the error against the tolerances.
 
     A third, narrower column zooms on the goal window of the last step drawn (the one that
-    decided), where a goal tolerance far finer than the path tolerance can be seen.
+    decided), where a goal tolerance far finer than the path tolerance can be seen. Error
+    panels are scaled to the errors, in rad, mrad or µrad (m, mm or µm): a tolerance far
+    above them is named in the panel's note rather than drawn.
     """
-    figure, axes = grid(len(tracking.joints), 3, tracking.title, widths=(5, 5, 2))
+    figure, axes = grid(len(tracking.joints), 3, tracking.title, widths=(5, 5, 2), legend_rows=2)
     last = tracking.steps[-1] if tracking.steps else None
     begin = min([s.start_s for s in tracking.steps], default=0.0)
     end = max([s.end_s for s in tracking.steps], default=0.0)
@@ -107,28 +120,33 @@ def tracking_figure(tracking: Tracking) -> Figure:
         end = max(end, _window(tracking, last)[1])
     for row, joint in enumerate(tracking.joints):
         position, error, goal = axes[row]
+        unit = tracking.units[row]
+        largest = _largest_error(tracking.steps, joint, row)
+        span, off = symmetric_span(largest, (tracking.path_tolerance[row], tracking.goal_tolerance[row]))
+        scale, scaled_unit = prefixed(span, unit)
         for step in tracking.steps:
-            _tolerance_bands(error, tracking, step, row, step is last)
+            _tolerance_bands(error, tracking, step, row, step is last, scale)
             position.plot(step.times_s, step.reference[:, row], color=_REFERENCE, ls="--", lw=1.2)
             position.plot(step.times_s, finite_or_nan(step.actual[:, row]), color=_ACTUAL, lw=1.0)
-            _error_curve(error, step, row)
+            _error_curve(error, step, row, scale)
         error.axhline(0.0, color="0.7", lw=0.6)
-        _error_limits(error, tracking.steps, joint, row,
-                      max(tracking.path_tolerance[row], tracking.goal_tolerance[row]))
-        _tolerance_note(error, tracking, row)
+        error.set_ylim(-span * scale, span * scale)
+        corner_note(error, _tolerance_note(tracking, row, largest, off))
         _least_span(position)
-        position.set_ylabel(f"{joint}\n[{tracking.units[row]}]")
-        error.set_ylabel(f"[{tracking.units[row]}]")
-        _violations((position, error), tracking.steps, joint, label=row == 0)
+        position.set_ylabel(f"{joint}\n[{unit}]", fontsize=9)
+        error.set_ylabel(f"[{scaled_unit}]", fontsize=9)
+        _violations((position, error), (1.0, scale), tracking.steps, joint, label=row == 0)
         if last is not None:
             _goal_zoom(goal, tracking, last, row)
-        for axis in (position, error):
-            axis.set_xlim(begin, end + 0.01 * (end - begin) if end > begin else begin + 1.0)
+    for column in (0, 1):
+        time_axis(axes[:, column], begin, end + 0.01 * (end - begin) if end > begin else begin + 1.0)
+    if last is not None and last.end_s >= _window(tracking, last)[0]:
+        time_axis(axes[:, 2], *_zoom_range(tracking, last), bins=3)
     axes[0, 0].set_title("position: plan reference and actual", fontsize=10)
     axes[0, 1].set_title("tracking error = reference - actual", fontsize=10)
     axes[0, 2].set_title("goal window", fontsize=10)
     step_lines(axes[:, :2], [(s.name, s.start_s) for s in tracking.steps])
-    figure.legend(handles=_tracking_legend(tracking), loc="outside lower center", ncol=3, fontsize=9, frameon=False)
+    legend(figure, _tracking_legend(tracking), 3)
     return figure
 
 
@@ -144,13 +162,16 @@ def _window(tracking: Tracking, step: TrackedStep) -> tuple[float, float]:
     return last_point - tracking.period_s, max(deadline, step.end_s)
 
 
-def _tolerance_bands(axis: Axes, tracking: Tracking, step: TrackedStep, row: int, last: bool) -> None:
+def _tolerance_bands(
+    axis: Axes, tracking: Tracking, step: TrackedStep, row: int, last: bool, scale: float
+) -> None:
     """Shade the path tolerance while the step's trajectory runs and the goal tolerance after it; return None.
 
     The goal window of the last step runs to goal_time after its last point (a dotted line),
     the others' until they were decided; a tolerance of 0 is not checked and gets no band.
+    Values are drawn times `scale` (the panel's unit prefix).
     """
-    path, goal = tracking.path_tolerance[row], tracking.goal_tolerance[row]
+    path, goal = tracking.path_tolerance[row] * scale, tracking.goal_tolerance[row] * scale
     start, end = _window(tracking, step)
     if path > 0.0:
         axis.fill_between((step.start_s, min(start, step.end_s)), -path, path, color=_PATH, alpha=0.15, lw=0)
@@ -174,40 +195,52 @@ def _goal_zoom(axis: Axes, tracking: Tracking, step: TrackedStep, row: int) -> N
                       f"its last point at\n{start:.3f} s", transform=axis.transAxes, ha="center", va="top",
                       fontsize=9, color="0.3")
         return
-    # From a little before the goal check to a little after the decision: a long goal_time would hide a quick one.
-    margin = max(0.25 * (step.end_s - start), 0.1 * step.planned_s, 5.0 * tracking.period_s)
     if row == 0:
         axis.text(0.02, 0.97, step.name, transform=axis.transAxes, rotation=90, va="top", fontsize=7, color="0.3")
-    _tolerance_bands(axis, tracking, step, row, True)
-    _error_curve(axis, step, row)
+    # Scaled to the error the zoom shows and the violations, not to the steps before it.
+    joint = tracking.joints[row]
+    checked = step.times_s >= _zoom_range(tracking, step)[0]
+    decided = [float(np.nanmax(np.abs(finite_or_nan(bound[checked, row])), initial=0.0))
+               for bound in (step.error_low, step.error_high)]
+    marks = [abs(m.error) for m in step.marks if m.joint == joint and m.check in _POSITION_CHECKS]
+    largest = max([value for value in (*decided, *marks) if math.isfinite(value)], default=0.0)
+    span, off = symmetric_span(largest, (tracking.goal_tolerance[row],))
+    scale, unit = prefixed(span, tracking.units[row])
+    _tolerance_bands(axis, tracking, step, row, True, scale)
+    _error_curve(axis, step, row, scale)
     axis.axhline(0.0, color="0.7", lw=0.6)
-    axis.set_xlim(start - margin, max(step.end_s, start) + margin)
-    # Scaled to what decides: the goal tolerance and the error at the decision; the approach may run off the top.
-    decided = [abs(float(step.error[-1, row]))] if len(step.times_s) else []
-    marks = [abs(m.error) for m in step.marks if m.joint == tracking.joints[row] and m.check in _POSITION_CHECKS]
-    largest = max([tracking.goal_tolerance[row], *decided, *marks])
-    if 0.0 < largest < math.inf:
-        axis.set_ylim(-1.5 * largest, 1.5 * largest)
-    _violations((axis,), [step], tracking.joints[row], label=False)
+    axis.set_ylim(-span * scale, span * scale)
+    axis.set_ylabel(f"[{unit}]", fontsize=8, labelpad=1)
+    if off:
+        corner_note(axis, f"goal ±{off[0]:.3g} {tracking.units[row]}\noff-scale")
+    _violations((axis,), (scale,), [step], joint, label=False)
 
 
-def _error_curve(axis: Axes, step: TrackedStep, row: int) -> None:
-    """Draw a step's error, shaded between its smallest and largest where samples were decimated; return None."""
+def _zoom_range(tracking: Tracking, step: TrackedStep) -> tuple[float, float]:
+    """Return the time range [s] of a step's goal zoom: a little before the goal check to a little after the decision.
+
+    A long goal_time would otherwise hide a quick decision.
+    """
+    start = _window(tracking, step)[0]
+    margin = max(0.25 * (step.end_s - start), 0.1 * step.planned_s, 5.0 * tracking.period_s)
+    return start - margin, max(step.end_s, start) + margin
+
+
+def _largest_error(steps: Sequence[TrackedStep], joint: str, row: int) -> float:
+    """Return a joint's largest finite |error| over the steps' samples and position violations."""
+    sampled = [float(np.nanmax(np.abs(finite_or_nan(bound[:, row])), initial=0.0))
+               for s in steps for bound in (s.error_low, s.error_high)]
+    marked = [abs(m.error) for s in steps for m in s.marks
+              if m.joint == joint and m.check in _POSITION_CHECKS and math.isfinite(m.error)]
+    return max([*sampled, *marked], default=0.0)
+
+
+def _error_curve(axis: Axes, step: TrackedStep, row: int, scale: float) -> None:
+    """Draw a step's error times `scale`, shaded between its smallest and largest where thinned; return None."""
     low, high = finite_or_nan(step.error_low[:, row]), finite_or_nan(step.error_high[:, row])
     if not np.array_equal(low, high, equal_nan=True):
-        axis.fill_between(step.times_s, low, high, color=_ACTUAL, alpha=0.35, lw=0)
-    axis.plot(step.times_s, finite_or_nan(step.error[:, row]), color=_ACTUAL, lw=1.0)
-
-
-def _error_limits(axis: Axes, steps: Sequence[TrackedStep], joint: str, row: int, tolerance: float) -> None:
-    """Set an error panel's y range symmetric around 0, holding the errors, violations and `tolerance`; return None."""
-    largest = max([tolerance]
-                  + [float(np.nanmax(np.abs(finite_or_nan(s.error_high[:, row])), initial=0.0)) for s in steps]
-                  + [float(np.nanmax(np.abs(finite_or_nan(s.error_low[:, row])), initial=0.0)) for s in steps]
-                  + [abs(m.error) for s in steps for m in s.marks
-                     if m.joint == joint and m.check in _POSITION_CHECKS and math.isfinite(m.error)])
-    if largest > 0.0:
-        axis.set_ylim(-1.2 * largest, 1.2 * largest)
+        axis.fill_between(step.times_s, low * scale, high * scale, color=_ACTUAL, alpha=0.35, lw=0)
+    axis.plot(step.times_s, finite_or_nan(step.error[:, row]) * scale, color=_ACTUAL, lw=1.0)
 
 
 def _least_span(axis: Axes) -> None:
@@ -219,19 +252,22 @@ def _least_span(axis: Axes) -> None:
         axis.set_ylim(middle - 0.5 * _LEAST_SPAN, middle + 0.5 * _LEAST_SPAN)
 
 
-def _tolerance_note(axis: Axes, tracking: Tracking, row: int) -> None:
-    """Write a joint's largest error and tolerances in a corner of its error panel (0: not checked); return None."""
+def _tolerance_note(tracking: Tracking, row: int, largest: float, off: Sequence[float]) -> str:
+    """Return an error panel's note: the largest error and each tolerance, unchecked or off-scale."""
     unit = tracking.units[row]
-    largest = max([float(np.nanmax(np.abs(finite_or_nan(bound[:, row])), initial=0.0))
-                   for s in tracking.steps for bound in (s.error_low, s.error_high)], default=0.0)
-    parts = [f"largest |error| {largest:.3g} {unit}"]
+    parts = []
     for what, value in (("path", tracking.path_tolerance[row]), ("goal", tracking.goal_tolerance[row])):
-        parts.append(f"{what} ±{value:.3g}" if value > 0.0 else f"{what} 0: not checked")
-    corner_note(axis, ", ".join(parts))
+        if value <= 0.0:
+            parts.append(f"{what} 0: not checked")
+        else:
+            parts.append(f"{what} ±{value:.3g}" + (" (off-scale)" if value in off else ""))
+    return f"largest |error| {largest:.3g} {unit}; " + ", ".join(parts)
 
 
-def _violations(axes: Sequence[Axes], steps: Sequence[TrackedStep], joint: str, label: bool) -> None:
-    """Mark a joint's violations on `axes` (position, then error panels); return None.
+def _violations(
+    axes: Sequence[Axes], scales: Sequence[float], steps: Sequence[TrackedStep], joint: str, label: bool
+) -> None:
+    """Mark a joint's violations on `axes` (position, then error panels, each drawn times its scale); return None.
 
     A position check is a red x at the actual position and at the error; another check of
     the joint, or a time check (no joint), a red dashed line, named on top if `label`.
@@ -240,8 +276,8 @@ def _violations(axes: Sequence[Axes], steps: Sequence[TrackedStep], joint: str, 
         for mark in step.marks:
             if mark.joint == joint and mark.check in _POSITION_CHECKS:
                 values = (mark.actual, mark.error) if len(axes) == 2 else (mark.error,)
-                for axis, value in zip(axes, values, strict=True):
-                    axis.plot([mark.time_s], [value], "x", color=_VIOLATION, ms=9, mew=2, zorder=5)
+                for axis, value, scale in zip(axes, values, scales, strict=True):
+                    axis.plot([mark.time_s], [value * scale], "x", color=_VIOLATION, ms=9, mew=2, zorder=5)
             elif mark.joint in (joint, ""):
                 for axis in axes:
                     axis.axvline(mark.time_s, color=_VIOLATION, ls="--", lw=1.2)

@@ -20,8 +20,7 @@ from numpy.typing import NDArray
 
 from ...bag import PlanFile
 from ...control import SCAN_ROWS, SampleSource, Violation, in_controller_order, position_error
-from ...errors import InputError, UsageError
-from ...trajectory import PointBefore, peak_rates, sample
+from ...trajectory import PointBefore, sample
 from .._plan_files import plan_config
 from ..execution import (
     CheckedRecording,
@@ -32,95 +31,17 @@ from ..execution import (
     check,
     execute,
 )
-from ._figures import PlanCurves, plan_figure, write_png
+from ._figures import position_units, step_budget, write_png
 from ._tracking import TrackedStep, Tracking, ViolationMark, tracking_figure
 
 if TYPE_CHECKING:
-    from ...config import ControllerConfig, RobotConfig
+    from ...config import ControllerConfig
     from ...control import CheckReport, ExecutionReport, StepCheck
     from ...types import JointTrajectory, TfSamples
 
 __all__ = [
-    "POINTS_PER_SERIES", "check_plot_path", "check_plotted", "execute_plotted", "thinned", "write_plan_plot",
+    "check_plotted", "execute_plotted", "thinned",
 ]
-
-POINTS_PER_SERIES = 5000
-"""About how many samples per joint a plot keeps of each series, whatever the length of the run."""
-
-_MIN_STEP_POINTS = 200
-
-
-def check_plot_path(path: Path, flag: str = "--plot") -> None:
-    """Refuse a plot path before any work: it must name a .png file in an existing folder; return None.
-
-    Raises:
-        UsageError: The name does not end in .png.
-        InputError: Its folder does not exist (as -o's "cannot write", exit 3).
-
-    """
-    if path.suffix.lower() != ".png":
-        raise UsageError(f"{flag} '{path}': expected a file name ending in .png (the plot is a PNG image)")
-    if not path.parent.is_dir():
-        raise InputError(f"{flag} '{path}': cannot write: folder '{path.parent}' does not exist")
-
-
-def write_plan_plot(plan: PlanFile | None, source: Path, path: Path) -> None:
-    """Write a PNG of a plan's joints (position, velocity, acceleration against their limits) to `path`; return None.
-
-    `plan` is the plan read from `source`, None if `source` is no plan file.
-
-    Raises:
-        UsageError: `source` is not a moveplan plan file.
-        InputError: `path` cannot be written.
-
-    """
-    if plan is None:
-        raise UsageError(f"--plot: {source} is not a moveplan plan file; --plot draws the joints of a plan")
-    config = plan_config(plan, source)
-    joints = plan.steps[0].trajectory.joint_names
-    total = sum(step.trajectory.duration_s for step in plan.steps)
-    times, positions, velocities, accelerations, knots, knot_positions = [], [], [], [], [], []
-    for step in plan.steps:
-        trajectory = step.trajectory
-        count = _step_budget(trajectory.duration_s, total)
-        since = np.union1d(np.linspace(0.0, trajectory.duration_s, count), trajectory.times_s)
-        p, v, a = sample(trajectory, since)
-        times.append(step.start_s + since)
-        positions.append(p)
-        velocities.append(v)
-        accelerations.append(a)
-        knots.append(step.start_s + trajectory.times_s)
-        knot_positions.append(trajectory.positions)
-    limits = {j: dict(plan.limits.get(j, {})) for j in joints}
-    for j in joints:
-        if j in config.limits and config.limits[j].continuous:  # its ±pi bounds are no limits
-            limits[j].pop("lower", None)
-            limits[j].pop("upper", None)
-    peaks = _peak_shares(plan)
-    curves = PlanCurves(
-        title=f"moveplan inspect {source.name}: {plan.robot_name} / {plan.group}, {len(plan.steps)} steps, "
-              f"{total:.2f} s; peak velocity {peaks[0]:.0%}, acceleration {peaks[1]:.0%} of the limits",
-        joints=joints, units=_units(config, joints), steps=tuple((s.name, s.start_s, s.trajectory.duration_s)
-                                                               for s in plan.steps),
-        times_s=np.concatenate(times), positions=np.concatenate(positions), velocities=np.concatenate(velocities),
-        accelerations=np.concatenate(accelerations), knots_s=np.concatenate(knots),
-        knot_positions=np.concatenate(knot_positions), limits=limits,
-    )
-    write_png(plan_figure(curves), path)
-
-
-def _peak_shares(plan: PlanFile) -> tuple[float, float]:
-    """Return the plan's largest velocity and acceleration as shares of the joint's limit, over joints and steps."""
-    shares = [0.0, 0.0]
-    for step in plan.steps:
-        for which, peaks in enumerate(peak_rates(step.trajectory)):
-            key = ("max_velocity", "max_acceleration")[which]
-            for joint, peak in zip(step.trajectory.joint_names, peaks, strict=True):
-                limit = plan.limits.get(joint, {}).get(key, 0.0)
-                if limit > 0.0:
-                    shares[which] = max(shares[which], float(peak) / limit)
-    return shares[0], shares[1]
-
 
 def execute_plotted(
     request: ExecuteRequest, plot: Path, output: Path | None = None, distro: str = "jazzy"
@@ -190,7 +111,7 @@ class _ExecutionPlot:
         """Keep the step's samples, decimated, on the execution's timeline; return None."""
         step = self._plan.steps[len(self._steps)]
         planned = step.trajectory.duration_s
-        every = _every(len(report.times_s), _step_budget(planned, self._total))
+        every = _every(len(report.times_s), step_budget(planned, self._total))
         series = thinned(report.times_s + self._offset_s, report.reference_positions, report.actual_positions,
                           report.error, every, last=True)
         self._steps.append(TrackedStep(step.name, self._offset_s, planned, self._offset_s + report.duration_s,
@@ -205,7 +126,7 @@ class _ExecutionPlot:
                  f"of {len(self._plan.steps)} steps in {execution.duration_s:.3f} s\n"
                  f"{_shortened(execution.result.message)}" + ("" if last.report.ok else f" (step '{last.name}')"))
         config = plan_config(self._plan, self._source)
-        write_png(tracking_figure(_tracking(title, controller, _units(config, controller.joints), self._steps)),
+        write_png(tracking_figure(_tracking(title, controller, position_units(config, controller.joints), self._steps)),
                   self._plot)
         self.written = True
 
@@ -246,12 +167,12 @@ def _checked_tracking(checked: CheckedRecording, request: CheckRequest) -> Track
     for step, planned in zip(steps, plan.steps, strict=False):
         trajectory = in_controller_order(planned.trajectory, controller)
         tracked.append(_recorded_step(samples, columns, continuous, step, trajectory, origin,
-                                      _step_budget(step.duration_s, total)))
+                                      step_budget(step.duration_s, total)))
     verdict = "within tolerances" if report.ok else report.result.name
     title = (f"moveplan check-tolerances {request.plan.name} {request.recording.name}: {verdict}{which}; "
              f"t = 0 is {round(origin, 3) + 0.0:.3f} s into the recording\n{_shortened(report.result.message)}")
     config = plan_config(plan, request.plan)
-    return _tracking(title, controller, _units(config, controller.joints), tracked)
+    return _tracking(title, controller, position_units(config, controller.joints), tracked)
 
 
 def _drawn_steps(report: CheckReport) -> tuple[Sequence[StepCheck], str]:
@@ -314,12 +235,6 @@ def _every(count: int, budget: int) -> int:
     return max(1, math.ceil(count / max(budget, 1)))
 
 
-def _step_budget(duration_s: float, total_s: float) -> int:
-    """Return the samples a step of `duration_s` [s] keeps: its share of POINTS_PER_SERIES, never very few."""
-    share = duration_s / total_s if total_s > 0.0 else 1.0
-    return max(_MIN_STEP_POINTS, int(POINTS_PER_SERIES * share))
-
-
 _Series = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
                 NDArray[np.float64], NDArray[np.float64]]
 """Times, reference, actual, error, error min and error max of kept samples."""
@@ -360,12 +275,6 @@ def _tracking(title: str, controller: ControllerConfig, units: Sequence[str], st
         goal_time_s=controller.goal_time_s,
         period_s=1.0 / controller.update_rate_hz,
     )
-
-
-def _units(config: RobotConfig, joints: Sequence[str]) -> tuple[str, ...]:
-    """Return per joint its position unit: m for a prismatic joint, else rad."""
-    kinds = config.urdf_joints
-    return tuple("m" if j in kinds and kinds[j].type == "prismatic" else "rad" for j in joints)
 
 
 def _shortened(message: str, length: int = 150) -> str:

@@ -6,9 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ...bag import atomic_file
 from ...control import JointTuning
 from ..tuning import TuneResult
+from ._figures import write_png
 
 __all__ = ["write_tuning_plot"]
 
@@ -19,13 +19,14 @@ def write_tuning_plot(result: TuneResult, path: Path) -> None:
     Raises:
         InputError: `path` cannot be written.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")  # files only; never a window
-    from matplotlib import pyplot
+    from matplotlib.figure import Figure
 
     rows = max(1, len(result.joints))
-    figure, axes = pyplot.subplots(rows, 1, figsize=(12, 2.6 * rows + 0.6), squeeze=False)
+    height = 2.6 * rows + 0.6
+    # Margins fixed in inches (title; the last time axis) rather than by tight_layout, which draws everything twice.
+    figure = Figure(figsize=(12, height))
+    axes = figure.subplots(rows, 1, squeeze=False, gridspec_kw={
+        "left": 0.07, "right": 0.975, "top": 1.0 - 0.75 / height, "bottom": 0.55 / height, "hspace": 0.42})
     for axis, tuning in zip(axes[:, 0], result.joints, strict=False):
         setup = tuning.setup
         chosen = [s for s in tuning.stages if s.chosen and s.trace is not None]
@@ -55,13 +56,9 @@ def write_tuning_plot(result: TuneResult, path: Path) -> None:
         axis.legend(fontsize="x-small", loc="upper right", ncol=2)
     axes[-1, 0].set_xlabel("time since the bump [s]")
     verdict = "verified" if result.ok else "NOT verified"
-    figure.suptitle(f"tune-pid {result.controller}: {verdict} ({result.verification.result.name})", fontsize=11)
-    figure.tight_layout(rect=(0.0, 0.0, 1.0, 0.98))
-    try:
-        with atomic_file(path) as stream:
-            figure.savefig(stream, format="png", dpi=100)
-    finally:
-        pyplot.close(figure)
+    figure.suptitle(f"tune-pid {result.controller}: {verdict} ({result.verification.result.name})", fontsize=11,
+                    y=1.0 - 0.1 / height, va="top")
+    write_png(figure, path)
 
 
 def _shown_s(tuning: JointTuning) -> float:
