@@ -33,13 +33,16 @@ def tuning_summary(result: TuneResult, plot: Path | None, as_json: bool, quiet: 
     rows = table(f"tune-pid {document['controller']} ({document['interface']}): the response each stage chose to a "
                  "bump of the joint at rest", ("joint", "stage", "p", "i", "d", "osc", "decay", "overshoot [rad]",
                                                "settle [s]", "why"), left=2)
+    rows.columns[-1].justify = "left"  # the reason is text
     for joint, tuned in document["joints"].items():
         for number, stage in enumerate(s for s in tuned["stages"] if s["chosen"]):
             g, r = stage["gains"], stage["response"]
             settle = "-" if r["settling_time_s"] is None else f"{r['settling_time_s']:.3f}"
+            # A diverged response has no decay or overshoot to give (JSON null): say why, not "inf/nan".
+            decay, overshoot = (("diverged", "diverged") if r["diverged"] else
+                                (_number(r["decay_ratio"], ".2f"), _number(r["overshoot"], ".1e")))
             rows.add_row(joint if number == 0 else "", stage["stage"], f"{g['p']:.4g}", f"{g['i']:.4g}",
-                         f"{g['d']:.4g}", str(r["oscillations"]), _number(r["decay_ratio"], ".2f"),
-                         _number(r["overshoot"], ".1e"), settle, escape(stage["note"]),
+                         f"{g['d']:.4g}", str(r["oscillations"]), decay, overshoot, settle, escape(stage["note"]),
                          end_section=stage["stage"] == "final")
     show(rows)
     verification = document["verification"]

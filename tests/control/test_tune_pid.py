@@ -147,6 +147,22 @@ def test_text_report_is_a_table_of_stages_and_the_verification(cli: Cli, tmp_pat
     assert "verification" in result.stdout and "SUCCESSFUL" in result.stdout and "ringing: none" in result.stdout
 
 
+def test_a_diverging_start_reads_diverged_not_inf_or_nan(cli: Cli, tmp_path: Path) -> None:
+    result = cli("tune-pid", UR_PLAN, "--controllers", SAMPLES / "ur10e_mistuned_controllers.yaml",
+                 "-o", tmp_path / "t.yaml", "--joints", "elbow_joint")
+    start = next(line for line in result.stdout.splitlines() if "the file's gains" in line)
+    assert "decay diverged" in start and "overshoot [rad] diverged" in start
+    assert "inf" not in result.stdout and "nan" not in result.stdout
+
+
+def test_tuning_from_zero_gains_keeps_the_file_s_i_clamp(cli: Cli, tmp_path: Path) -> None:
+    zero = tmp_path / "zero.yaml"
+    zero.write_text((DATA / "ur10e_zero_gains_controllers.yaml").read_text().replace("i_clamp: 0.0", "i_clamp: 0.05"))
+    assert "i_clamp: 0.05" in zero.read_text()
+    tuned, _ = tuned_then_executed(cli, UR_PLAN, zero, tmp_path / "t.yaml")
+    assert all(entry["gains"]["i_clamp"] == 0.05 for entry in tuned["joints"].values())
+
+
 def test_plot_is_a_png_with_a_panel_per_joint(cli: Cli, tmp_path: Path) -> None:
     plot = tmp_path / "tune.png"
     result = cli("tune-pid", UR_PLAN, "--controllers", DATA / "ur10e_p150_controllers.yaml",
