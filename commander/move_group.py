@@ -39,16 +39,17 @@ from ..core.config import (
     StepSpec,
     arc_point,
     default_position,
+    parse_goal_tolerances,
     path_constraints,
     pose_matrix,
 )
 from ..core.control import ExecutionSummary
-from ..core.errors import NoPlan, UnknownName, UsageError
+from ..core.errors import ConfigError, NoPlan, UnknownName, UsageError
 from ..core.model import solve_ik
 from ..core.pipeline import cartesian_motion, execute_motion, plan_motion
 from ..core.planning import joint_target, tip_target
 from ..core.timing import time_parameterize
-from ..core.types import StepResult
+from ..core.types import GoalTolerances, StepResult
 from ._messages import state_message
 from ._objects import attach_existing, detach
 from ._settings import PlanningSettings, real_number, scaling
@@ -448,17 +449,25 @@ class MoveGroupCommander(PlanningSettings):
         success, trajectory, _, _ = self.plan(joints)
         return success and self.execute(trajectory, wait)
 
-    def execute(self, plan_msg: Any, wait: bool = True) -> bool:
+    def execute(self, plan_msg: Any, wait: bool = True, tolerances: Any = None) -> bool:
         """Return True if executing a trajectory on the simulated controller succeeded; the robot moves either way.
 
         The robot ends where the execution did (also on a path violation); a trajectory that
         does not start where the robot is gets refused and moves nothing. Executions are
         synchronous: `wait` is accepted and unused. get_execution_report() says what happened.
+
+        `tolerances` (moveplan's, not MoveIt's: MoveIt 2 sends none) are those the
+        FollowJointTrajectory goal carries to the controller: a control_msgs goal (its
+        path_tolerance, goal_tolerance and goal_time_tolerance) or a mapping of those keys,
+        as a task step's `tolerances`. They replace the controller's for this execution and
+        travel with it into a saved plan, where check-tolerances applies them.
         """
         step = from_message(plan_msg, self._robot.joint_names, "execute")
+        if tolerances is not None:
+            step = replace(step, tolerances=_goal_tolerances(tolerances))
         world = self._world
         start = {j: world.joint_value(j) for j in step.trajectory.joint_names}
-        report = execute_motion(world.config, step.trajectory, start, world.execution, "execute")
+        report = execute_motion(world.config, step.trajectory, start, world.execution, "execute", step.tolerances)
         self._last = report.summary()
         if len(report.times_s):
             ended = world.with_joints(dict(zip(report.joint_names, report.actual_positions[-1].tolist(), strict=True)))
@@ -490,7 +499,7 @@ class MoveGroupCommander(PlanningSettings):
         timed = time_parameterize(names, given.positions[:, order], self._robot.max_velocity[index] * velocity,
                                   self._robot.max_acceleration[index] * acceleration)
         step = StepResult(name="retimed", goal={"trajectory": {"points": len(given.times_s)}}, planner="given",
-                          planning_time_s=0.0, trajectory=timed)
+                          planning_time_s=0.0, trajectory=timed, scaling=(velocity, acceleration))
         return to_message(step, self.get_planning_frame())
 
     def compute_cartesian_path(
@@ -676,6 +685,27 @@ class MoveGroupCommander(PlanningSettings):
             logger.warning("plan: %s", exc)
             return None, exc, time.perf_counter() - began
         return step, None, step.planning_time_s
+
+
+def _goal_tolerances(value: Any) -> GoalTolerances:
+    """Return the tolerances of a control_msgs FollowJointTrajectory goal, or of a mapping of its three fields.
+
+    Raises:
+        UsageError: Neither, or a field that is no list of JointTolerance (name, position,
+            velocity, acceleration) or no duration; the message begins with "execute: tolerances".
+    """
+    if hasattr(value, "path_tolerance") or hasattr(value, "goal_tolerance"):
+        def joints(items: Any) -> list[dict[str, Any]]:
+            keys = ("name", "position", "velocity", "acceleration")
+            return [{key: getattr(item, key) for key in keys if hasattr(item, key)} for item in items or ()]
+        seconds = getattr(value, "goal_time_tolerance", 0.0)
+        value = {"path_tolerance": joints(getattr(value, "path_tolerance", ())),
+                 "goal_tolerance": joints(getattr(value, "goal_tolerance", ())),
+                 "goal_time_tolerance": seconds.to_sec() if hasattr(seconds, "to_sec") else seconds}
+    try:
+        return parse_goal_tolerances(value, "execute: tolerances")
+    except ConfigError as exc:
+        raise UsageError(str(exc)) from exc
 
 
 def _step_name(goal: Goal) -> str:

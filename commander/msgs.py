@@ -22,8 +22,8 @@ from ..core.errors import UsageError
 
 __all__ = [
     "AllowedCollisionEntry", "AllowedCollisionMatrix", "AttachedCollisionObject", "BoundingVolume", "CollisionObject",
-    "ColorRGBA", "Constraints", "DeserializationError", "DisplayTrajectory", "Duration", "Header", "JointConstraint",
-    "JointState", "JointTrajectory", "JointTrajectoryPoint", "Marker", "MarkerArray", "Mesh", "MeshTriangle",
+    "ColorRGBA", "Constraints", "DeserializationError", "DisplayTrajectory", "Duration", "FollowJointTrajectoryGoal",
+    "Header", "JointConstraint", "JointState", "JointTolerance", "JointTrajectory", "JointTrajectoryPoint", "Marker", "MarkerArray", "Mesh", "MeshTriangle",
     "Message", "MoveItErrorCodes", "MultiDOFJointState", "MultiDOFJointTrajectory", "ObjectColor",
     "OrientationConstraint", "Plane", "PlanningScene", "PlanningSceneComponents", "PlanningSceneWorld", "Point",
     "PointStamped", "Pose", "PoseArray", "PoseStamped", "PositionConstraint", "Quaternion", "RobotState",
@@ -500,6 +500,26 @@ class RobotTrajectory(Message):
 
     joint_trajectory: JointTrajectory = field(default_factory=JointTrajectory)
     multi_dof_joint_trajectory: MultiDOFJointTrajectory = field(default_factory=MultiDOFJointTrajectory)
+
+
+@dataclass
+class JointTolerance(Message):
+    """control_msgs/JointTolerance: > 0 replaces the controller's tolerance, 0 keeps it, -1 erases it."""
+
+    name: str = ""
+    position: float = 0.0
+    velocity: float = 0.0
+    acceleration: float = 0.0
+
+
+@dataclass
+class FollowJointTrajectoryGoal(Message):
+    """control_msgs/FollowJointTrajectoryGoal: a trajectory and the tolerances the controller applies to it."""
+
+    trajectory: JointTrajectory = field(default_factory=JointTrajectory)
+    path_tolerance: list[JointTolerance] = field(default_factory=list)
+    goal_tolerance: list[JointTolerance] = field(default_factory=list)
+    goal_time_tolerance: Duration = field(default_factory=Duration)
 
 
 @dataclass

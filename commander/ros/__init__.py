@@ -11,6 +11,7 @@ A script ports by prefixing its ROS imports (moveit_commander itself is moveplan
     import moveit_commander                       from moveplan import commander as moveit_commander
 
 Packages: rospy, rostest, genpy, tf (transformations), tf2_ros, and the messages of std_msgs,
-geometry_msgs, sensor_msgs, trajectory_msgs, shape_msgs, moveit_msgs and visualization_msgs;
+geometry_msgs, sensor_msgs, trajectory_msgs, shape_msgs, moveit_msgs, visualization_msgs and
+control_msgs;
 moveit_ros_planning_interface's MoveGroupInterface, the C++ binding moveit_commander wraps.
 """

@@ -39,6 +39,7 @@ if TYPE_CHECKING:
         read_input,
         read_input_text,
     )
+    from .goal_tolerances import parse_goal_tolerances
     from .goals import SHIFT_AXES, Goal, JointGoal, NamedGoal, PoseGoal, ShiftGoal, Start, StartFrom
     from .joint_units import check_joint_units
     from .launch_files import LaunchFiles, launch_arguments
@@ -137,6 +138,7 @@ __all__ = [
     "mesh_file",
     "number",
     "parse_controllers",
+    "parse_goal_tolerances",
     "parse_planning_scene",
     "parse_scene",
     "parse_scene_text",
@@ -223,6 +225,7 @@ __getattr__ = lazy_exports(__name__, {
     "mesh_file": "meshes",
     "number": "fields",
     "parse_controllers": "controllers",
+    "parse_goal_tolerances": "goal_tolerances",
     "parse_planning_scene": "planning_scene_yaml",
     "parse_scene": "scene_yaml",
     "parse_scene_text": "scene_text",

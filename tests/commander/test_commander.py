@@ -17,6 +17,7 @@ from moveplan import commander as moveit_commander
 from moveplan.commander.conversions import pose_to_list
 from moveplan.commander.msgs import JointState, MoveItErrorCodes, Pose, PoseStamped, RobotState, TransformStamped
 from moveplan.commander.ros import rospy, tf2_ros
+from moveplan.commander.ros.control_msgs.msg import FollowJointTrajectoryGoal, JointTolerance
 from moveplan.commander.ros.tf.transformations import euler_from_quaternion, quaternion_from_euler
 from moveplan.core.bag import read_plan
 from moveplan.core.config import load_task
@@ -317,6 +318,27 @@ def test_an_edited_trajectory_executes_as_given(group: moveit_commander.MoveGrou
     trajectory.joint_trajectory.joint_names[0] = "elbow"
     with pytest.raises(UsageError, match="execute: joint_names .* expected distinct joints of the group"):
         group.execute(trajectory)
+
+
+def test_tolerances_sent_with_execute_replace_the_controller_s_and_are_saved(cli: Cli, tmp_path: Path) -> None:
+    """JTC's get_segment_tolerances (test_tolerances.cpp): > 0 replaces the controller's tolerance, -1 erases it."""
+    robot = moveit_commander.RobotCommander("ur10e", plant="lag", plant_params={"tau": 0.05})
+    group = moveit_commander.MoveGroupCommander("manipulator")
+    target = [0.5, -1.2, -1.8, 0.0, 1.57, 0.0]
+    tight = FollowJointTrajectoryGoal(goal_tolerance=[JointTolerance(name="elbow_joint", position=1e-6)],
+                                      goal_time_tolerance=rospy.Duration(0.001))
+    assert group.execute(group.plan(target)[1], tolerances=tight) is False
+    assert group.get_execution_report().result.name == "GOAL_TOLERANCE_VIOLATED"
+    assert group.go("home")
+    erased = {"goal_tolerance": [{"name": "elbow_joint", "position": -1}]}
+    assert group.execute(group.plan(target)[1], tolerances=erased) is True
+    out = tmp_path / "session.mcap"
+    robot.save(out)
+    assert [s.tolerances.goal[0].position if s.tolerances else None for s in read_plan(out).steps] == [1e-6, None, -1.0]
+    with pytest.raises(UsageError, match=r"^execute: tolerances\.goal_tolerance\[0\]"):
+        group.execute(group.plan("home")[1], tolerances={"goal_tolerance": [{"nme": "elbow_joint"}]})
+    with pytest.raises(UsageError, match=r"^execute: tolerances: expected a mapping"):
+        group.execute(group.plan("home")[1], tolerances=5)
 
 
 # Cartesian paths
