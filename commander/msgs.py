@@ -23,11 +23,12 @@ from ..core.errors import UsageError
 __all__ = [
     "AllowedCollisionEntry", "AllowedCollisionMatrix", "AttachedCollisionObject", "BoundingVolume", "CollisionObject",
     "ColorRGBA", "Constraints", "DeserializationError", "DisplayTrajectory", "Duration", "FollowJointTrajectoryGoal",
-    "Header", "JointConstraint", "JointState", "JointTolerance", "JointTrajectory", "JointTrajectoryPoint", "Marker", "MarkerArray", "Mesh", "MeshTriangle",
-    "Message", "MoveItErrorCodes", "MultiDOFJointState", "MultiDOFJointTrajectory", "ObjectColor",
-    "OrientationConstraint", "Plane", "PlanningScene", "PlanningSceneComponents", "PlanningSceneWorld", "Point",
-    "PointStamped", "Pose", "PoseArray", "PoseStamped", "PositionConstraint", "Quaternion", "RobotState",
-    "RobotTrajectory", "SolidPrimitive", "String", "Time", "Transform", "TransformStamped", "Twist", "Vector3", "plain",
+    "Header", "JointConstraint", "JointState", "JointTolerance", "JointTrajectory", "JointTrajectoryPoint", "Marker",
+    "MarkerArray", "Mesh", "MeshTriangle", "Message", "MoveItErrorCodes", "MultiDOFJointState",
+    "MultiDOFJointTrajectory", "ObjectColor", "OrientationConstraint", "Plane", "PlanningScene",
+    "PlanningSceneComponents", "PlanningSceneWorld", "Point", "PointStamped", "Pose", "PoseArray", "PoseStamped",
+    "PositionConstraint", "Quaternion", "RobotState", "RobotTrajectory", "SolidPrimitive", "String", "Time",
+    "Transform", "TransformStamped", "Twist", "Vector3", "plain",
 ]
 
 
