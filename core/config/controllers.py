@@ -85,6 +85,8 @@ class ControllerConfig:
     gains: dict[str, dict[str, float]]
     allow_nonzero_velocity_at_trajectory_end: bool = False
     """Jazzy's default (false): JTC refuses a goal whose last point still moves."""
+    allow_partial_joints_goal: bool = False
+    """JTC's default (false): a goal must name every joint; true: the joints it leaves out hold where they are."""
 
 
 @dataclass(frozen=True)
@@ -314,6 +316,8 @@ def _joint_trajectory_controller(
         allow_nonzero_velocity_at_trajectory_end=boolean(
             params.get("allow_nonzero_velocity_at_trajectory_end", False),
             f"{where}.allow_nonzero_velocity_at_trajectory_end"),
+        allow_partial_joints_goal=boolean(params.get("allow_partial_joints_goal", False),
+                                          f"{where}.allow_partial_joints_goal"),
     )
 
 

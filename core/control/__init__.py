@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     from .releases import DEFAULT_RELEASE, fills_point_before
     from .results import ExecutionResult, ExecutionSummary, Violation
     from .step_tracking import recorded_tracking, sample_index, simulated_tracking
-    from .tolerances import in_controller_order, position_error, unchecked_joints
+    from .tolerances import check_goal_joints, in_controller_order, position_error, unchecked_joints
     from .tuning import Gains, JointSetup, JointTuning, tune_joint
 
 __all__ = [
@@ -62,6 +62,7 @@ __all__ = [
     "controller_states",
     "fills_point_before",
     "fit_plant",
+    "check_goal_joints",
     "in_controller_order",
     "make_plant",
     "merged_margins",
@@ -106,6 +107,7 @@ __getattr__ = lazy_exports(__name__, {
     "controller_states": "published",
     "fills_point_before": "releases",
     "fit_plant": "plants",
+    "check_goal_joints": "tolerances",
     "in_controller_order": "tolerances",
     "make_plant": "plants",
     "merged_margins": "margins",

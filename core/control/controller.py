@@ -173,7 +173,10 @@ def simulate(
         goal_tolerances: Tolerances the goal carries, replacing the controller's for it
             (tolerances.goal_segment_tolerances).
     """
-    trajectory = in_controller_order(trajectory, controller)
+    hold = None if start_positions is None else np.asarray(start_positions, dtype=np.float64)
+    if hold is not None and len(hold) != len(controller.joints):
+        hold = None  # the trajectory's joints only: no joint is left out to hold
+    trajectory = in_controller_order(trajectory, controller, hold)
     joints = trajectory.joint_names
     names = set(continuous_joints)
     continuous = np.array([j in names for j in joints])

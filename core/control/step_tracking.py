@@ -88,11 +88,12 @@ def recorded_tracking(
         return report
     later = [c.start_s for c in report.cycles if cycle is not None and c.start_s > cycle.start_s]
     goal = np.array([controller.goal_tolerance[j] for j in controller.joints])
+    hold = samples.read_positions(0, 1)[0] if samples.count else None  # where joints a partial goal leaves out stay
     tracked = []
     for number, step in enumerate(steps):
         last = number + 1 == len(steps)
         end_s = step.start_s + step.duration_s + HOLD_S if last else steps[number + 1].start_s
-        trajectory = in_controller_order(trajectories[number], controller)
+        trajectory = in_controller_order(trajectories[number], controller, hold)
         figures = _recorded_step(step, trajectory, samples, min([end_s, *later]), goal, continuous)
         tracked.append(replace(step, report=replace(step.report, tracking=figures)))
     if cycle is None:

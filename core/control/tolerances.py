@@ -24,6 +24,7 @@ __all__ = [
     "ERASE",
     "SegmentTolerances",
     "StateTolerance",
+    "check_goal_joints",
     "check_state_tolerance_per_joint",
     "goal_segment_tolerances",
     "in_controller_order",
@@ -126,25 +127,55 @@ def velocity_error_computable(controller: ControllerConfig) -> bool:
 
 
 def in_controller_order(
-    trajectory: JointTrajectory, controller: ControllerConfig
+    trajectory: JointTrajectory, controller: ControllerConfig, hold: NDArray[np.float64] | None = None
 ) -> JointTrajectory:
-    """Return the trajectory with columns in the controller's joint order, as JTC sorts goals."""
-    for joint in trajectory.joint_names:
-        if joint not in controller.joints:
-            raise UnknownName("joint", joint, f"controller '{controller.name}'", controller.joints)
-    missing = [j for j in controller.joints if j not in trajectory.joint_names]
-    if missing:
-        raise InputError(
-            f"Joints on incoming trajectory don't match the controller joints: controller "
-            f"'{controller.name}' also has {', '.join(missing)} (partial goals are not allowed)"
-        )
+    """Return the trajectory with columns in the controller's joint order, as JTC sorts goals.
+
+    A goal leaving joints out is refused, unless the controller has allow_partial_joints_goal:
+    then each joint left out holds at `hold` (the robot's positions, in the controller's
+    order), with zero velocity and acceleration, as JTC's fill_partial_goal fills it.
+
+    Raises:
+        UnknownName: A joint the controller does not drive.
+        InputError: Joints left out, and partial goals not allowed (or `hold` not given).
+    """
+    missing = check_goal_joints(trajectory.joint_names, controller)
+    if missing and hold is None:
+        raise InputError(f"Joints on incoming trajectory don't match the controller joints: controller "
+                         f"'{controller.name}' also has {', '.join(missing)} (the robot's positions to hold "
+                         "them at are not known here)")
     if trajectory.joint_names == controller.joints:
         return trajectory
-    order = [trajectory.joint_names.index(j) for j in controller.joints]
-    return JointTrajectory(
-        controller.joints, trajectory.times_s, trajectory.positions[:, order],
-        trajectory.velocities[:, order], trajectory.accelerations[:, order],
-    )
+    count = len(trajectory.times_s)
+    columns = []
+    for k, joint in enumerate(controller.joints):
+        if joint in trajectory.joint_names:
+            index = trajectory.joint_names.index(joint)
+            columns.append((trajectory.positions[:, index], trajectory.velocities[:, index],
+                            trajectory.accelerations[:, index]))
+        else:
+            assert hold is not None
+            columns.append((np.full(count, float(hold[k])), np.zeros(count), np.zeros(count)))
+    positions, velocities, accelerations = (np.stack([c[i] for c in columns], axis=1) for i in range(3))
+    return JointTrajectory(controller.joints, trajectory.times_s, positions, velocities, accelerations,
+                           has_velocities=trajectory.has_velocities, has_accelerations=trajectory.has_accelerations)
+
+
+def check_goal_joints(joints: Sequence[str], controller: ControllerConfig) -> list[str]:
+    """Return the controller's joints a goal naming `joints` leaves out, if JTC accepts such a goal.
+
+    Raises:
+        UnknownName: A joint the controller does not drive.
+        InputError: Joints left out and the controller does not allow partial goals (JTC's message).
+    """
+    for joint in joints:
+        if joint not in controller.joints:
+            raise UnknownName("joint", joint, f"controller '{controller.name}'", controller.joints)
+    missing = [j for j in controller.joints if j not in joints]
+    if missing and not controller.allow_partial_joints_goal:
+        raise InputError(f"Joints on incoming trajectory don't match the controller joints: controller "
+                         f"'{controller.name}' also has {', '.join(missing)} (partial goals are not allowed)")
+    return missing
 
 
 def unchecked_joints(controller: ControllerConfig) -> dict[str, tuple[str, ...]]:

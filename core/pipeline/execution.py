@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 from .. import bag as recording
 from ..bag import open_joint_states
-from ..config import ControllerConfig, ExecutionConfig, JointGoal, RobotConfig, check_joint_units
+from ..config import ControllerConfig, JointGoal, RobotConfig, check_joint_units
 from ..control import (
     DEFAULT_RELEASE,
     CheckReport,
@@ -29,6 +29,7 @@ from ..control import (
     RecordingStart,
     SampleSource,
     Violation,
+    check_goal_joints,
     check_recording,
     fills_point_before,
     merged_margins,
@@ -197,7 +198,7 @@ def execute(
                                  request.strict)
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
     plant = configured_plant(config, request.plant, request.plant_params, controller, continuous)
-    reports = _simulated_steps(request, plan, controller, config.execution, plant, continuous)
+    reports = _simulated_steps(request, plan, controller, config, plant, continuous)
     robot = None
     if record is not None and link_poses:
         # pinocchio is imported here, not at the top: check-tolerances shares this module and needs no kinematics.
@@ -233,7 +234,7 @@ def _simulated_steps(
     request: ExecuteRequest,
     plan: recording.PlanFile,
     controller: ControllerConfig,
-    execution: ExecutionConfig,
+    config: RobotConfig,
     plant: Plant,
     continuous: list[str],
 ) -> Iterator[tuple[str, ExecutionReport, dict[str, JointTracking]]]:
@@ -243,7 +244,7 @@ def _simulated_steps(
     """
     from ..control import Disturbance, simulate
 
-    start = _start_positions(request, plan, controller)
+    start = _start_positions(request, plan, controller, config.initial_positions)
     goal = np.array([controller.goal_tolerance[j] for j in controller.joints])
     wraps = np.array([j in continuous for j in controller.joints])
     for step in plan.steps:
@@ -252,7 +253,7 @@ def _simulated_steps(
         bumps = [Disturbance(d.time_s - step.start_s, d.joint, d.delta)
                  for d in request.disturbances if step.start_s <= d.time_s < end or (d.time_s >= end and last)]
         try:
-            report = simulate(step.trajectory, controller, execution, plant, continuous_joints=continuous,
+            report = simulate(step.trajectory, controller, config.execution, plant, continuous_joints=continuous,
                               start_positions=start, disturbances=bumps, seed=request.seed,
                               fill_point_before=fills_point_before(request.ros2_controllers),
                               goal_tolerances=step.tolerances)
@@ -284,14 +285,21 @@ def _step_tf(robot: Robot, report: ExecutionReport, offset_s: float) -> TfSample
 
 
 def _start_positions(
-    request: ExecuteRequest, plan: recording.PlanFile, controller: ControllerConfig
+    request: ExecuteRequest, plan: recording.PlanFile, controller: ControllerConfig, initial: Mapping[str, float]
 ) -> NDArray[np.float64] | None:
-    """Return where the simulated robot starts, in the controller's joint order (None = plan start)."""
-    if request.start_joints is None:
-        return None
+    """Return where the simulated robot starts, in the controller's joint order (None = plan start).
+
+    Joints of the controller the plan leaves out start where the fake hardware starts them
+    (`initial`): a controller allowing partial goals holds them there.
+    """
     first = plan.steps[0].trajectory
     start = dict(zip(first.joint_names, first.positions[0], strict=True))
-    for joint, value in (request.start_joints.named_values or {}).items():
+    others = {j: initial[j] for j in controller.joints if j not in start and j in initial}
+    if request.start_joints is None and not others:
+        return None
+    start.update(others)
+    named = request.start_joints.named_values if request.start_joints is not None else None
+    for joint, value in (named or {}).items():
         if joint not in start:
             raise UnknownName("joint", joint, "--start-joints", start)
         start[joint] = value
@@ -312,6 +320,11 @@ def check(request: CheckRequest, then: Callable[[CheckedRecording], None] | None
     plan = read_valid_plan(request.plan)
     config = plan_config(plan, request.plan)
     controller = plan_controller(config, plan, request.plan, request.controllers, strict=request.strict)
+    for step in plan.steps:  # a goal JTC refuses is said before the recording is read
+        try:
+            check_goal_joints(step.trajectory.joint_names, controller)
+        except InputError as exc:
+            raise InputError(f"{request.plan}: step '{step.name}': {exc}") from None
     continuous = [j for j, lim in config.limits.items() if lim.continuous]
     # The samples wait on disk and are read back a window at a time: memory does not grow with the recording.
     with open_joint_states(request.recording, request.topic, joints=controller.joints,

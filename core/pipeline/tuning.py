@@ -214,7 +214,8 @@ def _recorded_steps(checked: CheckedRecording) -> list[RecordedStep]:
         first, stop = sample_index(samples, step.start_s - _FIT_BEFORE_S), sample_index(samples, end)
         if stop - first < 3:
             continue
-        trajectory = in_controller_order(checked.plan.steps[number].trajectory, checked.controller)
+        hold = samples.read_positions(0, 1)[0][columns]  # where joints a partial goal leaves out stay
+        trajectory = in_controller_order(checked.plan.steps[number].trajectory, checked.controller, hold)
         positions = samples.read_positions(first, stop)[:, columns]
         steps.append(RecordedStep(trajectory, samples.read_times(first, stop) - step.start_s, positions))
     return steps

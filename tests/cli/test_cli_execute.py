@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import SAMPLES, UR10E, Cli
+from conftest import ROOT, SAMPLES, UR10E, Cli
 
 from moveplan.core.control.results import Violation
 from moveplan.core.pipeline import execution as pipeline
@@ -249,3 +249,30 @@ def test_tolerances_a_task_step_sends_with_its_goal_are_honoured_by_execute_and_
     assert cli("plan", task, "--seed", 0, "-o", plan).exit_code == 0
     code, document = cli.json("execute", plan, "--fake", *lag)
     assert code == 0, document
+
+
+def test_a_partial_goal_holds_the_joints_it_leaves_out_where_the_controller_allows_it(cli: Cli, tmp_path: Path) -> None:
+    """test_trajectory_controller.cpp test_partial_joint_list(_not_allowed): JTC's fill_partial_goal holds them."""
+    from moveplan.core.bag.jointstates import read_joint_states
+
+    arm = (ROOT / "configs" / "panda" / "ros2_controllers.yaml").read_text()
+    assert "      - panda_joint7\n    allow_nonzero_velocity_at_trajectory_end: true\n" in arm
+    partial, strict = tmp_path / "partial.yaml", tmp_path / "strict.yaml"
+    allow = "    allow_nonzero_velocity_at_trajectory_end: true\n"
+    partial.write_text(arm.replace("      - panda_joint7\n", "      - panda_joint7\n      - panda_finger_joint1\n")
+                       .replace(allow, allow + "    allow_partial_joints_goal: true\n"))
+    strict.write_text(partial.read_text().replace("    allow_partial_joints_goal: true\n", ""))
+    plan, run = tmp_path / "arm.mcap", tmp_path / "run.mcap"
+    assert cli("plan", "--robot", "panda", "--joints", "panda_joint1=0.5,panda_joint4=-2.0", "-o", plan).exit_code == 0
+    code, document = cli.json("execute", plan, "--fake", "--controllers", partial, "-o", run)
+    assert code == 0 and document["result"]["name"] == "SUCCESSFUL", document
+    recorded = read_joint_states(run)
+    finger = recorded.positions[:, recorded.names.index("panda_finger_joint1")]
+    assert finger.min() == finger.max() == 0.0  # held where the fake hardware starts it (initial_positions)
+    code, checked = cli.json("check-tolerances", plan, run, "--controllers", partial)
+    assert code == 0 and checked["result"]["name"] == "SUCCESSFUL", checked
+    for command in (("execute", plan, "--fake"), ("check-tolerances", plan, run)):
+        refused = cli(*command, "--controllers", strict)
+        assert refused.exit_code == 3 and refused.stderr.strip() == (
+            f"moveplan: error: {plan}: step 'goal': Joints on incoming trajectory don't match the controller joints: "
+            "controller 'panda_arm_controller' also has panda_finger_joint1 (partial goals are not allowed)")

@@ -87,8 +87,10 @@ class CheckContext:
         # profiled more coarsely, not in gigabytes (a plan under about half an hour keeps 1 ms).
         total_s = sum(step.trajectory.duration_s for step in plan.steps)
         resolution = max(1e-3, total_s / PLAN_PROFILE_SAMPLES)
+        # Joints a partial goal leaves out hold where the robot is; it is taken as recorded first.
+        hold = samples.rows(0, 1)[0] if samples.count else None
         profiles = tuple(
-            StepProfile.build(step.name, in_controller_order(step.trajectory, controller),
+            StepProfile.build(step.name, in_controller_order(step.trajectory, controller, hold),
                               samples.continuous, zone, resolution)
             for step in plan.steps
         )

@@ -114,14 +114,14 @@ def time_axis(column: Sequence[Axes], low: float, high: float, bins: int = 7) ->
     a tick is a handful of artists, and drawing them is most of a figure's cost.
     """
     from matplotlib import rcParams
-    from matplotlib.ticker import MaxNLocator
+    from matplotlib.ticker import MaxNLocator, NullLocator
 
     times = [float(t) for t in MaxNLocator(nbins=bins).tick_values(low, high) if low <= t <= high]
     for axis in column:
         axis.set_xlim(low, high)
     column[-1].set_xticks(times)
     for axis in column[:-1]:
-        axis.set_xticks([])
+        axis.xaxis.set_major_locator(NullLocator())
         axis.vlines(times, 0.0, 1.0, transform=axis.get_xaxis_transform(), color=rcParams["grid.color"],
                     lw=rcParams["grid.linewidth"], alpha=0.3, zorder=0.5)
 

@@ -164,8 +164,9 @@ def _checked_tracking(checked: CheckedRecording, request: CheckRequest) -> Track
     total = sum(s.duration_s for s in steps) or 1.0
     tracked = []
     # The steps checked are the plan's, in order, from its first.
+    hold = samples.read_positions(0, 1)[0, columns] if samples.count else None  # joints a partial goal leaves out
     for step, planned in zip(steps, plan.steps, strict=False):
-        trajectory = in_controller_order(planned.trajectory, controller)
+        trajectory = in_controller_order(planned.trajectory, controller, hold)
         tracked.append(_recorded_step(samples, columns, continuous, step, trajectory, origin,
                                       step_budget(step.duration_s, total)))
     verdict = "within tolerances" if report.ok else report.result.name
