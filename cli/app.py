@@ -48,6 +48,7 @@ from .parsing import (
     parse_params,
     parse_pose,
     parse_seeds,
+    parse_shard,
     parse_shift,
     parse_time,
 )
@@ -349,7 +350,15 @@ def benchmark(
     planning_time: Annotated[str, typer.Option(
         help="Each search's budget, in seconds at 20,000 checked motions a second (not wall time).")] = "1.0",
     timeout: TimeoutOpt = None,
-    jobs: Annotated[int, typer.Option(min=1, help="Planner/seed processes run at a time (1: cleanest times).")] = 1,
+    jobs: Annotated[int, typer.Option(min=1, help="Worker processes, each taking the next (planner, seed, problem) run "
+                                      "(1: cleanest times).")] = 1,
+    shard: Annotated[str | None, typer.Option(
+        help="Run only shard K of N: every N-th problem from the K-th ('2/4'); merge the shards' --csv files "
+             "with benchmark-merge.")] = None,
+    exact_check: Annotated[bool, typer.Option(
+        "--exact-check/--no-exact-check",
+        help="Re-check every plan against the meshes at 1 mm (exact_valid); off: faster runs, exact_valid empty.")]
+        = True,
     csv: Annotated[Path | None, typer.Option(help="Write one CSV row per run here.")] = None,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG of the time distributions here.")] = None,
     package_path: PackagePathOpt = None,
@@ -375,6 +384,7 @@ def benchmark(
             summarize,
             write_csv,
         )
+        from ..core.pipeline import shard as shard_of
         from . import render
 
         check_outputs({"--csv": csv, "--plot": plot},
@@ -389,12 +399,15 @@ def benchmark(
         if timeout_s is not None:
             check_planning_time(timeout_s, "--timeout")
         found = find_problems(problems, count)
+        if shard is not None:
+            index, total = parse_shard(shard)
+            found = shard_of(found, index, total)
         source = robot_source(robot, package_path, xacro_arg, urdf, srdf, strict_limits, joint_limits, launch,
                               launch_arg, strict)
         config = source.load()
         planners = [p.strip() for text in planner or [config.motion.planner] for p in text.split(",")]
         with render.benchmark_progress(len(found) * len(planners) * len(seed_list), quiet) as advance:
-            runs = run_benchmark(source, found, planners, seed_list, time_s, jobs, advance, timeout_s)
+            runs = run_benchmark(source, found, planners, seed_list, time_s, jobs, advance, timeout_s, exact_check)
         with all_or_none() as written:
             if csv is not None:
                 write_csv(runs, csv)
@@ -403,6 +416,39 @@ def benchmark(
                 plot_benchmark(runs, plot)
                 written.append(plot)
     render.benchmark_summary(runs, summarize(runs), as_json, quiet)
+
+
+@app.command("benchmark-merge")
+def benchmark_merge(
+    runs: Annotated[list[Path], typer.Argument(help="The --csv files of benchmark runs (one benchmark's shards).")],
+    csv: Annotated[Path | None, typer.Option(help="Write every run, one CSV row each, here.")] = None,
+    plot: Annotated[Path | None, typer.Option(help="Write a PNG of the time distributions here.")] = None,
+    as_json: JsonOpt = False,
+    quiet: QuietOpt = False,
+) -> None:
+    """Merge the runs of benchmark shards (their --csv files) into one summary, as benchmark prints it."""
+    setup_logging(False, quiet)
+    with exit_codes(as_json):
+        from ..core.errors import InputError
+        from ..core.pipeline import plot_benchmark, read_runs, summarize, write_csv
+        from . import render
+
+        check_outputs({"--csv": csv, "--plot": plot}, {"RUNS": runs})
+        if plot is not None:
+            from ..core.pipeline import check_plot_path
+
+            check_plot_path(plot)
+        merged = read_runs(runs)
+        if not merged:
+            raise InputError(f"{', '.join(map(str, runs))}: no benchmark run in these files")
+        with all_or_none() as written:
+            if csv is not None:
+                write_csv(merged, csv)
+                written.append(csv)
+            if plot is not None:
+                plot_benchmark(merged, plot)
+                written.append(plot)
+    render.benchmark_summary(merged, summarize(merged), as_json, quiet)
 
 
 app.command("state")(state_command.state)

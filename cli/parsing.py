@@ -19,7 +19,7 @@ if TYPE_CHECKING:  # imported where used: `moveplan --help` loads no config code
 __all__ = [
     "MAX_SEED", "MAX_SEEDS", "parse_angle", "parse_disturbance", "parse_joint_values",
     "parse_joints", "parse_number", "parse_optional", "parse_params", "parse_pose", "parse_pose_angle", "parse_seeds",
-    "parse_shift", "parse_time",
+    "parse_shard", "parse_shift", "parse_time",
 ]
 
 _T = TypeVar("_T")
@@ -168,6 +168,15 @@ def parse_disturbance(text: str) -> Any:
         raise UsageError(f"--disturb: expected 't=SECONDS,joint=NAME,delta=RAD', got '{text}'")
     time_s = parse_time(fields["t"], "--disturb t")
     return Disturbance(time_s, fields["joint"], parse_number(fields["delta"], "--disturb delta"))
+
+
+def parse_shard(text: str) -> tuple[int, int]:
+    """Return (K, N) of a `--shard K/N` text: shard K (1-based) of N."""
+    index, slash, count = text.strip().partition("/")
+    if slash and index.isdigit() and count.isdigit() and len(index) <= 6 and len(count) <= 6:
+        return int(index), int(count)
+    shown = text if len(text) <= 40 else f"{text[:37]}..."
+    raise UsageError(f"--shard: expected K/N, shard K of N ('2/4'), got '{shown}'")
 
 
 def parse_seeds(text: str) -> list[int]:

@@ -391,5 +391,6 @@ def benchmark_summary(runs: list[Run], rows: list[dict[str, Any]], as_json: bool
         rows_table.add_row(row["scenario"], row["planner"], f"{row['succeeded']}/{row['runs']}",
                       *(ms(row, stage) for stage in ("search", "simplify", "certify", "timing", "total", "whole_call")),
                            number(row["path_length_median"], 2),
-                           number(row["duration_median_s"], 2), f"{row['exact_valid']}/{row['succeeded']}")
+                           number(row["duration_median_s"], 2),
+                           "-" if row["exact_valid"] is None else f"{row['exact_valid']}/{row['succeeded']}")
     show(rows_table)

@@ -14,7 +14,17 @@ from .._faces import lazy_exports
 
 if TYPE_CHECKING:
     from ._checks import Problem
-    from .benchmark import ProblemFiles, Run, find_problems, plot_benchmark, run_benchmark, summarize, write_csv
+    from .benchmark import (
+        ProblemFiles,
+        Run,
+        find_problems,
+        plot_benchmark,
+        read_runs,
+        run_benchmark,
+        shard,
+        summarize,
+        write_csv,
+    )
     from .documents import (
         benchmark_document,
         failure_document,
@@ -92,12 +102,14 @@ __all__ = [
     "plan_to_file",
     "plot_benchmark",
     "robot_document",
+    "read_runs",
     "run_benchmark",
     "scene_document",
     "session_plan",
     "start_configuration",
     "state",
     "state_document",
+    "shard",
     "summarize",
     "tune",
     "tuning_document",
@@ -152,12 +164,14 @@ __getattr__ = lazy_exports(__name__, {
     "plan_to_file": "plan",
     "plot_benchmark": "benchmark",
     "robot_document": "documents",
+    "read_runs": "benchmark",
     "run_benchmark": "benchmark",
     "scene_document": "scene_export",
     "session_plan": "session",
     "start_configuration": "session",
     "state": "robot_state",
     "state_document": "documents",
+    "shard": "benchmark",
     "summarize": "benchmark",
     "tune": "tuning",
     "tuning_document": "tuning",

@@ -2,8 +2,10 @@
 
 A problem is a MoveIt PlanningScene + MotionPlanRequest pair (`sceneNNNN.yaml`,
 `requestNNNN.yaml`, as MotionBenchMaker writes them) or a moveplan task file.
-Each (planner, seed) runs in a process of its own; every run is seeded anew,
-so a problem and seed give the same path here as with `moveplan plan`.
+Worker processes take (planner, seed, problem) runs from one queue; every run is seeded
+anew, so a problem and seed give the same path here as with `moveplan plan`, whichever
+process ran it. A benchmark split into shards (`shard`) on several machines is put back
+together by `read_runs` from the shards' CSV files.
 """
 
 from __future__ import annotations
@@ -29,7 +31,8 @@ from ..errors import ConfigError, InputError, MoveplanError, NoPlan, UsageError
 from .request import RobotSource
 
 __all__ = [
-    "STAGES", "ProblemFiles", "Run", "find_problems", "plot_benchmark", "run_benchmark", "summarize", "write_csv",
+    "STAGES", "ProblemFiles", "Run", "find_problems", "plot_benchmark", "read_runs", "run_benchmark", "shard",
+    "summarize", "write_csv",
 ]
 
 logger = logging.getLogger(__name__)
@@ -117,7 +120,18 @@ def find_problems(paths: Sequence[Path], count: int | None = None) -> tuple[Prob
     return tuple(problems)
 
 
-RunProblem = Callable[[ProblemFiles], Run]
+def shard(problems: Sequence[ProblemFiles], index: int, count: int) -> tuple[ProblemFiles, ...]:
+    """Return shard `index` of `count` (1-based): every count-th problem from the index-th, so shards balance.
+
+    Raises:
+        UsageError: `index` is not in 1..count, or the shard holds no problem.
+    """
+    if not 1 <= index <= count:
+        raise UsageError(f"--shard {index}/{count}: expected K/N with 1 <= K <= N")
+    chosen = tuple(problems[index - 1 :: count])
+    if not chosen:
+        raise UsageError(f"--shard {index}/{count}: no problem falls in this shard ({len(problems)} problems)")
+    return chosen
 
 
 def run_benchmark(
@@ -129,47 +143,54 @@ def run_benchmark(
     jobs: int = 1,
     on_run: Callable[[Run], None] | None = None,
     timeout: float | None = None,
+    exact_check: bool = True,
 ) -> list[Run]:
     """Return every run of every problem with every planner and seed, in a stable order.
 
-    Each (planner, seed) is one child process; `jobs` of them run at a time.
-    `on_run` is called in this process as each run completes (for a progress bar).
-    `planning_time` is each search's budget of work; `timeout` its wall-clock safety limit
-    (None: the default for the budget).
+    `jobs` worker processes take (planner, seed, problem) runs from one queue, so a single
+    planner and seed spread over the cores too; every run is seeded anew, so which process
+    ran it changes nothing but its times. `on_run` is called in this process as each run
+    completes (for a progress bar). `planning_time` is each search's budget of work;
+    `timeout` its wall-clock safety limit (None: the default for the budget). Without
+    `exact_check`, the independent mesh re-check of each plan is skipped (exact_valid None).
     """
     context = multiprocessing.get_context("spawn")
-    results = context.Queue()
-    pending = [(planner, seed) for planner in planners for seed in seeds]
-    running: dict[tuple[str, int], Any] = {}
+    tasks, results = context.Queue(), context.Queue()
+    work = [(planner, seed, index) for planner in planners for seed in seeds for index in range(len(problems))]
+    for task in work:
+        tasks.put(task)
+    workers = [context.Process(target=_worker, args=(robot, tuple(problems), (planning_time, timeout), exact_check,
+                                                      tasks, results), daemon=True)
+               for _ in range(max(1, min(jobs, len(work))))]
+    for _ in workers:
+        tasks.put(None)  # one stop sign each, behind the work
+    for process in workers:
+        process.start()
     runs: list[Run] = []
-    while pending or running:
-        while pending and len(running) < max(1, jobs):
-            planner, seed = pending.pop(0)
-            process = context.Process(
-                target=_worker, args=(robot, tuple(problems), planner, seed, (planning_time, timeout), results),
-                daemon=True)
-            process.start()
-            running[(planner, seed)] = process
-        try:
-            kind, key, payload = results.get(timeout=1.0)
-        except queue_module.Empty:
-            dead = [(key, p.exitcode) for key, p in running.items() if not p.is_alive() and p.exitcode != 0]
-            if dead:
-                (planner, seed), code = dead[0]
-                raise MoveplanError(f"benchmark worker for planner {planner}, seed {seed} died "
-                                    f"(exit code {code})") from None
-            continue
-        if kind == "run":
-            run = Run(**payload)
-            runs.append(run)
-            if on_run is not None:
-                on_run(run)
-        elif kind == "done":
-            running.pop(key).join()
-        else:
-            for process in running.values():
+    done = 0
+    try:
+        while done < len(workers):
+            try:
+                kind, payload = results.get(timeout=1.0)
+            except queue_module.Empty:
+                dead = [p.exitcode for p in workers if not p.is_alive() and p.exitcode != 0]
+                if dead:
+                    raise MoveplanError(f"a benchmark worker died (exit code {dead[0]})") from None
+                continue
+            if kind == "run":
+                run = Run(**payload)
+                runs.append(run)
+                if on_run is not None:
+                    on_run(run)
+            elif kind == "done":
+                done += 1
+            else:
+                raise _rebuild(payload)
+    finally:
+        for process in workers:
+            if process.is_alive() and done < len(workers):
                 process.terminate()
-            raise _rebuild(payload)
+            process.join()
     order = {p.name: i for i, p in enumerate(problems)}
     return sorted(runs, key=lambda r: (list(planners).index(r.planner), r.seed, order[r.problem]))
 
@@ -182,30 +203,34 @@ def _rebuild(payload: dict[str, Any]) -> Exception:
     return RuntimeError(f"benchmark worker failed: {payload['message']}\n{payload['traceback']}")
 
 
-def _worker(robot: Path | RobotSource, problems: tuple[ProblemFiles, ...], planner: str, seed: int,
-            budget: tuple[float, float | None], results: Any) -> None:
-    """Run every problem with one planner and seed, and put each run on `results`."""
-    key = (planner, seed)
+def _worker(robot: Path | RobotSource, problems: tuple[ProblemFiles, ...], budget: tuple[float, float | None],
+            exact_check: bool, tasks: Any, results: Any) -> None:
+    """Run (planner, seed, problem index) tasks from `tasks` until a stop sign; put each run on `results`."""
     try:
         from ..config import load_robot_config
 
         config = robot.load() if isinstance(robot, RobotSource) else load_robot_config(robot)
         with tempfile.TemporaryDirectory(prefix="moveplan-benchmark-") as folder:
-            # Once untimed: the process's one-time set-up (numba's kernels, the sphere models) is
-            # no part of any call, as the config's loading is not.
-            _solve(problems[0], config, planner, seed, budget, Path(folder) / "plan.mcap")
-            for problem in problems:
-                run = _solve(problem, config, planner, seed, budget, Path(folder) / "plan.mcap")
-                results.put(("run", key, asdict(run)))
+            output = Path(folder) / "plan.mcap"
+            warm = False
+            while (task := tasks.get()) is not None:
+                planner, seed, index = task
+                if not warm:
+                    # Once untimed: the process's one-time set-up (numba's kernels, the sphere models) is
+                    # no part of any call, as the config's loading is not.
+                    _solve(problems[0], config, planner, seed, budget, exact_check, output)
+                    warm = True
+                run = _solve(problems[index], config, planner, seed, budget, exact_check, output)
+                results.put(("run", asdict(run)))
     except Exception as exc:  # noqa: BLE001 - reported to the parent, which raises it there
-        results.put(("error", key, {"exit_code": getattr(exc, "exit_code", 1), "message": str(exc),
-                                    "traceback": traceback.format_exc()}))
+        results.put(("error", {"exit_code": getattr(exc, "exit_code", 1), "message": str(exc),
+                               "traceback": traceback.format_exc()}))
         return
-    results.put(("done", key, None))
+    results.put(("done", None))
 
 
 def _solve(problem: ProblemFiles, config: Any, planner: str, seed: int, budget: tuple[float, float | None],
-           output: Path) -> Run:
+           exact_check: bool, output: Path) -> Run:
     """Return the run of one problem, its plan written to `output`; no plan is a failed run, bad input an error.
 
     `budget` is the search's planning time and wall-clock timeout.
@@ -221,7 +246,7 @@ def _solve(problem: ProblemFiles, config: Any, planner: str, seed: int, budget: 
     request = pipeline.resolve_request(load_task(problem.task) if problem.task else None, flags)
     where: dict[str, Any] = {"problem": problem.name, "scenario": problem.scenario, "planner": planner, "seed": seed}
     try:
-        plan = pipeline.plan(request, config=config, exact_check=True)
+        plan = pipeline.plan(request, config=config, exact_check=exact_check)
     except NoPlan as exc:
         return Run(**where, ok=False, error=str(exc))
     write_plan(output, plan)
@@ -238,7 +263,7 @@ def _solve(problem: ProblemFiles, config: Any, planner: str, seed: int, budget: 
         planning_time_s=sum(s.planning_time_s for s in plan.steps), whole_call_s=whole_call_s,
         checks=int(total("checks")),
         path_length=total("path_length"), duration_s=sum(s.trajectory.duration_s for s in plan.steps),
-        exact_valid=all(s.get("exact_valid") == 1.0 for s in steps),
+        exact_valid=all(s.get("exact_valid") == 1.0 for s in steps) if exact_check else None,
     )
 
 
@@ -265,9 +290,64 @@ def summarize(runs: Iterable[Run]) -> list[dict[str, Any]]:
         rows.append({
             **row,
             "path_length_median": stat("path_length", 50), "duration_median_s": stat("duration_s", 50),
-            "exact_valid": sum(1 for r in ok if r.exact_valid),
+            # None where no run was re-checked (benchmark --no-exact-check).
+            "exact_valid": sum(1 for r in ok if r.exact_valid) if any(r.exact_valid is not None for r in ok) else None,
         })
     return rows
+
+
+def read_runs(paths: Sequence[Path]) -> list[Run]:
+    """Return the runs of benchmark CSV files (each one shard's `--csv`), in file order.
+
+    Raises:
+        InputError: A file is missing, not a benchmark CSV (its header), holds a malformed
+            value, or repeats a run (problem, planner, seed) another row or file holds; the
+            message names the file and row.
+    """
+    fields = Run.__dataclass_fields__
+    runs: list[Run] = []
+    seen: dict[tuple[str, str, int], str] = {}
+    for path in paths:
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise InputError(f"{path}: cannot read: {getattr(exc, 'strerror', None) or exc}") from None
+        reader = csv.DictReader(io.StringIO(text, newline=""))
+        if reader.fieldnames is None or set(reader.fieldnames) != set(fields):
+            raise InputError(f"{path}: not a benchmark CSV (expected the columns {', '.join(fields)})")
+        for number, row in enumerate(reader, start=2):
+            where = f"{path}: row {number}"
+            try:
+                run = Run(**{name: _cell(row[name], fields[name].type) for name in fields})
+            except (ValueError, TypeError) as exc:
+                raise InputError(f"{where}: {exc}") from None
+            key = (run.problem, run.planner, run.seed)
+            if key in seen:
+                raise InputError(f"{where}: problem {run.problem}, planner {run.planner}, seed {run.seed} "
+                                 f"is also in {seen[key]}: shards overlap")
+            seen[key] = where
+            runs.append(run)
+    return runs
+
+
+def _cell(text: str | None, kind: Any) -> Any:
+    """Return a CSV cell as the Run field of type `kind` (written by write_csv: empty for None)."""
+    if text is None:
+        raise ValueError("a cell is missing")
+    kind = str(kind)
+    if kind == "str":
+        return text
+    if kind == "str | None":
+        return text or None
+    if kind == "int":
+        return int(text)
+    if kind in ("bool", "bool | None"):
+        if text == "" and kind == "bool | None":
+            return None
+        if text not in ("True", "False"):
+            raise ValueError(f"expected True or False, got {text!r}")
+        return text == "True"
+    return float(text) if text else float("nan")
 
 
 def write_csv(runs: Iterable[Run], path: Path) -> None:

@@ -86,3 +86,53 @@ def test_a_malformed_request_stops_the_benchmark_with_exit_3_naming_it(cli: Cli,
     (problems / "box_panda" / "request0002.yaml").write_text("group_name: [unclosed\n")
     code, document = cli.json("benchmark", problems, "--robot", "panda", "--planner", "RRTConnect")
     assert code == 3 and "request0002.yaml" in document["error"]["message"], document
+
+
+def _outcomes(path: Path) -> dict[tuple[str, str, str], tuple[str, ...]]:
+    """Return per (problem, planner, seed) what a run found: success, checks, path, duration, validity."""
+    with path.open() as stream:
+        return {(r["problem"], r["planner"], r["seed"]): (r["ok"], r["checks"], r["path_length"], r["duration_s"],
+                                                          r["exact_valid"]) for r in csv.DictReader(stream)}
+
+
+def test_shards_merged_give_the_runs_of_the_whole_benchmark(cli: Cli, problems: Path, tmp_path: Path) -> None:
+    """Two processes, or two shards on two machines, find what one process finds: each run is seeded anew."""
+    common = ("benchmark", problems, "--robot", "panda", "--planner", "RRTConnect", "--seeds", "0-1", "-q")
+    whole, first, second, merged = (tmp_path / f"{name}.csv" for name in ("whole", "first", "second", "merged"))
+    assert cli(*common, "--jobs", "2", "--csv", whole).exit_code == 0
+    assert cli(*common, "--shard", "1/2", "--csv", first).exit_code == 0
+    assert cli(*common, "--shard", "2/2", "--csv", second, "--no-exact-check").exit_code == 0
+    assert {key[0] for key in _outcomes(first)} == {"box_panda/0001"}  # every second problem from the first
+    code, document = cli.json("benchmark-merge", first, second, "--csv", merged)
+    assert code == 0, document
+    overall = next(r for r in document["summary"] if r["scenario"] == "all")
+    assert overall["runs"] == 4 and overall["succeeded"] == 4 and overall["exact_valid"] == 2  # shard 2 unchecked
+    together, alone = _outcomes(merged), _outcomes(whole)
+    assert together.keys() == alone.keys()
+    for key, found in together.items():
+        assert found[:4] == alone[key][:4], key
+        assert found[4] == ("True" if key[0] == "box_panda/0001" else "")
+
+
+def test_merging_overlapping_or_foreign_files_is_refused_naming_them(cli: Cli, problems: Path, tmp_path: Path) -> None:
+    runs = tmp_path / "runs.csv"
+    assert cli("benchmark", problems, "--robot", "panda", "--planner", "RRTConnect", "--csv", runs, "-q").exit_code == 0
+    code, document = cli.json("benchmark-merge", runs, runs)
+    assert code == 3 and f"{runs}: row 2: problem box_panda/0001, planner RRTConnect, seed 0 is also in {runs}: " \
+        "row 2: shards overlap" == document["error"]["message"], document
+    other = tmp_path / "other.csv"
+    other.write_text("a,b\n1,2\n")
+    code, document = cli.json("benchmark-merge", other)
+    assert code == 3 and document["error"]["message"].startswith(f"{other}: not a benchmark CSV"), document
+    broken = tmp_path / "broken.csv"
+    broken.write_text(runs.read_text().replace(",True,", ",yes,", 1))
+    code, document = cli.json("benchmark-merge", broken)
+    assert code == 3 and document["error"]["message"].startswith(f"{broken}: row 2: expected True or False"), document
+    code, document = cli.json("benchmark-merge", tmp_path / "missing.csv")
+    assert code == 3 and "missing.csv: cannot read" in document["error"]["message"], document
+
+
+@pytest.mark.parametrize(("shard", "message"), [("3/2", "1 <= K <= N"), ("1-2", "expected K/N"), ("3/5", "no problem")])
+def test_a_bad_shard_is_a_usage_error(cli: Cli, problems: Path, shard: str, message: str) -> None:
+    result = cli("benchmark", problems, "--robot", "panda", "--shard", shard)
+    assert result.exit_code == 2 and message in result.stderr, result.stderr
