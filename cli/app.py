@@ -236,9 +236,18 @@ def execute(
 
 @app.command("check-tolerances")
 def check_tolerances(
-    plan_file: Annotated[Path, typer.Argument(metavar="PLAN", help="Plan file written by moveplan plan.")],
-    recording_file: Annotated[Path, typer.Argument(
-        metavar="RECORDING", help="A ROS 2 bag with sensor_msgs/JointState: .mcap, .db3 or a bag folder.")],
+    plan_file: Annotated[Path | None, typer.Argument(metavar="PLAN", help="Plan file written by moveplan plan.")]
+        = None,
+    recording_file: Annotated[Path | None, typer.Argument(
+        metavar="RECORDING", help="A ROS 2 bag with sensor_msgs/JointState: .mcap, .db3 or a bag folder.")] = None,
+    manifest: Annotated[Path | None, typer.Option(metavar="FLEET.csv", help=(
+        "Check many pairs instead of PLAN RECORDING: a CSV with columns plan, recording (paths relative to it, "
+        "globs allowed); other columns are carried into the results."))] = None,
+    jobs: Annotated[int, typer.Option(min=1, help="With --manifest: worker processes checking items at once.")] = 1,
+    csv: Annotated[Path | None, typer.Option(metavar="RESULTS.csv", help=(
+        "With --manifest: write a row per item as it is judged."))] = None,
+    resume: Annotated[bool, typer.Option("--resume", help=(
+        "With --manifest and --csv: skip pairs the CSV already judges (same file contents), add the rest."))] = False,
     topic: Annotated[str, typer.Option(help="JointState topic in the recording.")] = "/joint_states",
     controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml overriding the plan's.")] = None,
     strict: StrictOpt = False,
@@ -257,6 +266,7 @@ def check_tolerances(
 
     Exit 0 within tolerances, 5 on a violation, 3 if the recording cuts the execution (with --start all,
     every execution) off before a verdict; with --start all, cut-off cycles are INCOMPLETE and not counted.
+    With --manifest: exit 0 if every item passes, 3 if any could not be checked, else 5 on any violation.
     """
     setup_logging(verbose, quiet)
     with exit_codes(as_json):
@@ -269,19 +279,64 @@ def check_tolerances(
         source: TimeSource = "log" if time_source == "log" else "header"
         when: RecordingStart = ("auto" if start == "auto" else "all" if start == "all"
                                 else parse_time(start, "--start (auto, all or seconds)"))
-        request = CheckRequest(plan_file, recording_file, topic, controllers, when, source, skip_damaged, strict)
-        if plot is None:
-            report = check(request)
+        if manifest is not None:
+            if plan_file is not None or recording_file is not None or plot is not None:
+                raise UsageError("--manifest checks the pairs it lists: give no PLAN, RECORDING or --plot with it")
+            code = _check_fleet(manifest, (topic, controllers, when, source, skip_damaged, strict), jobs, csv, resume,
+                                as_json, quiet)
         else:
-            from ..core.pipeline import check_plot_path, check_plotted
+            if plan_file is None or recording_file is None:
+                raise UsageError("check-tolerances needs PLAN and RECORDING, or --manifest FLEET.csv")
+            if csv is not None or resume or jobs != 1:
+                raise UsageError("--jobs, --csv and --resume go with --manifest")
+            request = CheckRequest(plan_file, recording_file, topic, controllers, when, source, skip_damaged, strict)
+            if plot is None:
+                report = check(request)
+            else:
+                from ..core.pipeline import check_plot_path, check_plotted
 
-            check_outputs({"--plot": plot}, {"PLAN": plan_file, "RECORDING": recording_file,
-                                             "--controllers": controllers})
-            check_plot_path(plot)
-            report = check_plotted(request, plot)
-    render.check_summary(report, recording_file, as_json, quiet)
-    # Cut off before any verdict: the check could not be done on this recording (bad input).
-    raise typer.Exit(0 if report.ok else 5 if report.complete else 3)
+                check_outputs({"--plot": plot}, {"PLAN": plan_file, "RECORDING": recording_file,
+                                                 "--controllers": controllers})
+                check_plot_path(plot)
+                report = check_plotted(request, plot)
+            render.check_summary(report, recording_file, as_json, quiet)
+            # Cut off before any verdict: the check could not be done on this recording (bad input).
+            code = 0 if report.ok else 5 if report.complete else 3
+    raise typer.Exit(code)
+
+
+def _check_fleet(manifest: Path, flags: tuple[Any, ...], jobs: int, csv: Path | None, resume: bool, as_json: bool,
+                 quiet: bool) -> int:
+    """Check every pair a manifest lists, stream results to `csv`, print the batch's report; return its exit code."""
+    from ..core.errors import UsageError
+    from ..core.pipeline import CheckFlags, ResultsFile, batch_exit_code, check_items, judged_pairs, read_manifest
+    from ..core.pipeline import sha256_of as digest
+    from . import render
+
+    if resume and csv is None:
+        raise UsageError("--resume reads and extends the results of --csv RESULTS.csv: give --csv")
+    items = read_manifest(manifest)
+    if csv is not None:
+        check_outputs({"--csv": csv}, {"--manifest": manifest, **{f"item {i.index}": i.recording for i in items},
+                                       **{f"plan {i.index}": i.plan for i in items}})
+    judged = judged_pairs(csv) if resume and csv is not None else {}
+    keys = [(digest(item.plan), digest(item.recording)) for item in items] if judged else []
+    resumed = [judged[key] for key in dict.fromkeys(keys) if key in judged]
+    todo = [item for number, item in enumerate(items) if not judged or keys[number] not in judged]
+    results_file = ResultsFile(csv, list(items[0].columns), append=resume) if csv is not None else None
+    try:
+        with render.fleet_progress(len(todo), quiet or as_json) as advance:
+            def arrived(result: Any) -> None:
+                if results_file is not None:
+                    results_file.write(result)
+                advance(result)
+
+            results = check_items(todo, CheckFlags(*flags), jobs, arrived)
+    finally:
+        if results_file is not None:
+            results_file.close()
+    render.fleet_report(results, resumed, as_json, quiet)
+    return batch_exit_code([r.exit_code for r in results] + [int(r["exit_code"]) for r in resumed])
 
 
 @app.command("robot")

@@ -24,12 +24,12 @@ from .tables import number as _number
 if TYPE_CHECKING:  # each command imports only the core modules it runs
     from ..core.config import RobotConfig
     from ..core.control import CheckReport
-    from ..core.pipeline import Inspection, PlanExecution, PlanResult, Run, StateResult
+    from ..core.pipeline import Inspection, ItemResult, PlanExecution, PlanResult, Run, StateResult
     from ..core.types import RobotState
 
 __all__ = [
     "PROGRESS_EVERY_S", "benchmark_progress", "benchmark_summary", "check_summary", "execution_summary",
-    "inspect_summary", "plan_summary", "robot_summary", "state_summary",
+    "fleet_progress", "fleet_report", "inspect_summary", "plan_summary", "robot_summary", "state_summary",
 ]
 
 logger = logging.getLogger("moveplan")
@@ -333,37 +333,76 @@ def benchmark_progress(total: int, quiet: bool) -> Iterator[Callable[[Run], None
     On a file or a pipe, a line such as `benchmark: 120/1500 runs, 118 solved, 42 s` once a run ends
     PROGRESS_EVERY_S after the last line: a CI job's log shows the benchmark is alive.
     """
+    with _progress(total, quiet, "benchmark", "planning", "runs", ("solved", "failed")) as count:
+        yield lambda run: count(run.ok)
+
+
+@contextmanager
+def fleet_progress(total: int, quiet: bool) -> Iterator[Callable[[ItemResult], None]]:
+    """Yield a callback that counts a checked item, as benchmark_progress counts runs."""
+    with _progress(total, quiet, "check-tolerances", "checking", "items", ("passed", "not passed")) as count:
+        yield lambda result: count(result.exit_code == 0)
+
+
+@contextmanager
+def _progress(total: int, quiet: bool, command: str, doing: str, unit: str,
+              words: tuple[str, str]) -> Iterator[Callable[[bool], None]]:
+    """Yield a callback taking whether a finished piece of work went well: a bar on a terminal, else lines."""
     if quiet or not is_terminal(sys.stderr):
-        yield (lambda run: None) if quiet else _progress_lines(total)
+        yield (lambda good: None) if quiet else _progress_lines(total, command, unit, words[0])
         return
     progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                         console=Console(stderr=True), transient=True)
     with progress:
-        task = progress.add_task("planning", total=total)
-        failed = 0
+        task = progress.add_task(doing, total=total)
+        bad = 0
 
-        def advance(run: Run) -> None:
-            nonlocal failed
-            failed += not run.ok
-            progress.update(task, advance=1, description=f"planning ({failed} failed)" if failed else "planning")
+        def advance(good: bool) -> None:
+            nonlocal bad
+            bad += not good
+            progress.update(task, advance=1, description=f"{doing} ({bad} {words[1]})" if bad else doing)
 
         yield advance
 
 
-def _progress_lines(total: int) -> Callable[[Run], None]:
-    """Return a callback that counts a finished run and prints a progress line on stderr every PROGRESS_EVERY_S."""
+def _progress_lines(total: int, command: str, unit: str, word: str) -> Callable[[bool], None]:
+    """Return a callback that counts finished work and prints a progress line on stderr every PROGRESS_EVERY_S."""
     began = last = time.monotonic()
-    done = solved = 0
+    done = good_ones = 0
 
-    def advance(run: Run) -> None:
-        nonlocal done, solved, last
-        done, solved = done + 1, solved + run.ok
+    def advance(good: bool) -> None:
+        nonlocal done, good_ones, last
+        done, good_ones = done + 1, good_ones + good
         now = time.monotonic()
         if now - last >= PROGRESS_EVERY_S:
             last = now
-            print(f"benchmark: {done}/{total} runs, {solved} solved, {now - began:.0f} s", file=sys.stderr, flush=True)
+            print(f"{command}: {done}/{total} {unit}, {good_ones} {word}, {now - began:.0f} s", file=sys.stderr,
+                  flush=True)
 
     return advance
+
+
+def fleet_report(results: list[ItemResult], resumed: list[dict[str, str]], as_json: bool, quiet: bool) -> None:
+    """Print a batch check: a line per item that did not pass and the counts; or its JSON document."""
+    from ..core.pipeline import fleet_summary
+
+    summary = fleet_summary(results, resumed)
+    if as_json:
+        items = [{"index": r.item.index, "plan": str(r.item.plan), "recording": str(r.item.recording),
+                  "columns": r.item.columns, "exit_code": r.exit_code, **r.document} for r in results]
+        _emit({"items": items, "summary": summary})
+        return
+    if quiet:
+        return
+    for failing in summary["failing"]:
+        _console.print(f"{escape(failing['recording'])} against {escape(failing['plan'])}: {failing['result']} "
+                      f"(exit {failing['exit_code']})", soft_wrap=True)
+    resumed_text = f", {summary['resumed']} judged before (--resume)" if summary["resumed"] else ""
+    worst = summary["worst_margins"][0] if summary["worst_margins"] else None
+    smallest = (f"; smallest margin {worst['margin']:.3g} ({worst['joint']}, {escape(worst['recording'])})"
+                if worst else "")
+    _console.print(f"{summary['items']} items: {summary['passed']} passed, {summary['failed']} failed, "
+                  f"{summary['unreadable']} not checked{resumed_text}{smallest}", soft_wrap=True)
 
 
 def benchmark_summary(runs: list[Run], rows: list[dict[str, Any]], as_json: bool, quiet: bool) -> None:

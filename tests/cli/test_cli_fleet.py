@@ -1,0 +1,133 @@
+"""`check-tolerances --manifest`: a night's recordings checked in one command, each as a single check would."""
+
+from __future__ import annotations
+
+import csv
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from conftest import SAMPLES, Cli
+
+RECORDINGS = SAMPLES / "recordings"
+
+
+@pytest.fixture()
+def fleet(tmp_path: Path) -> Path:
+    """Return a manifest of five items: a pass, a violation, a corrupt file, a missing one and a glob's match."""
+    for name in ("tool_up_plan", "tool_up_ok", "tool_up_path_violation", "tool_up_goal_missed"):
+        shutil.copy(RECORDINGS / f"{name}.mcap", tmp_path / f"{name}.mcap")
+    (tmp_path / "corrupt.mcap").write_bytes(b"\x89MCAP0\r\n" + b"\x00" * 40)
+    manifest = tmp_path / "fleet.csv"
+    manifest.write_text("plan,recording,robot\n"
+                        "tool_up_plan.mcap,tool_up_ok.mcap,cell-1\n"
+                        "tool_up_plan.mcap,tool_up_path_violation.mcap,cell-2\n"
+                        "tool_up_plan.mcap,corrupt.mcap,cell-3\n"
+                        "tool_up_plan.mcap,missing.mcap,cell-4\n"
+                        "tool_up_plan.mcap,tool_up_goal_*.mcap,cell-5\n")
+    return manifest
+
+
+def _rows(path: Path) -> list[dict[str, str]]:
+    with path.open() as stream:
+        return list(csv.DictReader(stream))
+
+
+def test_every_item_gets_the_verdict_its_single_check_gives(cli: Cli, fleet: Path) -> None:
+    code, document = cli.json("check-tolerances", "--manifest", fleet)
+    assert code == 3, document  # an item could not be checked: that outranks the violation
+    items = document["items"]
+    assert [(Path(i["recording"]).name, i["exit_code"], i["columns"]) for i in items] == [
+        ("tool_up_ok.mcap", 0, {"robot": "cell-1"}), ("tool_up_path_violation.mcap", 5, {"robot": "cell-2"}),
+        ("corrupt.mcap", 3, {"robot": "cell-3"}), ("missing.mcap", 3, {"robot": "cell-4"}),
+        ("tool_up_goal_missed.mcap", 0, {"robot": "cell-5"})]
+    for item in items:
+        single_code, single = cli.json("check-tolerances", item["plan"], item["recording"])
+        assert single_code == item["exit_code"]
+        keep = {key: value for key, value in item.items() if key not in ("index", "plan", "recording", "columns",
+                                                                         "exit_code")}
+        if single_code == 3:
+            assert keep["error"]["message"] == single["error"]["message"] and not keep["ok"]
+        else:
+            assert keep == single
+    summary = document["summary"]
+    assert (summary["items"], summary["passed"], summary["failed"], summary["unreadable"]) == (5, 2, 1, 2)
+    assert summary["worst_margins"][0]["recording"].endswith("tool_up_path_violation.mcap")
+    assert summary["worst_margins"][0]["joint"] == "wrist_1_joint" and summary["worst_margins"][0]["margin"] < 0
+
+
+def test_two_workers_give_the_same_document_and_results_stream_to_csv(cli: Cli, fleet: Path, tmp_path: Path) -> None:
+    one, two = tmp_path / "one.csv", tmp_path / "two.csv"
+    code_one, alone = cli.json("check-tolerances", "--manifest", fleet, "--csv", one)
+    code_two, together = cli.json("check-tolerances", "--manifest", fleet, "--csv", two, "--jobs", "2")
+    assert code_one == code_two == 3 and alone == together
+    rows = sorted(_rows(two), key=lambda row: int(row["index"]))
+    assert sorted(_rows(one), key=lambda row: int(row["index"])) == rows
+    assert [(row["ok"], row["exit_code"], row["result"], row["robot"]) for row in rows] == [
+        ("True", "0", "SUCCESSFUL", "cell-1"), ("False", "5", "PATH_TOLERANCE_VIOLATED", "cell-2"),
+        ("False", "3", "InputError", "cell-3"), ("False", "3", "InputError", "cell-4"),
+        ("True", "0", "SUCCESSFUL", "cell-5")]
+    assert rows[1]["worst_joint"] == "wrist_1_joint" and float(rows[1]["worst_margin"]) < 0
+    assert rows[3]["recording_sha256"] == "" and "file not found" in rows[3]["error"]
+
+
+def test_resume_skips_the_pairs_already_judged(cli: Cli, fleet: Path, tmp_path: Path) -> None:
+    results = tmp_path / "results.csv"
+    assert cli("check-tolerances", "--manifest", fleet, "--csv", results, "-q").exit_code == 3
+    # It arrived since: an execution of the plan, a recording judged by no earlier run.
+    assert cli("execute", tmp_path / "tool_up_plan.mcap", "--fake", "-o", tmp_path / "missing.mcap").exit_code == 0
+    code, document = cli.json("check-tolerances", "--manifest", fleet, "--csv", results, "--resume")
+    summary = document["summary"]
+    assert (summary["checked"], summary["resumed"]) == (1, 4)  # only the pair whose file could not be read
+    assert [Path(i["recording"]).name for i in document["items"]] == ["missing.mcap"]
+    assert code == 3 and (summary["passed"], summary["unreadable"]) == (3, 1)  # corrupt.mcap, judged before
+    assert len(_rows(results)) == 6  # the first run's five rows, and the one judged now
+    replaced = ("execute", tmp_path / "tool_up_plan.mcap", "--fake", "--plant", "lag", "--plant-param", "tau=0.01")
+    assert cli(*replaced, "-o", tmp_path / "tool_up_ok.mcap").exit_code == 0  # another night, the same name
+    _, again = cli.json("check-tolerances", "--manifest", fleet, "--csv", results, "--resume")
+    assert [Path(i["recording"]).name for i in again["items"]] == ["tool_up_ok.mcap"]  # keyed by contents
+
+
+def test_exit_codes_all_pass_and_any_violation(cli: Cli, fleet: Path) -> None:
+    passing, failing = fleet.parent / "passing.csv", fleet.parent / "failing.csv"
+    passing.write_text("plan,recording\ntool_up_plan.mcap,tool_up_ok.mcap\n")
+    failing.write_text("plan,recording\ntool_up_plan.mcap,tool_up_ok.mcap\ntool_up_plan.mcap,tool_up_path_violation.mcap\n")
+    assert cli("check-tolerances", "--manifest", passing).exit_code == 0
+    result = cli("check-tolerances", "--manifest", failing)
+    assert result.exit_code == 5
+    last = result.stdout.splitlines()[-1]
+    assert last.startswith("2 items: 1 passed, 1 failed, 0 not checked; smallest margin -0.05 (wrist_1_joint")
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("plan,bag\na.mcap,b.mcap\n", "a manifest needs the columns plan and recording (its header: plan, bag)"),
+    ("plan,recording\n", "the manifest lists no (plan, recording) pair"),
+    ("plan,recording\na.mcap,\n", "row 2: plan and recording are both needed"),
+    ("plan,recording\na.mcap,b.mcap,c\n", "row 2: more cells than the header names"),
+])
+def test_a_bad_manifest_exits_3_naming_it(cli: Cli, tmp_path: Path, text: str, message: str) -> None:
+    manifest = tmp_path / "fleet.csv"
+    manifest.write_text(text)
+    code, document = cli.json("check-tolerances", "--manifest", manifest)
+    assert code == 3 and document["error"]["message"] == f"{manifest}: {message}", document
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--manifest", "M", "--plot", "p.png"], "give no PLAN, RECORDING or --plot with it"),
+    (["--manifest", "M", "--resume"], "--resume reads and extends the results of --csv"),
+    (["PLAN", "REC", "--csv", "r.csv"], "--jobs, --csv and --resume go with --manifest"),
+    ([], "needs PLAN and RECORDING, or --manifest FLEET.csv"),
+])
+def test_flags_that_do_not_go_together_exit_2(cli: Cli, fleet: Path, args: list[str], message: str) -> None:
+    swapped = [str(fleet) if a == "M" else str(RECORDINGS / "tool_up_plan.mcap") if a == "PLAN"
+               else str(RECORDINGS / "tool_up_ok.mcap") if a == "REC" else a for a in args]
+    result = cli("check-tolerances", *swapped)
+    assert result.exit_code == 2 and message in result.stderr, result.stderr
+    assert not (fleet.parent / "p.png").exists()
+
+
+def test_the_json_document_is_one_strict_document(cli: Cli, fleet: Path) -> None:
+    result = cli("check-tolerances", "--manifest", fleet, "--json")
+    document = json.loads(result.stdout, parse_constant=lambda name: pytest.fail(f"non-JSON {name}"))
+    assert set(document) == {"items", "summary"}
