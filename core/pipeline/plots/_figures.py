@@ -85,6 +85,7 @@ def grid(
     The margins are fixed in inches (title, column titles, tick labels, legend rows) rather
     than found by a layout engine: that engine draws the whole figure once more to measure it.
     """
+    from matplotlib import rc_context
     from matplotlib.figure import Figure
     from matplotlib.ticker import MaxNLocator
 
@@ -93,10 +94,12 @@ def grid(
     panel_height = (_ROW_IN * rows - _ROW_GAP_IN * (rows - 1)) / rows
     panel_width = (_WIDTH_IN - _LEFT_IN - _RIGHT_IN - _COLUMN_GAP_IN * (columns - 1)) / columns
     figure = Figure(figsize=(_WIDTH_IN, height), dpi=_DPI)
-    axes = figure.subplots(rows, columns, squeeze=False, width_ratios=widths, gridspec_kw={
-        "left": _LEFT_IN / _WIDTH_IN, "right": 1.0 - _RIGHT_IN / _WIDTH_IN, "top": 1.0 - _TOP_IN / height,
-        "bottom": (head - _TOP_IN) / height, "wspace": _COLUMN_GAP_IN / panel_width,
-        "hspace": _ROW_GAP_IN / panel_height})
+    # Titles at a fixed height: placed automatically, each panel's would be measured on every draw.
+    with rc_context({"axes.titley": 1.0}):
+        axes = figure.subplots(rows, columns, squeeze=False, width_ratios=widths, gridspec_kw={
+            "left": _LEFT_IN / _WIDTH_IN, "right": 1.0 - _RIGHT_IN / _WIDTH_IN, "top": 1.0 - _TOP_IN / height,
+            "bottom": (head - _TOP_IN) / height, "wspace": _COLUMN_GAP_IN / panel_width,
+            "hspace": _ROW_GAP_IN / panel_height})
     figure.suptitle(title, fontsize=10, y=1.0 - 0.06 / height, va="top")
     for axis in axes.ravel():
         axis.grid(True, alpha=0.3)
