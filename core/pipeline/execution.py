@@ -311,13 +311,17 @@ def prismatic_joints(config: RobotConfig) -> frozenset[str]:
     return frozenset(name for name, joint in config.urdf_joints.items() if joint.type == "prismatic")
 
 
-def check(request: CheckRequest, then: Callable[[CheckedRecording], None] | None = None) -> CheckReport:
+def check(
+    request: CheckRequest, then: Callable[[CheckedRecording], None] | None = None,
+    read_plan: Callable[[Path], recording.PlanFile] = read_valid_plan,
+) -> CheckReport:
     """Return the verdict of the controller's and MoveIt's rules on a recorded execution of a plan.
 
     `then`, if given, gets the verdict with what it was made from while the recording is
-    still open (plots.check_plotted draws from it).
+    still open (plots.check_plotted draws from it). `read_plan` reads and validates the plan
+    file (a batch check keeps the plans it read).
     """
-    plan = read_valid_plan(request.plan)
+    plan = read_plan(request.plan)
     config = plan_config(plan, request.plan)
     controller = plan_controller(config, plan, request.plan, request.controllers, strict=request.strict)
     for step in plan.steps:  # a goal JTC refuses is said before the recording is read

@@ -12,6 +12,7 @@ skip the pairs a results file already judges.
 from __future__ import annotations
 
 import csv
+import functools
 import glob
 import hashlib
 import io
@@ -21,9 +22,12 @@ import traceback
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import InputError, MoveplanError
+
+if TYPE_CHECKING:
+    from ..bag import PlanFile
 
 __all__ = [
     "RESULT_COLUMNS", "CheckFlags", "FleetItem", "ItemResult", "ResultsFile", "batch_exit_code", "check_item",
@@ -190,13 +194,32 @@ def check_item(item: FleetItem, flags: CheckFlags) -> ItemResult:
     request = CheckRequest(item.plan, item.recording, flags.topic, flags.controllers, flags.start, flags.time_source,
                            flags.skip_damaged, flags.strict)
     try:
-        document = check_document(check(request), item.recording)
+        document = check_document(check(request, read_plan=_read_plan), item.recording)
     except MoveplanError as exc:
         document = _error_document(exc.exit_code, exc.kind, str(exc))
     except Exception as exc:  # noqa: BLE001 - a bug met on one item is that item's result, not the batch's end
         document = _error_document(1, "internal", f"internal error (a bug in moveplan, please report it): "
                                                   f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}")
     return ItemResult(item, document, sha256_of(item.plan), sha256_of(item.recording))
+
+
+def _read_plan(path: Path) -> PlanFile:
+    """Return the plan file at `path`, read and validated once per process while the file stays the same."""
+    from ._plan_files import read_valid_plan
+
+    try:
+        stat = path.stat()
+    except OSError:
+        return read_valid_plan(path)  # which names the file and says why it cannot be read
+    return _plan_read(path, stat.st_mtime_ns, stat.st_size)
+
+
+@functools.lru_cache(maxsize=16)
+def _plan_read(path: Path, mtime_ns: int, size: int) -> PlanFile:
+    """Return the plan file at `path` as it was at `mtime_ns` with `size` bytes (the cache's key)."""
+    from ._plan_files import read_valid_plan
+
+    return read_valid_plan(path)
 
 
 def _error_document(exit_code: int, kind: str, message: str) -> dict[str, Any]:

@@ -131,3 +131,15 @@ def test_the_json_document_is_one_strict_document(cli: Cli, fleet: Path) -> None
     result = cli("check-tolerances", "--manifest", fleet, "--json")
     document = json.loads(result.stdout, parse_constant=lambda name: pytest.fail(f"non-JSON {name}"))
     assert set(document) == {"items", "summary"}
+
+
+def test_a_plan_rewritten_between_batches_is_read_anew(cli: Cli, fleet: Path, tmp_path: Path) -> None:
+    """A worker keeps the plans it read while their files stay the same; a rewritten plan is read again."""
+    passing = tmp_path / "passing.csv"
+    passing.write_text("plan,recording\ntool_up_plan.mcap,tool_up_ok.mcap\n")
+    assert cli("check-tolerances", "--manifest", passing).exit_code == 0
+    assert cli("plan", SAMPLES / "ur10e_joint_goals.yaml", "-o", tmp_path / "tool_up_plan.mcap").exit_code == 0
+    code, document = cli.json("check-tolerances", "--manifest", passing)
+    single_code, single = cli.json("check-tolerances", tmp_path / "tool_up_plan.mcap", tmp_path / "tool_up_ok.mcap")
+    assert code == single_code != 0
+    assert document["items"][0]["result"] == single["result"]
