@@ -243,7 +243,13 @@ def check_tolerances(
     manifest: Annotated[Path | None, typer.Option(metavar="FLEET.csv", help=(
         "Check many pairs instead of PLAN RECORDING: a CSV with columns plan, recording (paths relative to it, "
         "globs allowed); other columns are carried into the results."))] = None,
-    jobs: Annotated[int, typer.Option(min=1, help="With --manifest: worker processes checking items at once.")] = 1,
+    jobs: Annotated[int | None, typer.Option(min=1, help=(
+        "With --manifest: workers checking items at once (local: processes, default 1; ray: actors, default one "
+        "per CPU of the cluster)."))] = None,
+    engine: Annotated[str, typer.Option(help=(
+        "With --manifest: local (processes on this machine) or ray (actors on the Ray cluster at --ray-address "
+        "or RAY_ADDRESS)."))] = "local",
+    ray_address: Annotated[str | None, typer.Option(help="With --engine ray: the cluster, HOST:PORT.")] = None,
     csv: Annotated[Path | None, typer.Option(metavar="RESULTS.csv", help=(
         "With --manifest: write a row per item as it is judged."))] = None,
     resume: Annotated[bool, typer.Option("--resume", help=(
@@ -283,12 +289,12 @@ def check_tolerances(
             if plan_file is not None or recording_file is not None or plot is not None:
                 raise UsageError("--manifest checks the pairs it lists: give no PLAN, RECORDING or --plot with it")
             code = _check_fleet(manifest, (topic, controllers, when, source, skip_damaged, strict), jobs, csv, resume,
-                                as_json, quiet)
+                                (engine, ray_address), as_json, quiet)
         else:
             if plan_file is None or recording_file is None:
                 raise UsageError("check-tolerances needs PLAN and RECORDING, or --manifest FLEET.csv")
-            if csv is not None or resume or jobs != 1:
-                raise UsageError("--jobs, --csv and --resume go with --manifest")
+            if csv is not None or resume or jobs is not None or engine != "local" or ray_address is not None:
+                raise UsageError("--jobs, --csv, --resume, --engine and --ray-address go with --manifest")
             request = CheckRequest(plan_file, recording_file, topic, controllers, when, source, skip_damaged, strict)
             if plot is None:
                 report = check(request)
@@ -305,8 +311,8 @@ def check_tolerances(
     raise typer.Exit(code)
 
 
-def _check_fleet(manifest: Path, flags: tuple[Any, ...], jobs: int, csv: Path | None, resume: bool, as_json: bool,
-                 quiet: bool) -> int:
+def _check_fleet(manifest: Path, flags: tuple[Any, ...], jobs: int | None, csv: Path | None, resume: bool,
+                 where: tuple[str, str | None], as_json: bool, quiet: bool) -> int:
     """Check every pair a manifest lists, stream results to `csv`, print the batch's report; return its exit code."""
     from ..core.errors import UsageError
     from ..core.pipeline import CheckFlags, ResultsFile, batch_exit_code, check_items, judged_pairs, read_manifest
@@ -315,6 +321,9 @@ def _check_fleet(manifest: Path, flags: tuple[Any, ...], jobs: int, csv: Path | 
 
     if resume and csv is None:
         raise UsageError("--resume reads and extends the results of --csv RESULTS.csv: give --csv")
+    engine, ray_address = where
+    if engine not in ("local", "ray"):
+        raise UsageError(f"--engine: expected local or ray, got '{engine}'")
     items = read_manifest(manifest)
     if csv is not None:
         check_outputs({"--csv": csv}, {"--manifest": manifest, **{f"item {i.index}": i.recording for i in items},
@@ -331,7 +340,7 @@ def _check_fleet(manifest: Path, flags: tuple[Any, ...], jobs: int, csv: Path | 
                     results_file.write(result)
                 advance(result)
 
-            results = check_items(todo, CheckFlags(*flags), jobs, arrived)
+            results = check_items(todo, CheckFlags(*flags), jobs, arrived, engine, ray_address)
     finally:
         if results_file is not None:
             results_file.close()
@@ -405,8 +414,13 @@ def benchmark(
     planning_time: Annotated[str, typer.Option(
         help="Each search's budget, in seconds at 20,000 checked motions a second (not wall time).")] = "1.0",
     timeout: TimeoutOpt = None,
-    jobs: Annotated[int, typer.Option(min=1, help="Worker processes, each taking the next (planner, seed, problem) run "
-                                      "(1: cleanest times).")] = 1,
+    jobs: Annotated[int | None, typer.Option(min=1, help=(
+        "Workers, each taking the next (planner, seed, problem) run (local: processes, default 1, the cleanest "
+        "times; ray: actors, default one per CPU of the cluster)."))] = None,
+    engine: Annotated[str, typer.Option(help=(
+        "local (processes on this machine) or ray (actors on the Ray cluster at --ray-address or RAY_ADDRESS)."))]
+        = "local",
+    ray_address: Annotated[str | None, typer.Option(help="With --engine ray: the cluster, HOST:PORT.")] = None,
     shard: Annotated[str | None, typer.Option(
         help="Run only shard K of N: every N-th problem from the K-th ('2/4'); merge the shards' --csv files "
              "with benchmark-merge.")] = None,
@@ -431,6 +445,7 @@ def benchmark(
     """Plan many problems with several planners and seeds; report success, times, path quality, exact validity."""
     setup_logging(False, quiet)
     with exit_codes(as_json):
+        from ..core.errors import UsageError
         from ..core.pipeline import (
             check_planning_time,
             find_problems,
@@ -448,6 +463,8 @@ def benchmark(
             from ..core.pipeline import check_plot_path
 
             check_plot_path(plot)
+        if engine not in ("local", "ray"):
+            raise UsageError(f"--engine: expected local or ray, got '{engine}'")
         seed_list = parse_seeds(seeds)
         time_s = check_planning_time(parse_number(planning_time, "--planning-time"))
         timeout_s = parse_optional(parse_number, timeout, "--timeout")
@@ -462,7 +479,8 @@ def benchmark(
         config = source.load()
         planners = [p.strip() for text in planner or [config.motion.planner] for p in text.split(",")]
         with render.benchmark_progress(len(found) * len(planners) * len(seed_list), quiet) as advance:
-            runs = run_benchmark(source, found, planners, seed_list, time_s, jobs, advance, timeout_s, exact_check)
+            runs = run_benchmark(source, found, planners, seed_list, time_s, jobs, advance, timeout_s, exact_check,
+                                 engine, ray_address)
         with all_or_none() as written:
             if csv is not None:
                 write_csv(runs, csv)

@@ -11,6 +11,7 @@ together by `read_runs` from the shards' CSV files.
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import logging
 import multiprocessing
@@ -31,8 +32,8 @@ from ..errors import ConfigError, InputError, MoveplanError, NoPlan, UsageError
 from .request import RobotSource
 
 __all__ = [
-    "STAGES", "ProblemFiles", "Run", "find_problems", "plot_benchmark", "read_runs", "run_benchmark", "shard",
-    "summarize", "write_csv",
+    "STAGES", "ProblemFiles", "Run", "Solver", "find_problems", "plot_benchmark", "read_runs", "run_benchmark",
+    "shard", "summarize", "write_csv",
 ]
 
 logger = logging.getLogger(__name__)
@@ -140,33 +141,86 @@ def run_benchmark(
     planners: Sequence[str],
     seeds: Sequence[int],
     planning_time: float,
-    jobs: int = 1,
+    jobs: int | None = None,
     on_run: Callable[[Run], None] | None = None,
     timeout: float | None = None,
     exact_check: bool = True,
+    engine: str = "local",
+    ray_address: str | None = None,
 ) -> list[Run]:
     """Return every run of every problem with every planner and seed, in a stable order.
 
-    `jobs` worker processes take (planner, seed, problem) runs from one queue, so a single
-    planner and seed spread over the cores too; every run is seeded anew, so which process
-    ran it changes nothing but its times. `on_run` is called in this process as each run
-    completes (for a progress bar). `planning_time` is each search's budget of work;
-    `timeout` its wall-clock safety limit (None: the default for the budget). Without
-    `exact_check`, the independent mesh re-check of each plan is skipped (exact_valid None).
+    `jobs` worker processes (engine "local") or Ray actors (engine "ray", on the cluster at
+    `ray_address` or RAY_ADDRESS; `jobs` None: one per CPU) take (planner, seed, problem) runs
+    from one queue, so a single planner and seed spread over the cores too; every run is
+    seeded anew, so which worker ran it changes nothing but its times. `on_run` is called in
+    this process as each run completes (for a progress bar). `planning_time` is each search's
+    budget of work; `timeout` its wall-clock safety limit (None: the default for the budget).
+    Without `exact_check`, the independent mesh re-check of each plan is skipped (exact_valid None).
     """
+    work = [(planner, seed, index) for planner in planners for seed in seeds for index in range(len(problems))]
+    order = {p.name: i for i, p in enumerate(problems)}
+    runs: list[Run] = []
+
+    def arrived(run: Run) -> None:
+        runs.append(run)
+        if on_run is not None:
+            on_run(run)
+
+    if engine == "ray":
+        from ._ray_engine import ray_cluster, ray_map
+
+        make = functools.partial(Solver, robot, tuple(problems), (planning_time, timeout), exact_check)
+        with ray_cluster(ray_address) as ray:
+            ray_map(ray, make, work, jobs, arrived)
+    elif engine != "local":
+        raise UsageError(f"--engine: expected local or ray, got '{engine}'")
+    else:
+        _in_processes(robot, problems, work, (planning_time, timeout), exact_check, jobs or 1, arrived)
+    return sorted(runs, key=lambda r: (list(planners).index(r.planner), r.seed, order[r.problem]))
+
+
+class Solver:
+    """A benchmark worker: the robot config loaded once, then (planner, seed, problem index) runs solved in turn."""
+
+    def __init__(self, robot: Path | RobotSource, problems: tuple[ProblemFiles, ...],
+                 budget: tuple[float, float | None], exact_check: bool) -> None:
+        """Load the robot config; the problems are solved later, by index."""
+        from ..config import load_robot_config
+
+        self._config = robot.load() if isinstance(robot, RobotSource) else load_robot_config(robot)
+        self._problems, self._budget, self._exact = problems, budget, exact_check
+        self._folder = tempfile.TemporaryDirectory(prefix="moveplan-benchmark-")
+        self._warm = False
+
+    def run(self, task: tuple[str, int, int]) -> Run:
+        """Return the run of one (planner, seed, problem index)."""
+        planner, seed, index = task
+        output = Path(self._folder.name) / "plan.mcap"
+        if not self._warm:
+            # Once untimed: the process's one-time set-up (numba's kernels, the sphere models) is
+            # no part of any call, as the config's loading is not.
+            _solve(self._problems[0], self._config, planner, seed, self._budget, self._exact, output)
+            self._warm = True
+        return _solve(self._problems[index], self._config, planner, seed, self._budget, self._exact, output)
+
+
+def _in_processes(
+    robot: Path | RobotSource, problems: Sequence[ProblemFiles], work: Sequence[tuple[str, int, int]],
+    budget: tuple[float, float | None], exact_check: bool, jobs: int, arrived: Callable[[Run], None],
+) -> None:
+    """Solve `work` in `jobs` spawned worker processes taking runs from one queue; hand each run to `arrived`."""
     context = multiprocessing.get_context("spawn")
     tasks, results = context.Queue(), context.Queue()
-    work = [(planner, seed, index) for planner in planners for seed in seeds for index in range(len(problems))]
     for task in work:
         tasks.put(task)
-    workers = [context.Process(target=_worker, args=(robot, tuple(problems), (planning_time, timeout), exact_check,
-                                                      tasks, results), daemon=True)
+    workers = [context.Process(target=_worker, args=(robot, tuple(problems), budget, exact_check, tasks, results),
+                               daemon=True)
                for _ in range(max(1, min(jobs, len(work))))]
     for _ in workers:
         tasks.put(None)  # one stop sign each, behind the work
     for process in workers:
         process.start()
-    runs: list[Run] = []
     done = 0
     try:
         while done < len(workers):
@@ -178,10 +232,7 @@ def run_benchmark(
                     raise MoveplanError(f"a benchmark worker died (exit code {dead[0]})") from None
                 continue
             if kind == "run":
-                run = Run(**payload)
-                runs.append(run)
-                if on_run is not None:
-                    on_run(run)
+                arrived(Run(**payload))
             elif kind == "done":
                 done += 1
             else:
@@ -191,8 +242,6 @@ def run_benchmark(
             if process.is_alive() and done < len(workers):
                 process.terminate()
             process.join()
-    order = {p.name: i for i, p in enumerate(problems)}
-    return sorted(runs, key=lambda r: (list(planners).index(r.planner), r.seed, order[r.problem]))
 
 
 def _rebuild(payload: dict[str, Any]) -> Exception:
@@ -207,21 +256,9 @@ def _worker(robot: Path | RobotSource, problems: tuple[ProblemFiles, ...], budge
             exact_check: bool, tasks: Any, results: Any) -> None:
     """Run (planner, seed, problem index) tasks from `tasks` until a stop sign; put each run on `results`."""
     try:
-        from ..config import load_robot_config
-
-        config = robot.load() if isinstance(robot, RobotSource) else load_robot_config(robot)
-        with tempfile.TemporaryDirectory(prefix="moveplan-benchmark-") as folder:
-            output = Path(folder) / "plan.mcap"
-            warm = False
-            while (task := tasks.get()) is not None:
-                planner, seed, index = task
-                if not warm:
-                    # Once untimed: the process's one-time set-up (numba's kernels, the sphere models) is
-                    # no part of any call, as the config's loading is not.
-                    _solve(problems[0], config, planner, seed, budget, exact_check, output)
-                    warm = True
-                run = _solve(problems[index], config, planner, seed, budget, exact_check, output)
-                results.put(("run", asdict(run)))
+        solver = Solver(robot, problems, budget, exact_check)
+        while (task := tasks.get()) is not None:
+            results.put(("run", asdict(solver.run(task))))
     except Exception as exc:  # noqa: BLE001 - reported to the parent, which raises it there
         results.put(("error", {"exit_code": getattr(exc, "exit_code", 1), "message": str(exc),
                                "traceback": traceback.format_exc()}))

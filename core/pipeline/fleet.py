@@ -24,13 +24,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import InputError, MoveplanError
+from ..errors import InputError, MoveplanError, UsageError
 
 if TYPE_CHECKING:
     from ..bag import PlanFile
 
 __all__ = [
-    "RESULT_COLUMNS", "CheckFlags", "FleetItem", "ItemResult", "ResultsFile", "batch_exit_code", "check_item",
+    "ENGINES", "RESULT_COLUMNS", "CheckFlags", "FleetItem", "ItemChecker", "ItemResult", "ResultsFile",
+    "batch_exit_code", "check_item",
     "check_items", "fleet_summary", "judged_pairs", "read_manifest", "result_row", "sha256_of",
 ]
 
@@ -162,14 +163,25 @@ class CheckFlags:
     strict: bool = False
 
 
+ENGINES = ("local", "ray")
+"""Where a batch runs: processes on this machine, or actors on an existing Ray cluster."""
+
+
 def check_items(
-    items: Sequence[FleetItem], flags: CheckFlags, jobs: int = 1, on_result: Callable[[ItemResult], None] | None = None,
+    items: Sequence[FleetItem], flags: CheckFlags, jobs: int | None = None,
+    on_result: Callable[[ItemResult], None] | None = None, engine: str = "local", ray_address: str | None = None,
 ) -> list[ItemResult]:
     """Return every item's result, in manifest order; `on_result` gets each as it arrives.
 
-    `jobs` worker processes take items from one queue and keep what items share loaded
-    across them (the interpreter, the robot models); with `jobs` 1 the items are checked in
-    this process.
+    Engine "local": `jobs` worker processes (None: 1, the items checked in this process)
+    take items from one queue. Engine "ray": `jobs` actors (None: one per CPU of the
+    cluster at `ray_address`, or RAY_ADDRESS). Either way a worker keeps what items share
+    loaded across them (the interpreter, the plans it read), and an item's result does not
+    depend on where it ran.
+
+    Raises:
+        UsageError: An unknown engine; for "ray", Ray missing or no cluster address.
+        InputError: The Ray cluster cannot be reached.
     """
     results: list[ItemResult] = []
 
@@ -178,12 +190,31 @@ def check_items(
         if on_result is not None:
             on_result(result)
 
-    if jobs <= 1 or len(items) <= 1:
+    if engine == "ray":
+        from ._ray_engine import ray_cluster, ray_map
+
+        with ray_cluster(ray_address) as ray:
+            ray_map(ray, functools.partial(ItemChecker, flags), items, jobs, arrived)
+    elif engine != "local":
+        raise UsageError(f"--engine: expected one of {', '.join(ENGINES)}, got '{engine}'")
+    elif (jobs or 1) <= 1 or len(items) <= 1:
         for item in items:
             arrived(check_item(item, flags))
     else:
-        _in_workers(items, flags, jobs, arrived)
+        _in_workers(items, flags, jobs or 1, arrived)
     return sorted(results, key=lambda r: r.item.index)
+
+
+class ItemChecker:
+    """A worker of the Ray engine: checks items with the same flags, keeping the plans it read."""
+
+    def __init__(self, flags: CheckFlags) -> None:
+        """Check with `flags`."""
+        self._flags = flags
+
+    def run(self, item: FleetItem) -> ItemResult:
+        """Return the result of checking `item`."""
+        return check_item(item, self._flags)
 
 
 def check_item(item: FleetItem, flags: CheckFlags) -> ItemResult:

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -116,7 +119,7 @@ def test_a_bad_manifest_exits_3_naming_it(cli: Cli, tmp_path: Path, text: str, m
 @pytest.mark.parametrize(("args", "message"), [
     (["--manifest", "M", "--plot", "p.png"], "give no PLAN, RECORDING or --plot with it"),
     (["--manifest", "M", "--resume"], "--resume reads and extends the results of --csv"),
-    (["PLAN", "REC", "--csv", "r.csv"], "--jobs, --csv and --resume go with --manifest"),
+    (["PLAN", "REC", "--csv", "r.csv"], "--jobs, --csv, --resume, --engine and --ray-address go with --manifest"),
     ([], "needs PLAN and RECORDING, or --manifest FLEET.csv"),
 ])
 def test_flags_that_do_not_go_together_exit_2(cli: Cli, fleet: Path, args: list[str], message: str) -> None:
@@ -143,3 +146,42 @@ def test_a_plan_rewritten_between_batches_is_read_anew(cli: Cli, fleet: Path, tm
     single_code, single = cli.json("check-tolerances", tmp_path / "tool_up_plan.mcap", tmp_path / "tool_up_ok.mcap")
     assert code == single_code != 0
     assert document["items"][0]["result"] == single["result"]
+
+
+# --- the Ray engine -------------------------------------------------------------------------------------------------
+
+
+def _moveplan(*args: object, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+    """Run moveplan in a process of its own: Ray's driver state stays out of the test process."""
+    return subprocess.run([sys.executable, "-m", "moveplan.cli.app", *map(str, args)], capture_output=True, text=True,
+                          env={**os.environ, "RAY_USAGE_STATS_ENABLED": "0", **(env or {})}, timeout=600, check=False)
+
+
+def test_the_ray_engine_gives_the_local_engine_s_verdicts(fleet: Path, tmp_path: Path, ray_address: str) -> None:
+    local = _moveplan("check-tolerances", "--manifest", fleet, "--json", "--csv", tmp_path / "local.csv")
+    on_ray = _moveplan("check-tolerances", "--manifest", fleet, "--json", "--csv", tmp_path / "ray.csv",
+                       "--engine", "ray", env={"RAY_ADDRESS": ray_address})
+    assert local.returncode == on_ray.returncode == 3, on_ray.stderr
+    assert json.loads(on_ray.stdout) == json.loads(local.stdout)
+    assert sorted(_rows(tmp_path / "ray.csv"), key=lambda r: int(r["index"])) == \
+        sorted(_rows(tmp_path / "local.csv"), key=lambda r: int(r["index"]))
+
+
+def test_the_ray_engine_says_what_it_lacks(fleet: Path, tmp_path: Path) -> None:
+    blocked = tmp_path / "no_ray" / "ray"
+    blocked.mkdir(parents=True)
+    (blocked / "__init__.py").write_text("raise ImportError('No module named ray')\n")
+    missing = _moveplan("check-tolerances", "--manifest", fleet, "--engine", "ray", "--ray-address", "127.0.0.1:1",
+                        env={"PYTHONPATH": str(blocked.parent)})
+    assert missing.returncode == 2
+    assert missing.stderr.strip() == ("moveplan: error: --engine ray needs Ray, an optional extra: "
+                                      "pip install 'moveplan[ray]'")
+    environment = {key: value for key, value in os.environ.items() if key != "RAY_ADDRESS"}
+    nowhere = subprocess.run([sys.executable, "-m", "moveplan.cli.app", "check-tolerances", "--manifest", str(fleet),
+                              "--engine", "ray"], capture_output=True, text=True, env=environment, timeout=600,
+                             check=False)
+    assert nowhere.returncode == 2 and "give --ray-address HOST:PORT or set RAY_ADDRESS" in nowhere.stderr
+    refused = _moveplan("check-tolerances", "--manifest", fleet, "--engine", "ray", "--ray-address", "127.0.0.1:1")
+    assert refused.returncode == 3
+    assert refused.stderr.strip().startswith("moveplan: error: --ray-address 127.0.0.1:1: cannot connect to a Ray "
+                                             "cluster there")

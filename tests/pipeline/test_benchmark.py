@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import csv
+import os
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -136,3 +139,16 @@ def test_merging_overlapping_or_foreign_files_is_refused_naming_them(cli: Cli, p
 def test_a_bad_shard_is_a_usage_error(cli: Cli, problems: Path, shard: str, message: str) -> None:
     result = cli("benchmark", problems, "--robot", "panda", "--shard", shard)
     assert result.exit_code == 2 and message in result.stderr, result.stderr
+
+
+def test_the_ray_engine_finds_what_local_processes_find(problems: Path, tmp_path: Path, ray_address: str) -> None:
+    """Runs on a Ray cluster (a head and a worker node) are the runs two local processes make."""
+    common = ["benchmark", str(problems), "--robot", "panda", "--planner", "RRTConnect", "--seeds", "0-1", "-q"]
+    local, on_ray = tmp_path / "local.csv", tmp_path / "ray.csv"
+    for extra in (["--jobs", "2", "--csv", str(local)], ["--engine", "ray", "--ray-address", ray_address,
+                                                         "--csv", str(on_ray)]):
+        result = subprocess.run([sys.executable, "-m", "moveplan.cli.app", *common, *extra], capture_output=True,
+                                text=True, timeout=600, check=False,
+                                env={**os.environ, "RAY_USAGE_STATS_ENABLED": "0"})
+        assert result.returncode == 0, result.stderr
+    assert _outcomes(on_ray) == _outcomes(local) and len(_outcomes(local)) == 4
