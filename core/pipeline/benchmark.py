@@ -14,12 +14,9 @@ import csv
 import functools
 import io
 import logging
-import multiprocessing
-import queue as queue_module
 import re
 import tempfile
 import time
-import traceback
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -28,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..bag import atomic_file
-from ..errors import ConfigError, InputError, MoveplanError, NoPlan, UsageError
+from ..errors import ConfigError, InputError, NoPlan, UsageError
 from .request import RobotSource
 
 __all__ = [
@@ -176,7 +173,10 @@ def run_benchmark(
     elif engine != "local":
         raise UsageError(f"--engine: expected local or ray, got '{engine}'")
     else:
-        _in_processes(robot, problems, work, (planning_time, timeout), exact_check, jobs or 1, arrived)
+        from ._local_engine import process_map
+
+        process_map(functools.partial(Solver, robot, tuple(problems), (planning_time, timeout), exact_check), work,
+                    jobs or 1, arrived)
     return sorted(runs, key=lambda r: (list(planners).index(r.planner), r.seed, order[r.problem]))
 
 
@@ -203,67 +203,6 @@ class Solver:
             _solve(self._problems[0], self._config, planner, seed, self._budget, self._exact, output)
             self._warm = True
         return _solve(self._problems[index], self._config, planner, seed, self._budget, self._exact, output)
-
-
-def _in_processes(
-    robot: Path | RobotSource, problems: Sequence[ProblemFiles], work: Sequence[tuple[str, int, int]],
-    budget: tuple[float, float | None], exact_check: bool, jobs: int, arrived: Callable[[Run], None],
-) -> None:
-    """Solve `work` in `jobs` spawned worker processes taking runs from one queue; hand each run to `arrived`."""
-    context = multiprocessing.get_context("spawn")
-    tasks, results = context.Queue(), context.Queue()
-    for task in work:
-        tasks.put(task)
-    workers = [context.Process(target=_worker, args=(robot, tuple(problems), budget, exact_check, tasks, results),
-                               daemon=True)
-               for _ in range(max(1, min(jobs, len(work))))]
-    for _ in workers:
-        tasks.put(None)  # one stop sign each, behind the work
-    for process in workers:
-        process.start()
-    done = 0
-    try:
-        while done < len(workers):
-            try:
-                kind, payload = results.get(timeout=1.0)
-            except queue_module.Empty:
-                dead = [p.exitcode for p in workers if not p.is_alive() and p.exitcode != 0]
-                if dead:
-                    raise MoveplanError(f"a benchmark worker died (exit code {dead[0]})") from None
-                continue
-            if kind == "run":
-                arrived(Run(**payload))
-            elif kind == "done":
-                done += 1
-            else:
-                raise _rebuild(payload)
-    finally:
-        for process in workers:
-            if process.is_alive() and done < len(workers):
-                process.terminate()
-            process.join()
-
-
-def _rebuild(payload: dict[str, Any]) -> Exception:
-    """Return the error a worker reported, as the moveplan error class of its exit code."""
-    by_code: dict[int, type[MoveplanError]] = {2: UsageError, 3: InputError, 4: NoPlan}
-    if payload["exit_code"] in by_code:
-        return by_code[payload["exit_code"]](payload["message"])
-    return RuntimeError(f"benchmark worker failed: {payload['message']}\n{payload['traceback']}")
-
-
-def _worker(robot: Path | RobotSource, problems: tuple[ProblemFiles, ...], budget: tuple[float, float | None],
-            exact_check: bool, tasks: Any, results: Any) -> None:
-    """Run (planner, seed, problem index) tasks from `tasks` until a stop sign; put each run on `results`."""
-    try:
-        solver = Solver(robot, problems, budget, exact_check)
-        while (task := tasks.get()) is not None:
-            results.put(("run", asdict(solver.run(task))))
-    except Exception as exc:  # noqa: BLE001 - reported to the parent, which raises it there
-        results.put(("error", {"exit_code": getattr(exc, "exit_code", 1), "message": str(exc),
-                               "traceback": traceback.format_exc()}))
-        return
-    results.put(("done", None))
 
 
 def _solve(problem: ProblemFiles, config: Any, planner: str, seed: int, budget: tuple[float, float | None],

@@ -16,8 +16,6 @@ import functools
 import glob
 import hashlib
 import io
-import multiprocessing
-import queue as queue_module
 import traceback
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
@@ -201,7 +199,9 @@ def check_items(
         for item in items:
             arrived(check_item(item, flags))
     else:
-        _in_workers(items, flags, jobs or 1, arrived)
+        from ._local_engine import process_map
+
+        process_map(functools.partial(ItemChecker, flags), items, jobs or 1, arrived)
     return sorted(results, key=lambda r: r.item.index)
 
 
@@ -256,48 +256,6 @@ def _plan_read(path: Path, mtime_ns: int, size: int) -> PlanFile:
 def _error_document(exit_code: int, kind: str, message: str) -> dict[str, Any]:
     """Return the document of an item that could not be checked."""
     return {"ok": False, "error": {"exit_code": exit_code, "kind": kind, "message": message}}
-
-
-def _in_workers(
-    items: Sequence[FleetItem], flags: CheckFlags, jobs: int, arrived: Callable[[ItemResult], None]
-) -> None:
-    """Check `items` in `jobs` spawned worker processes taking them from one queue; hand each result to `arrived`."""
-    context = multiprocessing.get_context("spawn")
-    tasks, results = context.Queue(), context.Queue()
-    for item in items:
-        tasks.put(item)
-    workers = [context.Process(target=_worker, args=(flags, tasks, results), daemon=True)
-               for _ in range(min(jobs, len(items)))]
-    for _ in workers:
-        tasks.put(None)
-    for process in workers:
-        process.start()
-    done = 0
-    try:
-        while done < len(workers):
-            try:
-                result = results.get(timeout=1.0)
-            except queue_module.Empty:
-                dead = [p.exitcode for p in workers if not p.is_alive() and p.exitcode != 0]
-                if dead:
-                    raise MoveplanError(f"a batch check worker died (exit code {dead[0]})") from None
-                continue
-            if result is None:
-                done += 1
-            else:
-                arrived(result)
-    finally:
-        for process in workers:
-            if process.is_alive() and done < len(workers):
-                process.terminate()
-            process.join()
-
-
-def _worker(flags: CheckFlags, tasks: Any, results: Any) -> None:
-    """Check items from `tasks` until a stop sign, putting each result on `results`, then None."""
-    while (item := tasks.get()) is not None:
-        results.put(check_item(item, flags))
-    results.put(None)
 
 
 class ResultsFile:
