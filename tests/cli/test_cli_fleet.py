@@ -185,3 +185,28 @@ def test_the_ray_engine_says_what_it_lacks(fleet: Path, tmp_path: Path) -> None:
     assert refused.returncode == 3
     assert refused.stderr.strip().startswith("moveplan: error: --ray-address 127.0.0.1:1: cannot connect to a Ray "
                                              "cluster there")
+
+
+def test_unreadable_manifests_and_results_exit_3_naming_the_file(cli: Cli, fleet: Path, tmp_path: Path) -> None:
+    binary = tmp_path / "binary.csv"
+    binary.write_bytes(b"\xff\xfe\x00plan,recording\n")
+    folder = tmp_path / "folder.csv"
+    folder.mkdir()
+    for manifest, message in ((binary, "cannot read"), (folder, "cannot read: Is a directory"),
+                              (tmp_path / "missing.csv", "cannot read: No such file or directory")):
+        code, document = cli.json("check-tolerances", "--manifest", manifest)
+        assert code == 3 and document["error"]["message"].startswith(f"{manifest}: {message}"), document
+    foreign = tmp_path / "foreign.csv"
+    foreign.write_text("a,b\n1,2\n")
+    code, document = cli.json("check-tolerances", "--manifest", fleet, "--csv", foreign, "--resume")
+    assert code == 3 and document["error"]["message"] == (
+        f"{foreign}: not the results of a batch check (--resume reads the --csv a batch wrote)"), document
+    assert foreign.read_text() == "a,b\n1,2\n"  # left as it was
+
+
+def test_a_results_file_that_is_an_input_is_refused_before_any_work(cli: Cli, fleet: Path) -> None:
+    recording = fleet.parent / "tool_up_ok.mcap"
+    before = recording.read_bytes()
+    result = cli("check-tolerances", "--manifest", fleet, "--csv", recording)
+    assert result.exit_code == 2 and "--csv" in result.stderr, result.stderr
+    assert recording.read_bytes() == before
