@@ -6,6 +6,7 @@ commands, so `moveplan --help` stays fast.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -254,6 +255,9 @@ def check_tolerances(
         "With --manifest: write a row per item as it is judged."))] = None,
     resume: Annotated[bool, typer.Option("--resume", help=(
         "With --manifest and --csv: skip pairs the CSV already judges (same file contents), add the rest."))] = False,
+    html: Annotated[Path | None, typer.Option(metavar="REPORT.html", help=(
+        "With --manifest: write one self-contained page: the summary, a sortable, filterable row per item, "
+        "each opening its tracking errors."))] = None,
     topic: Annotated[str, typer.Option(help="JointState topic in the recording.")] = "/joint_states",
     controllers: Annotated[Path | None, typer.Option(help="ros2_controllers.yaml overriding the plan's.")] = None,
     strict: StrictOpt = False,
@@ -289,12 +293,12 @@ def check_tolerances(
             if plan_file is not None or recording_file is not None or plot is not None:
                 raise UsageError("--manifest checks the pairs it lists: give no PLAN, RECORDING or --plot with it")
             code = _check_fleet(manifest, (topic, controllers, when, source, skip_damaged, strict), jobs, csv, resume,
-                                (engine, ray_address), as_json, quiet)
+                                (engine, ray_address, html), as_json, quiet)
         else:
             if plan_file is None or recording_file is None:
                 raise UsageError("check-tolerances needs PLAN and RECORDING, or --manifest FLEET.csv")
-            if csv is not None or resume or jobs is not None or engine != "local" or ray_address is not None:
-                raise UsageError("--jobs, --csv, --resume, --engine and --ray-address go with --manifest")
+            if csv is not None or resume or jobs is not None or engine != "local" or ray_address is not None or html:
+                raise UsageError("--jobs, --csv, --resume, --engine, --ray-address and --html go with --manifest")
             request = CheckRequest(plan_file, recording_file, topic, controllers, when, source, skip_damaged, strict)
             if plot is None:
                 report = check(request)
@@ -312,22 +316,30 @@ def check_tolerances(
 
 
 def _check_fleet(manifest: Path, flags: tuple[Any, ...], jobs: int | None, csv: Path | None, resume: bool,
-                 where: tuple[str, str | None], as_json: bool, quiet: bool) -> int:
+                 where: tuple[str, str | None, Path | None], as_json: bool, quiet: bool) -> int:
     """Check every pair a manifest lists, stream results to `csv`, print the batch's report; return its exit code."""
     from ..core.errors import UsageError
-    from ..core.pipeline import CheckFlags, ResultsFile, batch_exit_code, check_items, judged_pairs, read_manifest
+    from ..core.pipeline import (
+        CheckFlags,
+        ResultsFile,
+        batch_exit_code,
+        check_items,
+        judged_pairs,
+        read_manifest,
+        write_fleet_html,
+    )
     from ..core.pipeline import sha256_of as digest
     from . import render
 
     if resume and csv is None:
         raise UsageError("--resume reads and extends the results of --csv RESULTS.csv: give --csv")
-    engine, ray_address = where
+    engine, ray_address, html = where
     if engine not in ("local", "ray"):
         raise UsageError(f"--engine: expected local or ray, got '{engine}'")
     items = read_manifest(manifest)
-    if csv is not None:
-        check_outputs({"--csv": csv}, {"--manifest": manifest, **{f"item {i.index}": i.recording for i in items},
-                                       **{f"plan {i.index}": i.plan for i in items}})
+    check_outputs({"--csv": csv, "--html": html}, {"--manifest": manifest,
+                                                   **{f"item {i.index}": i.recording for i in items},
+                                                   **{f"plan {i.index}": i.plan for i in items}})
     judged = judged_pairs(csv) if resume and csv is not None else {}
     keys = [(digest(item.plan), digest(item.recording)) for item in items] if judged else []
     resumed = [judged[key] for key in dict.fromkeys(keys) if key in judged]
@@ -340,10 +352,13 @@ def _check_fleet(manifest: Path, flags: tuple[Any, ...], jobs: int | None, csv: 
                     results_file.write(result)
                 advance(result)
 
-            results = check_items(todo, CheckFlags(*flags), jobs, arrived, engine, ray_address)
+            settings = replace(CheckFlags(*flags), series_points=300 if html else 0)
+            results = check_items(todo, settings, jobs, arrived, engine, ray_address)
     finally:
         if results_file is not None:
             results_file.close()
+    if html is not None:
+        write_fleet_html(html, manifest, results, resumed)
     render.fleet_report(results, resumed, as_json, quiet)
     return batch_exit_code([r.exit_code for r in results] + [int(r["exit_code"]) for r in resumed])
 
@@ -430,6 +445,9 @@ def benchmark(
         = True,
     csv: Annotated[Path | None, typer.Option(help="Write one CSV row per run here.")] = None,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG of the time distributions here.")] = None,
+    html: Annotated[Path | None, typer.Option(metavar="REPORT.html", help=(
+        "Write one self-contained page: the summary, a sortable, filterable row per run, each opening its "
+        "times."))] = None,
     package_path: PackagePathOpt = None,
     xacro_arg: XacroArgOpt = None,
     urdf: UrdfOpt = None,
@@ -457,7 +475,7 @@ def benchmark(
         from ..core.pipeline import shard as shard_of
         from . import render
 
-        check_outputs({"--csv": csv, "--plot": plot},
+        check_outputs({"--csv": csv, "--plot": plot, "--html": html},
                       {"PROBLEMS": problems, "--robot": robot, **description_inputs(urdf, srdf, joint_limits)})
         if plot is not None:
             from ..core.pipeline import check_plot_path
@@ -488,6 +506,11 @@ def benchmark(
             if plot is not None:
                 plot_benchmark(runs, plot)
                 written.append(plot)
+            if html is not None:
+                from ..core.pipeline import write_benchmark_html
+
+                write_benchmark_html(html, runs, summarize(runs))
+                written.append(html)
     render.benchmark_summary(runs, summarize(runs), as_json, quiet)
 
 

@@ -23,6 +23,7 @@ if TYPE_CHECKING:
         run_benchmark,
         shard,
         summarize,
+        write_benchmark_html,
         write_csv,
     )
     from .documents import (
@@ -47,6 +48,7 @@ if TYPE_CHECKING:
         judged_pairs,
         read_manifest,
         sha256_of,
+        write_fleet_html,
     )
     from .inspection import Inspection, inspect_file
     from .plan import PlanResult, plan_to_file
@@ -137,7 +139,9 @@ __all__ = [
     "summarize",
     "tune",
     "tuning_document",
+    "write_benchmark_html",
     "write_csv",
+    "write_fleet_html",
     "write_plan_plot",
     "write_session",
     "write_tuning_plot",
@@ -199,7 +203,9 @@ __getattr__ = lazy_exports(__name__, {
     "summarize": "benchmark",
     "tune": "tuning",
     "tuning_document": "tuning",
+    "write_benchmark_html": "benchmark",
     "write_csv": "benchmark",
+    "write_fleet_html": "fleet",
     "write_plan_plot": "plots",
     "write_session": "session",
     "write_tuning_plot": "plots",

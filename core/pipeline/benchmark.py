@@ -30,7 +30,7 @@ from .request import RobotSource
 
 __all__ = [
     "STAGES", "ProblemFiles", "Run", "Solver", "find_problems", "plot_benchmark", "read_runs", "run_benchmark",
-    "shard", "summarize", "write_csv",
+    "shard", "summarize", "write_benchmark_html", "write_csv",
 ]
 
 logger = logging.getLogger(__name__)
@@ -343,6 +343,29 @@ def write_csv(runs: Iterable[Run], path: Path) -> None:
             writer.writerow(run.as_dict())
         text.flush()
         text.detach()  # the stream is atomic_file's to close
+
+
+def write_benchmark_html(path: Path, runs: Sequence[Run], rows: Sequence[dict[str, Any]]) -> None:
+    """Write a benchmark's HTML report: per planner and scenario the summary, a row per run opening its times."""
+    from .html_report import write_html
+
+    def ms(value: float) -> float | None:
+        return None if value != value else round(1e3 * value, 4)
+
+    overall = [r for r in rows if r["scenario"] == "all"]
+    summary = [("runs", str(len(runs)))] + [
+        (f"{r['planner']}", f"{r['succeeded']}/{r['runs']} solved, total median "
+                            f"{1e3 * (r['total_median_s'] or 0):.3g} ms, exact-valid {r['exact_valid']}")
+        for r in overall]
+    columns = ["problem", "scenario", "planner", "seed", "solved", "search [ms]", "total [ms]", "whole call [ms]",
+               "path [rad]", "duration [s]", "exact-valid", "error"]
+    table = [[r.problem, r.scenario, r.planner, r.seed, str(r.ok), ms(r.search_s), ms(r.total_s), ms(r.whole_call_s),
+              None if r.path_length != r.path_length else r.path_length,
+              None if r.duration_s != r.duration_s else r.duration_s,
+              "" if r.exact_valid is None else str(r.exact_valid), r.error or ""] for r in runs]
+    details: list[dict[str, Any] | None] = [
+        {"bars": [[stage, ms(getattr(r, f"{stage}_s")), "ms"] for stage in STAGES]} if r.ok else None for r in runs]
+    write_html(path, "moveplan benchmark", summary, columns, table, details, 4)
 
 
 def plot_benchmark(runs: Iterable[Run], path: Path) -> None:

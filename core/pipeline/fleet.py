@@ -30,7 +30,7 @@ if TYPE_CHECKING:
 __all__ = [
     "ENGINES", "RESULT_COLUMNS", "CheckFlags", "FleetItem", "ItemChecker", "ItemResult", "ResultsFile",
     "batch_exit_code", "check_item",
-    "check_items", "fleet_summary", "judged_pairs", "read_manifest", "result_row", "sha256_of",
+    "check_items", "fleet_summary", "judged_pairs", "read_manifest", "result_row", "sha256_of", "write_fleet_html",
 ]
 
 RESULT_COLUMNS = ("index", "plan", "recording", "plan_sha256", "recording_sha256", "ok", "exit_code", "result",
@@ -60,6 +60,7 @@ class ItemResult:
     document: dict[str, Any]
     plan_sha256: str = ""
     recording_sha256: str = ""
+    series: dict[str, Any] | None = None  # the tracking errors the HTML report draws (CheckFlags.series_points)
 
     @property
     def exit_code(self) -> int:
@@ -159,6 +160,7 @@ class CheckFlags:
     time_source: Any = "header"
     skip_damaged: bool = False
     strict: bool = False
+    series_points: int = 0  # per joint, the tracking error samples each result keeps for a report (0: none)
 
 
 ENGINES = ("local", "ray")
@@ -224,14 +226,41 @@ def check_item(item: FleetItem, flags: CheckFlags) -> ItemResult:
 
     request = CheckRequest(item.plan, item.recording, flags.topic, flags.controllers, flags.start, flags.time_source,
                            flags.skip_damaged, flags.strict)
+    drawn: list[dict[str, Any]] = []
+
+    def keep_series(checked: Any) -> None:
+        if flags.series_points and checked.report.complete:
+            from .plots.commands import checked_tracking
+
+            drawn.append(_series(checked_tracking(checked, request, flags.series_points)))
+
     try:
-        document = check_document(check(request, read_plan=_read_plan), item.recording)
+        document = check_document(check(request, keep_series, read_plan=_read_plan), item.recording)
     except MoveplanError as exc:
         document = _error_document(exc.exit_code, exc.kind, str(exc))
     except Exception as exc:  # noqa: BLE001 - a bug met on one item is that item's result, not the batch's end
         document = _error_document(1, "internal", f"internal error (a bug in moveplan, please report it): "
                                                   f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}")
-    return ItemResult(item, document, sha256_of(item.plan), sha256_of(item.recording))
+    return ItemResult(item, document, sha256_of(item.plan), sha256_of(item.recording), drawn[0] if drawn else None)
+
+
+def _series(tracking: Any) -> dict[str, Any]:
+    """Return a checked execution's tracking error per joint as JSON-ready lists: what a report draws."""
+    import numpy as np
+
+    times = np.concatenate([step.times_s for step in tracking.steps]) if tracking.steps else np.zeros(0)
+    joints = []
+    for column, joint in enumerate(tracking.joints):
+        errors = np.concatenate([step.error[:, column] for step in tracking.steps]) if tracking.steps else times
+        joints.append({"name": joint, "unit": tracking.units[column], "error": _rounded(errors),
+                       "path": float(tracking.path_tolerance[column]), "goal": float(tracking.goal_tolerance[column])})
+    return {"t": _rounded(times), "joints": joints, "steps": [[step.name, step.start_s] for step in tracking.steps]}
+
+
+def _rounded(values: Any) -> list[float | None]:
+    """Return values as floats of 6 significant digits, None where not finite (JSON has no NaN)."""
+    return [float(f"{value:.6g}") if value == value and abs(value) != float("inf") else None
+            for value in values.tolist()]
 
 
 def _read_plan(path: Path) -> PlanFile:
@@ -337,3 +366,47 @@ def fleet_summary(results: Sequence[ItemResult], resumed: Sequence[dict[str, str
         "worst_margins": [{"plan": r["plan"], "recording": r["recording"], "joint": r["worst_joint"], "margin": margin}
                           for margin, r in margins[:_WORST_LISTED]],
     }
+
+
+def write_fleet_html(
+    path: Path, manifest: Path, results: Sequence[ItemResult], resumed: Sequence[dict[str, str]]
+) -> None:
+    """Write a batch check's HTML report to `path`: the summary, a row per item, each opening its errors; return None.
+
+    Items an earlier run judged (--resume) are rows of their CSV values, with nothing to draw.
+    """
+    from .html_report import write_html
+
+    summary = fleet_summary(results, resumed)
+    extra = list(results[0].item.columns) if results else [k for k in (resumed[0] if resumed else {})
+                                                           if k not in RESULT_COLUMNS]
+    columns = ["#", "plan", "recording", "verdict", "exit", "worst joint", "margin", "ringing", "duration [s]", *extra]
+    rows, details = [], []
+    for result in results:
+        row = result_row(result)
+        ringing = [j for j, t in (result.document.get("tracking") or {}).items() if t.get("ringing")]
+        rows.append([row["index"], row["plan"], row["recording"], row["result"], row["exit_code"], row["worst_joint"],
+                     _number(row["worst_margin"]), ", ".join(ringing), _number(row["duration_s"]),
+                     *(row.get(k, "") for k in extra)])
+        details.append(result.series)
+    for row in resumed:
+        rows.append([int(row["index"]), row["plan"], row["recording"], row["result"], int(row["exit_code"]),
+                     row["worst_joint"], _number(row["worst_margin"]), "", _number(row["duration_s"]),
+                     *(row.get(k, "") for k in extra)])
+        details.append(None)
+    pairs = [("manifest", str(manifest)), ("items", str(summary["items"])), ("passed", str(summary["passed"])),
+             ("failed (a violation)", str(summary["failed"])), ("not checked", str(summary["unreadable"])),
+             ("judged by an earlier run", str(summary["resumed"])), ("exit code", str(summary["exit_code"]))]
+    if summary["worst_margins"]:
+        worst = summary["worst_margins"][0]
+        pairs.append(("smallest margin", f"{worst['margin']:.4g} ({worst['joint']}, {worst['recording']})"))
+    write_html(path, f"moveplan check-tolerances --manifest {manifest.name}", pairs, columns, rows, details, 3)
+
+
+def _number(value: Any) -> float | None:
+    """Return a CSV cell or a row value as a float, None if empty or not finite."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return None
+    return number if number == number and abs(number) != float("inf") else None

@@ -119,7 +119,7 @@ def test_a_bad_manifest_exits_3_naming_it(cli: Cli, tmp_path: Path, text: str, m
 @pytest.mark.parametrize(("args", "message"), [
     (["--manifest", "M", "--plot", "p.png"], "give no PLAN, RECORDING or --plot with it"),
     (["--manifest", "M", "--resume"], "--resume reads and extends the results of --csv"),
-    (["PLAN", "REC", "--csv", "r.csv"], "--jobs, --csv, --resume, --engine and --ray-address go with --manifest"),
+    (["PLAN", "REC", "--csv", "r.csv"], "--ray-address and --html go with --manifest"),
     ([], "needs PLAN and RECORDING, or --manifest FLEET.csv"),
 ])
 def test_flags_that_do_not_go_together_exit_2(cli: Cli, fleet: Path, args: list[str], message: str) -> None:

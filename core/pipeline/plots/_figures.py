@@ -193,10 +193,10 @@ def prefixed(span: float, unit: str) -> tuple[float, str]:
     return 1.0, unit
 
 
-def step_budget(duration_s: float, total_s: float) -> int:
-    """Return the samples a step of `duration_s` [s] keeps: its share of POINTS_PER_SERIES, never very few."""
+def step_budget(duration_s: float, total_s: float, points: int = POINTS_PER_SERIES) -> int:
+    """Return the samples a step of `duration_s` [s] keeps: its share of `points`, never very few."""
     share = duration_s / total_s if total_s > 0.0 else 1.0
-    return max(_MIN_STEP_POINTS, int(POINTS_PER_SERIES * share))
+    return max(min(_MIN_STEP_POINTS, points), int(points * share))
 
 
 def position_units(config: RobotConfig, joints: Sequence[str]) -> tuple[str, ...]:

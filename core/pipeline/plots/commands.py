@@ -31,7 +31,7 @@ from ..execution import (
     check,
     execute,
 )
-from ._figures import position_units, step_budget, write_png
+from ._figures import POINTS_PER_SERIES, position_units, step_budget, write_png
 from ._tracking import TrackedStep, Tracking, ViolationMark, tracking_figure
 
 if TYPE_CHECKING:
@@ -40,7 +40,7 @@ if TYPE_CHECKING:
     from ...types import JointTrajectory, TfSamples
 
 __all__ = [
-    "check_plotted", "execute_plotted", "thinned",
+    "check_plotted", "checked_tracking", "execute_plotted", "thinned",
 ]
 
 def execute_plotted(
@@ -87,7 +87,7 @@ def check_plotted(request: CheckRequest, plot: Path) -> CheckReport:
 
     def draw(checked: CheckedRecording) -> None:
         if checked.report.complete:
-            write_png(tracking_figure(_checked_tracking(checked, request)), plot)
+            write_png(tracking_figure(checked_tracking(checked, request)), plot)
 
     return check(request, draw)
 
@@ -153,8 +153,8 @@ class _Both:
             recorder.finish(execution)
 
 
-def _checked_tracking(checked: CheckedRecording, request: CheckRequest) -> Tracking:
-    """Return a checked execution's samples against the plan, and how to title it."""
+def checked_tracking(checked: CheckedRecording, request: CheckRequest, points: int = POINTS_PER_SERIES) -> Tracking:
+    """Return a checked execution's samples against the plan (about `points` per joint), and how to title it."""
     report, controller, plan = checked.report, checked.controller, checked.plan
     steps, which = _drawn_steps(report)
     samples = checked.samples
@@ -168,7 +168,7 @@ def _checked_tracking(checked: CheckedRecording, request: CheckRequest) -> Track
     for step, planned in zip(steps, plan.steps, strict=False):
         trajectory = in_controller_order(planned.trajectory, controller, hold)
         tracked.append(_recorded_step(samples, columns, continuous, step, trajectory, origin,
-                                      step_budget(step.duration_s, total)))
+                                      step_budget(step.duration_s, total, points)))
     verdict = "within tolerances" if report.ok else report.result.name
     title = (f"moveplan check-tolerances {request.plan.name} {request.recording.name}: {verdict}{which}; "
              f"t = 0 is {round(origin, 3) + 0.0:.3f} s into the recording\n{_shortened(report.result.message)}")
