@@ -1,7 +1,8 @@
 """Items per second of `check-tolerances --manifest` on a night's recordings, against a shell loop of single checks.
 
 Run from the repository root with moveplan installed:
-    python benchmarks/fleet.py [--items 1000] [--minutes 1] [--jobs 1,2] [--loop 10] [--repeats 3]
+    python benchmarks/fleet.py [--items 1000] [--minutes 1] [--jobs 1,2] [--engines local,ray] [--loop 10]
+        [--repeats 3]
 
 The recording is an executed file of a UR10e task alternating two joint goals for about
 `--minutes` (planned and executed once, kept under /tmp/moveplan_fleet_<minutes>/); the night's
@@ -9,7 +10,10 @@ The recording is an executed file of a UR10e task alternating two joint goals fo
 check's, not the disk's (each item is still read and hashed from its own path). Each batch is
 the whole command, `moveplan check-tolerances --manifest M --jobs N -q`, timed `--repeats`
 times (median); the shell loop runs `--loop` single checks, one process each, and its median
-per item is scaled to `--items`. Machines are shared and noisy: compare ratios, run it twice.
+per item is scaled to `--items`. For the Ray engine (`--engine ray`, needs `moveplan[ray]`) the
+script starts a cluster on this machine, a head and a worker node of one CPU each (stopped at
+the end), and runs the same batches with `--jobs N` actors. Machines are shared and noisy:
+compare ratios, run it twice.
 """
 
 from __future__ import annotations
@@ -20,6 +24,8 @@ import statistics
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 MOVEPLAN = [sys.executable, "-m", "moveplan.cli.app"]
@@ -72,6 +78,7 @@ def main() -> None:
     parser.add_argument("--items", type=int, default=1000)
     parser.add_argument("--minutes", type=float, default=1.0)
     parser.add_argument("--jobs", default="1,2")
+    parser.add_argument("--engines", default="local,ray")
     parser.add_argument("--loop", type=int, default=10)
     parser.add_argument("--repeats", type=int, default=3)
     args = parser.parse_args()
@@ -84,14 +91,35 @@ def main() -> None:
     loop_s = statistics.median(single) * args.items
     print(f"shell loop of single checks: {statistics.median(single):.3f} s an item (median of {args.loop}), "
           f"{loop_s:.0f} s for {args.items}: {args.items / loop_s:.2f} items/s")
-    first = None
-    for jobs in (int(j) for j in args.jobs.split(",")):
-        walls = [timed([*MOVEPLAN, "check-tolerances", "--manifest", str(manifest), "--jobs", str(jobs), "-q"])
-                 for _ in range(args.repeats)]
-        wall = statistics.median(walls)
-        first = first or wall
-        print(f"local engine, {jobs} worker(s): {wall:.1f} s (median of {args.repeats}), "
-              f"{args.items / wall:.2f} items/s; {first / wall:.2f}x one worker, {loop_s / wall:.1f}x the shell loop")
+    for engine in args.engines.split(","):
+        with cluster(engine) as address:
+            first = None
+            for jobs in (int(j) for j in args.jobs.split(",")):
+                command = [*MOVEPLAN, "check-tolerances", "--manifest", str(manifest), "--jobs", str(jobs), "-q",
+                           "--engine", engine, *(["--ray-address", address] if address else [])]
+                wall = statistics.median(timed(command) for _ in range(args.repeats))
+                first = first or wall
+                print(f"{engine} engine, {jobs} worker(s): {wall:.1f} s (median of {args.repeats}), "
+                      f"{args.items / wall:.2f} items/s; {first / wall:.2f}x one worker, "
+                      f"{loop_s / wall:.1f}x the shell loop")
+
+
+@contextmanager
+def cluster(engine: str) -> Iterator[str | None]:
+    """Yield a Ray cluster's address for engine "ray" (a head and a worker node here, one CPU each), else None."""
+    if engine != "ray":
+        yield None
+        return
+    from ray.cluster_utils import Cluster
+
+    os.environ["RAY_USAGE_STATS_ENABLED"] = "0"
+    ray_cluster = Cluster(initialize_head=True, head_node_args={"num_cpus": 1, "include_dashboard": False})
+    ray_cluster.add_node(num_cpus=1)
+    try:
+        ray_cluster.wait_for_nodes()
+        yield ray_cluster.address
+    finally:
+        ray_cluster.shutdown()
 
 
 if __name__ == "__main__":

@@ -230,7 +230,7 @@ def check_item(item: FleetItem, flags: CheckFlags) -> ItemResult:
 
     def keep_series(checked: Any) -> None:
         if flags.series_points and checked.report.complete:
-            from .plots.commands import checked_tracking
+            from .plots import checked_tracking
 
             drawn.append(_series(checked_tracking(checked, request, flags.series_points)))
 

@@ -14,12 +14,13 @@ from ..._faces import lazy_exports
 if TYPE_CHECKING:
     from ._figures import check_plot_path
     from ._plan import write_plan_plot
-    from .commands import check_plotted, execute_plotted
+    from .commands import check_plotted, checked_tracking, execute_plotted
     from .tuning import write_tuning_plot
 
 __all__ = [
     "check_plot_path",
     "check_plotted",
+    "checked_tracking",
     "execute_plotted",
     "write_plan_plot",
     "write_tuning_plot",
@@ -28,6 +29,7 @@ __all__ = [
 __getattr__ = lazy_exports(__name__, {
     "check_plot_path": "_figures",
     "check_plotted": "commands",
+    "checked_tracking": "commands",
     "execute_plotted": "commands",
     "write_plan_plot": "_plan",
     "write_tuning_plot": "tuning",
