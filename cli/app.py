@@ -323,12 +323,13 @@ def _check_fleet(manifest: Path, flags: tuple[Any, ...], jobs: int | None, csv: 
         CheckFlags,
         ResultsFile,
         batch_exit_code,
+        check_html_path,
         check_items,
         judged_pairs,
         read_manifest,
+        unresumed_items,
         write_fleet_html,
     )
-    from ..core.pipeline import sha256_of as digest
     from . import render
 
     if resume and csv is None:
@@ -336,14 +337,14 @@ def _check_fleet(manifest: Path, flags: tuple[Any, ...], jobs: int | None, csv: 
     engine, ray_address, html = where
     if engine not in ("local", "ray"):
         raise UsageError(f"--engine: expected local or ray, got '{engine}'")
+    if html is not None:
+        check_html_path(html)
     items = read_manifest(manifest)
     check_outputs({"--csv": csv, "--html": html}, {"--manifest": manifest,
                                                    **{f"item {i.index}": i.recording for i in items},
                                                    **{f"plan {i.index}": i.plan for i in items}})
     judged = judged_pairs(csv) if resume and csv is not None else {}
-    keys = [(digest(item.plan), digest(item.recording)) for item in items] if judged else []
-    resumed = [judged[key] for key in dict.fromkeys(keys) if key in judged]
-    todo = [item for number, item in enumerate(items) if not judged or keys[number] not in judged]
+    todo, resumed = unresumed_items(items, judged) if judged else (list(items), [])
     results_file = ResultsFile(csv, list(items[0].columns), append=resume) if csv is not None else None
     try:
         with render.fleet_progress(len(todo), quiet or as_json) as advance:
@@ -352,7 +353,7 @@ def _check_fleet(manifest: Path, flags: tuple[Any, ...], jobs: int | None, csv: 
                     results_file.write(result)
                 advance(result)
 
-            settings = replace(CheckFlags(*flags), series_points=300 if html else 0)
+            settings = replace(CheckFlags(*flags), series_points=300 if html else 0, hashes=csv is not None)
             results = check_items(todo, settings, jobs, arrived, engine, ray_address)
     finally:
         if results_file is not None:
@@ -467,16 +468,17 @@ def benchmark(
         from ..core.pipeline import (
             check_planning_time,
             find_problems,
-            plot_benchmark,
             run_benchmark,
-            summarize,
-            write_csv,
         )
         from ..core.pipeline import shard as shard_of
         from . import render
 
         check_outputs({"--csv": csv, "--plot": plot, "--html": html},
                       {"PROBLEMS": problems, "--robot": robot, **description_inputs(urdf, srdf, joint_limits)})
+        if html is not None:
+            from ..core.pipeline import check_html_path
+
+            check_html_path(html)
         if plot is not None:
             from ..core.pipeline import check_plot_path
 
@@ -499,19 +501,26 @@ def benchmark(
         with render.benchmark_progress(len(found) * len(planners) * len(seed_list), quiet) as advance:
             runs = run_benchmark(source, found, planners, seed_list, time_s, jobs, advance, timeout_s, exact_check,
                                  engine, ray_address)
-        with all_or_none() as written:
-            if csv is not None:
-                write_csv(runs, csv)
-                written.append(csv)
-            if plot is not None:
-                plot_benchmark(runs, plot)
-                written.append(plot)
-            if html is not None:
-                from ..core.pipeline import write_benchmark_html
+        rows = _benchmark_outputs(runs, csv, plot, html)
+    render.benchmark_summary(runs, rows, as_json, quiet)
 
-                write_benchmark_html(html, runs, summarize(runs))
-                written.append(html)
-    render.benchmark_summary(runs, summarize(runs), as_json, quiet)
+
+def _benchmark_outputs(runs: list[Any], csv: Path | None, plot: Path | None, html: Path | None) -> list[dict[str, Any]]:
+    """Write the runs' CSV, plot and page that were asked for, all or none; return their summary rows."""
+    from ..core.pipeline import plot_benchmark, summarize, write_benchmark_html, write_csv
+
+    rows = summarize(runs)
+    with all_or_none() as written:
+        if csv is not None:
+            write_csv(runs, csv)
+            written.append(csv)
+        if plot is not None:
+            plot_benchmark(runs, plot)
+            written.append(plot)
+        if html is not None:
+            write_benchmark_html(html, runs, rows)
+            written.append(html)
+    return rows
 
 
 @app.command("benchmark-merge")
@@ -519,6 +528,8 @@ def benchmark_merge(
     runs: Annotated[list[Path], typer.Argument(help="The --csv files of benchmark runs (one benchmark's shards).")],
     csv: Annotated[Path | None, typer.Option(help="Write every run, one CSV row each, here.")] = None,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG of the time distributions here.")] = None,
+    html: Annotated[Path | None, typer.Option(metavar="REPORT.html", help=(
+        "Write one self-contained page: the summary, a sortable, filterable row per run."))] = None,
     as_json: JsonOpt = False,
     quiet: QuietOpt = False,
 ) -> None:
@@ -526,10 +537,14 @@ def benchmark_merge(
     setup_logging(False, quiet)
     with exit_codes(as_json):
         from ..core.errors import InputError
-        from ..core.pipeline import plot_benchmark, read_runs, summarize, write_csv
+        from ..core.pipeline import read_runs
         from . import render
 
-        check_outputs({"--csv": csv, "--plot": plot}, {"RUNS": runs})
+        check_outputs({"--csv": csv, "--plot": plot, "--html": html}, {"RUNS": runs})
+        if html is not None:
+            from ..core.pipeline import check_html_path
+
+            check_html_path(html)
         if plot is not None:
             from ..core.pipeline import check_plot_path
 
@@ -537,14 +552,8 @@ def benchmark_merge(
         merged = read_runs(runs)
         if not merged:
             raise InputError(f"{', '.join(map(str, runs))}: no benchmark run in these files")
-        with all_or_none() as written:
-            if csv is not None:
-                write_csv(merged, csv)
-                written.append(csv)
-            if plot is not None:
-                plot_benchmark(merged, plot)
-                written.append(plot)
-    render.benchmark_summary(merged, summarize(merged), as_json, quiet)
+        rows = _benchmark_outputs(merged, csv, plot, html)
+    render.benchmark_summary(merged, rows, as_json, quiet)
 
 
 app.command("state")(state_command.state)

@@ -48,8 +48,10 @@ if TYPE_CHECKING:
         judged_pairs,
         read_manifest,
         sha256_of,
+        unresumed_items,
         write_fleet_html,
     )
+    from .html_report import check_html_path
     from .inspection import Inspection, inspect_file
     from .plan import PlanResult, plan_to_file
     from .plots import check_plot_path, check_plotted, execute_plotted, write_plan_plot, write_tuning_plot
@@ -99,6 +101,7 @@ __all__ = [
     "cartesian_motion",
     "check",
     "check_document",
+    "check_html_path",
     "check_execution",
     "check_items",
     "check_planning_time",
@@ -139,6 +142,7 @@ __all__ = [
     "summarize",
     "tune",
     "tuning_document",
+    "unresumed_items",
     "write_benchmark_html",
     "write_csv",
     "write_fleet_html",
@@ -168,6 +172,7 @@ __getattr__ = lazy_exports(__name__, {
     "cartesian_motion": "session",
     "check": "execution",
     "check_document": "report",
+    "check_html_path": "html_report",
     "check_execution": "session",
     "check_planning_time": "request",
     "check_plot_path": "plots",
@@ -203,6 +208,7 @@ __getattr__ = lazy_exports(__name__, {
     "summarize": "benchmark",
     "tune": "tuning",
     "tuning_document": "tuning",
+    "unresumed_items": "fleet",
     "write_benchmark_html": "benchmark",
     "write_csv": "benchmark",
     "write_fleet_html": "fleet",

@@ -18,7 +18,7 @@ import hashlib
 import io
 import traceback
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -30,7 +30,8 @@ if TYPE_CHECKING:
 __all__ = [
     "ENGINES", "RESULT_COLUMNS", "CheckFlags", "FleetItem", "ItemChecker", "ItemResult", "ResultsFile",
     "batch_exit_code", "check_item",
-    "check_items", "fleet_summary", "judged_pairs", "read_manifest", "result_row", "sha256_of", "write_fleet_html",
+    "check_items", "fleet_summary", "judged_pairs", "read_manifest", "result_row", "sha256_of", "unresumed_items",
+    "write_fleet_html",
 ]
 
 RESULT_COLUMNS = ("index", "plan", "recording", "plan_sha256", "recording_sha256", "ok", "exit_code", "result",
@@ -50,6 +51,7 @@ class FleetItem:
     plan: Path
     recording: Path
     columns: dict[str, str] = field(default_factory=dict)
+    sha256: tuple[str, str] | None = None  # the plan's and the recording's, once computed (unresumed_items)
 
 
 @dataclass(frozen=True)
@@ -150,6 +152,15 @@ def judged_pairs(path: Path) -> dict[tuple[str, str], dict[str, str]]:
     return {(r["plan_sha256"], r["recording_sha256"]): r for r in rows if r["plan_sha256"] and r["recording_sha256"]}
 
 
+def unresumed_items(
+    items: Sequence[FleetItem], judged: dict[tuple[str, str], dict[str, str]]
+) -> tuple[list[FleetItem], list[dict[str, str]]]:
+    """Return the items a results file does not judge yet (their files hashed once), and its rows for the others."""
+    keyed = [replace(item, sha256=(sha256_of(item.plan), sha256_of(item.recording))) for item in items]
+    resumed = [judged[key] for key in dict.fromkeys(item.sha256 for item in keyed if item.sha256) if key in judged]
+    return [item for item in keyed if item.sha256 not in judged], resumed
+
+
 @dataclass(frozen=True)
 class CheckFlags:
     """The check-tolerances flags every item is checked with (as CheckRequest's fields)."""
@@ -161,6 +172,7 @@ class CheckFlags:
     skip_damaged: bool = False
     strict: bool = False
     series_points: int = 0  # per joint, the tracking error samples each result keeps for a report (0: none)
+    hashes: bool = False  # each result carries its files' SHA-256 (a results file keys its rows by them)
 
 
 ENGINES = ("local", "ray")
@@ -241,7 +253,8 @@ def check_item(item: FleetItem, flags: CheckFlags) -> ItemResult:
     except Exception as exc:  # noqa: BLE001 - a bug met on one item is that item's result, not the batch's end
         document = _error_document(1, "internal", f"internal error (a bug in moveplan, please report it): "
                                                   f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}")
-    return ItemResult(item, document, sha256_of(item.plan), sha256_of(item.recording), drawn[0] if drawn else None)
+    hashes = item.sha256 or ((sha256_of(item.plan), sha256_of(item.recording)) if flags.hashes else ("", ""))
+    return ItemResult(item, document, *hashes, drawn[0] if drawn else None)
 
 
 def _series(tracking: Any) -> dict[str, Any]:

@@ -15,8 +15,19 @@ from pathlib import Path
 from typing import Any
 
 from ..bag import atomic_file
+from ..errors import InputError
 
-__all__ = ["write_html"]
+__all__ = ["check_html_path", "write_html"]
+
+
+def check_html_path(path: Path) -> None:
+    """Refuse a report path whose folder does not exist, before any work (as -o's "cannot write", exit 3); return None.
+
+    Raises:
+        InputError: The folder does not exist.
+    """
+    if not path.parent.is_dir():
+        raise InputError(f"--html '{path}': cannot write: folder '{path.parent}' does not exist")
 
 
 def write_html(

@@ -210,3 +210,13 @@ def test_a_results_file_that_is_an_input_is_refused_before_any_work(cli: Cli, fl
     result = cli("check-tolerances", "--manifest", fleet, "--csv", recording)
     assert result.exit_code == 2 and "--csv" in result.stderr, result.stderr
     assert recording.read_bytes() == before
+
+
+def test_an_unknown_engine_or_a_report_in_no_folder_is_refused_before_any_work(cli: Cli, fleet: Path) -> None:
+    engine = cli("check-tolerances", "--manifest", fleet, "--engine", "spark")
+    assert engine.exit_code == 2
+    assert engine.stderr.strip() == "moveplan: error: --engine: expected local or ray, got 'spark'"
+    nowhere = fleet.parent / "out" / "night.html"
+    report = cli("check-tolerances", "--manifest", fleet, "--html", nowhere, "--csv", fleet.parent / "r.csv")
+    assert report.exit_code == 3 and "cannot write: folder" in report.stderr, report.stderr
+    assert not (fleet.parent / "r.csv").exists() and not nowhere.parent.exists()

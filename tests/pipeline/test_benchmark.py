@@ -152,3 +152,14 @@ def test_the_ray_engine_finds_what_local_processes_find(problems: Path, tmp_path
                                 env={**os.environ, "RAY_USAGE_STATS_ENABLED": "0"})
         assert result.returncode == 0, result.stderr
     assert _outcomes(on_ray) == _outcomes(local) and len(_outcomes(local)) == 4
+
+
+def test_merged_shards_write_their_page_and_an_unknown_engine_is_refused(
+    cli: Cli, problems: Path, tmp_path: Path
+) -> None:
+    runs, page = tmp_path / "runs.csv", tmp_path / "runs.html"
+    assert cli("benchmark", problems, "--robot", "panda", "--planner", "RRTConnect", "--csv", runs, "-q").exit_code == 0
+    assert cli("benchmark-merge", runs, "--html", page, "-q").exit_code == 0
+    assert page.read_text().count('"box_panda/000') == 2  # a row per run in the page's data
+    refused = cli("benchmark", problems, "--robot", "panda", "--engine", "spark")
+    assert refused.exit_code == 2 and "--engine: expected local or ray, got 'spark'" in refused.stderr
