@@ -10,6 +10,8 @@ states placed by it certify a motion at a resolution given in metres, not radian
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
@@ -20,9 +22,12 @@ from ..trajectory import peak_rates, sample, sampler, straight_states
 from ..types import JointTrajectory
 
 __all__ = [
-    "MAX_REACH_M", "MAX_STATES", "PIECE", "farthest_point", "is_prismatic", "path_states", "reach", "segment_states",
-    "state_count", "trajectory_states", "uniform_states",
+    "MAX_REACH_M", "MAX_STATES", "PIECE", "Between", "farthest_point", "is_prismatic", "path_between", "path_states",
+    "reach", "segment_states", "state_count", "trajectory_between", "trajectory_states", "uniform_states",
 ]
+
+Between = Callable[[NDArray[np.float64]], NDArray[np.float64]]
+"""The states a motion passes at given travel values (ascending) [m], rows of group values."""
 
 PIECE = 4  # states at the peak speed per piece whose speed bound is taken from its ends
 
@@ -129,6 +134,20 @@ def path_states(
     return states, travel
 
 
+def path_between(states: NDArray[np.float64], travel: NDArray[np.float64]) -> Between:
+    """Return the states at travel values along the straight segments through `path_states`' states and travel.
+
+    Two neighbouring states lie on one straight segment, along which travel grows linearly.
+    """
+    def at(values: NDArray[np.float64]) -> NDArray[np.float64]:
+        k = np.clip(np.searchsorted(travel, values, side="right") - 1, 0, len(travel) - 2)
+        span = travel[k + 1] - travel[k]
+        into = np.divide(values - travel[k], span, out=np.zeros(len(values)), where=span > 0.0)
+        return np.asarray(states[k] + np.clip(into, 0.0, 1.0)[:, None] * (states[k + 1] - states[k]))
+
+    return at
+
+
 def trajectory_states(
     trajectory: JointTrajectory, reach_m: NDArray[np.float64], step_m: float
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -146,23 +165,45 @@ def trajectory_states(
     knots = trajectory.times_s
     if len(knots) == 1:
         return np.asarray(trajectory.positions), np.zeros(1)
-    peak_v, peak_a = peak_rates(trajectory)
+    at_travel, total = _travel_clock(trajectory, reach_m, step_m)
+    count = max(1, int(np.ceil(total / step_m)))
+    travel = total * (np.arange(count + 1) / count)
+    times = at_travel(travel)
+    times[0], times[-1] = knots[0], knots[-1]
+    return sampler(trajectory)(times, 0)[0], travel
+
+
+def trajectory_between(trajectory: JointTrajectory, reach_m: NDArray[np.float64], step_m: float) -> Between:
+    """Return the states of the interpolated trajectory at travel values, as `trajectory_states` places them."""
+    at_travel, _ = _travel_clock(trajectory, reach_m, step_m)
     at = sampler(trajectory)
+    return lambda travel: at(at_travel(travel), 0)[0]
+
+
+def _travel_clock(
+    trajectory: JointTrajectory, reach_m: NDArray[np.float64], step_m: float
+) -> tuple[Callable[[NDArray[np.float64]], NDArray[np.float64]], float]:
+    """Return the time [s] at which the trajectory reaches travel values [m] (see `trajectory_states`), and its travel.
+
+    The travel bound is linear within each piece, so the time of a travel value is too.
+    """
+    knots = trajectory.times_s
+    peak_v, peak_a = peak_rates(trajectory)
     speed, duration = float(peak_v @ reach_m), float(knots[-1] - knots[0])  # [m/s], bounds every point's speed
     state_count(speed * duration, step_m)
     pieces = max(1, int(np.ceil(speed * duration / (PIECE * step_m))))
     h = duration / pieces
     ends = np.linspace(knots[0], knots[-1], pieces + 1)
-    rate = np.abs(at(ends, 1)[1]) @ reach_m  # [m/s] at the pieces' ends
+    rate = np.abs(sampler(trajectory)(ends, 1)[1]) @ reach_m  # [m/s] at the pieces' ends
     motion = np.minimum((rate[:-1] + rate[1:] + float(peak_a @ reach_m) * h) / 2, speed) * h  # per piece [m]
     covered = np.concatenate(([0.0], np.cumsum(motion)))
-    count = max(1, int(np.ceil(covered[-1] / step_m)))
-    travel = covered[-1] * (np.arange(count + 1) / count)
-    piece = np.clip(np.searchsorted(covered, travel, side="right") - 1, 0, pieces - 1)
-    into = np.divide(travel - covered[piece], motion[piece], out=np.zeros(count + 1), where=motion[piece] > 0.0)
-    times = ends[piece] + np.clip(into, 0.0, 1.0) * h
-    times[0], times[-1] = knots[0], knots[-1]
-    return at(times, 0)[0], travel
+
+    def at_travel(travel: NDArray[np.float64]) -> NDArray[np.float64]:
+        piece = np.clip(np.searchsorted(covered, travel, side="right") - 1, 0, pieces - 1)
+        into = np.divide(travel - covered[piece], motion[piece], out=np.zeros(len(travel)), where=motion[piece] > 0.0)
+        return np.asarray(ends[piece] + np.clip(into, 0.0, 1.0) * h, dtype=np.float64)
+
+    return at_travel, float(covered[-1])
 
 
 def uniform_states(

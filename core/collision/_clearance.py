@@ -10,7 +10,7 @@ from typing import Any
 import numba
 import numpy as np
 
-from ._kernels import _inside, apart, forward, gap, place, place_owner, set_mimics, tabled, unpack
+from ._kernels import _inside, apart, forward, gap, place, place_owner, set_mimics, tabled_clearance, unpack
 from ._verdicts import CLEAR
 
 __all__ = ["certify", "clearance"]
@@ -78,13 +78,17 @@ def clearance(q: Any, model: Any, cap: float, scratch: Any) -> tuple[int, float]
 
 
 @numba.njit(cache=True)
-def certify(values: Any, travel: Any, cap: float, floats: Any, ints: Any, head: Any, qs: Any, out: Any) -> int:
-    """Write per state of a motion (rows of `values`) its verdict and configuration; return how many spheres judged.
+def certify(values: Any, travel: Any, cap: float, floor: float, floats: Any, ints: Any, head: Any, qs: Any, out: Any,
+            radius: Any) -> int:
+    """Write per state of a motion (rows of `values`) verdict, configuration and radius; return how many spheres judged.
 
     `travel[k]` bounds how far any robot point moves from the first state to state k (non-decreasing,
     core/collision/_certify.py). A state CLEAR with clearance c proves every later state whose travel
     is less than c beyond its own free under the spheres: those are not judged, only looked up in the
     distance tables (which need no kinematics), and read CLEAR if the tables say apart.
+    `radius[k]` of a CLEAR state bounds from below every checked pair's distance there, so no
+    robot point moving less than it (either way along the motion) reaches anything; 0 for the
+    rest. Clearances are sought up to `cap`, and past the motion's end only up to `floor`.
     """
     base, group, continuous, model = unpack(floats, ints, head)
     tables, joints, spheres, owners, inner = model[0], model[1], model[2], model[3], model[4]
@@ -104,11 +108,16 @@ def certify(values: Any, travel: Any, cap: float, floats: Any, ints: Any, head: 
             else:
                 q[group[i]] = values[k, i]
         set_mimics(q, values[k], model[8])
-        out[k] = tabled(q, tables)
-        if out[k] != CLEAR or travel[k] < covered:
+        out[k], tabled = tabled_clearance(q, tables)
+        radius[k] = 0.0
+        if out[k] != CLEAR:
             continue
-        out[k], c = clearance(q, model, min(cap, travel[-1] - travel[k]), scratch)
+        if travel[k] < covered:
+            radius[k] = min(covered - travel[k], tabled)
+            continue
+        out[k], c = clearance(q, model, min(cap, max(travel[-1] - travel[k], floor)), scratch)
         judged += 1
         if out[k] == CLEAR:
             covered = travel[k] + c
+            radius[k] = min(c, tabled)
     return judged

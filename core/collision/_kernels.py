@@ -16,7 +16,7 @@ import numpy as np
 
 from ._verdicts import CLEAR, COLLIDES, MAYBE
 
-__all__ = ["LAYOUT", "STRIDE", "classify", "edge", "pack", "tabled"]
+__all__ = ["LAYOUT", "STRIDE", "classify", "edge", "pack", "tabled", "tabled_clearance"]
 
 STRIDE = 8  # an edge's states are judged every STRIDE-th first
 
@@ -51,10 +51,14 @@ def apart(p: Any, r: Any, reach: float) -> bool:
 
 
 @numba.njit(cache=True)
-def tabled(q: Any, tables: Any) -> int:
-    """Return CLEAR if every tabulated pair is apart at `q`, COLLIDES if one surely touches, else MAYBE."""
+def tabled_clearance(q: Any, tables: Any) -> tuple[int, float]:
+    """Return the tables' verdict at `q` (see `tabled`) and, if CLEAR, the least tabulated distance less its margin.
+
+    That distance [m] bounds the tabulated pairs' distance at `q` from below: a table's margin
+    bounds how far a pair moves between a state and its nearest grid point.
+    """
     axes, start, step, count, offset, margin, distance = tables
-    verdict = CLEAR
+    verdict, best = CLEAR, np.inf
     for p in range(len(offset)):
         flat = 0
         for axis in range(2):
@@ -62,14 +66,21 @@ def tabled(q: Any, tables: Any) -> int:
                 continue
             x = (q[axes[p, axis]] - start[p, axis]) / step[p, axis]
             if x < -0.5 or x >= count[p, axis] - 0.5:
-                return MAYBE  # off the grid, where the margin does not hold
+                return MAYBE, 0.0  # off the grid, where the margin does not hold
             flat = flat * count[p, axis] + int(x + 0.5)
         d = distance[offset[p] + flat]
         if d < -margin[p]:
-            return COLLIDES
+            return COLLIDES, 0.0
         if d <= margin[p]:
             verdict = MAYBE
-    return verdict
+        best = min(best, d - margin[p])
+    return verdict, (best if verdict == CLEAR else 0.0)
+
+
+@numba.njit(cache=True)
+def tabled(q: Any, tables: Any) -> int:
+    """Return CLEAR if every tabulated pair is apart at `q`, COLLIDES if one surely touches, else MAYBE."""
+    return tabled_clearance(q, tables)[0]
 
 
 @numba.njit(cache=True)

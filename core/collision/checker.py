@@ -28,9 +28,14 @@ from ..errors import ConfigError, StartInCollision, UnknownName
 from ..model import Robot
 from ..types import CollisionObject, Shape
 
-__all__ = ["CollisionChecker", "GeometryMode", "coal_geometry", "convex_hull"]
+__all__ = ["CONTACT_M", "CollisionChecker", "GeometryMode", "coal_geometry", "convex_hull"]
 
 GeometryMode = Literal["exact", "convex"]
+
+CONTACT_M = 1e-6
+"""Shapes closer than this [m] count as touching. With no margin, coal's test as pinocchio asks it
+called the Panda hand's convex hull free while it sank 62 um into a box (tests/collision/test_collision.py);
+with a positive margin it finds that contact, and is no slower."""
 
 logger = logging.getLogger(__name__)
 
@@ -39,10 +44,6 @@ logger = logging.getLogger(__name__)
 _HULLS: dict[tuple[str, tuple[float, ...]], coal.ConvexBase] = {}
 # The robot's own geometry by (URDF, config folder, package path, mode): reading its meshes costs
 # ~80 ms, and a benchmark builds a checker per problem for one robot.
-# Shapes closer than this count as touching. With no margin, coal's test as pinocchio asks it
-# called the Panda hand's convex hull free while it sank 62 um into a box (tests/collision/test_collision.py);
-# with a positive margin it finds that contact, and is no slower.
-_MARGIN_M = 1e-6
 _ROBOT_GEOMETRY: dict[tuple[str, str, tuple[Path, ...], str], pin.GeometryModel] = {}
 
 
@@ -227,7 +228,7 @@ class CollisionChecker:
         self._pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(model, geom, 1)
         for data in (self.data, *self._pool.getGeometryDatas()):
             for request in data.collisionRequests:
-                request.security_margin = _MARGIN_M
+                request.security_margin = CONTACT_M
         self._check_fixed_pairs(fixed_pairs, robot_count)
 
     def _placed(self, obj: CollisionObject, source: str) -> pin.GeometryObject:
@@ -246,7 +247,7 @@ class CollisionChecker:
         pin.updateGeometryPlacements(self.robot.model, self.robot.data, self.geometry, self.data,
                                      self.robot.neutral())
         request = coal.CollisionRequest()
-        request.security_margin = _MARGIN_M
+        request.security_margin = CONTACT_M
         for i, j in pairs:
             if i < robot_count and j < robot_count:
                 continue  # links on one joint are rigidly attached: their contact is by design
@@ -270,11 +271,25 @@ class CollisionChecker:
                 return self.owner[pair.first], self.owner[pair.second]
         return None  # pragma: no cover - computeCollisions said there was one
 
-    def free_batch(self, q: NDArray[np.float64], stop_at_first: bool = False) -> NDArray[np.bool_]:
-        """Return, for configurations of shape (nq, k), which are collision-free.
+    def free_batch(
+        self, q: NDArray[np.float64], stop_at_first: bool = False, margin: float = CONTACT_M
+    ) -> NDArray[np.bool_]:
+        """Return, for configurations of shape (nq, k), which are collision-free: every checked pair `margin` [m] apart.
 
         With `stop_at_first`, checking ends at the first colliding state; states after it
         read as free, so only `all()` of the answer is meaningful.
         """
-        hits = pin.computeCollisionsInParallel(1, self._pool, np.asfortranarray(q), True, stop_at_first)
+        if margin != CONTACT_M:
+            self._set_margin(margin)
+        try:
+            hits = pin.computeCollisionsInParallel(1, self._pool, np.asfortranarray(q), True, stop_at_first)
+        finally:
+            if margin != CONTACT_M:
+                self._set_margin(CONTACT_M)
         return ~np.asarray(hits, dtype=bool)
+
+    def _set_margin(self, margin: float) -> None:
+        """Make the broadphase pool's checks find pairs closer than `margin` [m] (pinocchio widens its boxes by it)."""
+        for data in self._pool.getGeometryDatas():
+            for request in data.collisionRequests:
+                request.security_margin = margin

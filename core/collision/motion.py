@@ -11,7 +11,8 @@ loses only the little space between a mesh and its hull.
 Certification checks a trajectory as the controller interpolates it, at states so
 close that no point of the robot moves more than `step_m` between two of them
 (core/collision/_certify.py bounds that motion). The spheres skip the states a clearance
-proves free (core/collision/_kernels.py `certify`); coal decides the rest in one batch.
+proves free (core/collision/_clearance.py `certify`); coal decides the rest in one batch.
+Then the states' clearances must cover the motion between them (core/collision/_cover.py).
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ from ..model import Robot, Scene
 from ..trajectory import interpolate
 from ..types import JointTrajectory
 from . import _certify as certify
-from .checker import CollisionChecker, GeometryMode
+from ._cover import needed, uncovered_collision
+from .checker import CONTACT_M, CollisionChecker, GeometryMode
 from .sphere_filter import CLEAR, COLLIDES, MAYBE, SphereFilter, UnsupportedJoint
 
 __all__ = ["CERTIFY_STEP_M", "MotionChecker", "build_sphere_filter", "exact_checks", "hull_checker", "scene_checks"]
@@ -52,9 +54,9 @@ class Filter(Protocol):
         ...
 
     def certify(
-        self, values: NDArray[np.float64], travel: NDArray[np.float64]
-    ) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
-        """Return per state along a motion its verdict and the configurations, skipping what clearances prove free.
+        self, values: NDArray[np.float64], travel: NDArray[np.float64], floor: float
+    ) -> tuple[NDArray[np.int8], NDArray[np.float64], NDArray[np.float64]]:
+        """Return per state along a motion its verdict, the configurations, and radii (see SphereFilter.certify).
 
         `travel[k]` bounds how far any robot point moves from the first state to state k.
         """
@@ -156,24 +158,85 @@ class MotionChecker:
         return self.spheres.classify(values)
 
     def edge_free_certified(self, a: NDArray[np.float64], b: NDArray[np.float64]) -> bool:
-        """Return True if the straight edge is free at the states certification checks on it."""
+        """Return True if the straight edge is certified free (see `first_collision_on_path`)."""
         return self.first_collision_on_path(np.array([a, b])) is None
 
-    def first_collision_on_trajectory(self, trajectory: JointTrajectory) -> NDArray[np.float64] | None:
-        """Return the first colliding state along the interpolated trajectory, or None if it is free."""
+    def first_collision_on_trajectory(
+        self, trajectory: JointTrajectory, between: bool = True
+    ) -> NDArray[np.float64] | None:
+        """Return a colliding state along the interpolated trajectory (the first found), or None if it is free.
+
+        Free means free at every instant; with `between` False, only at the certification states.
+        """
         # The built filter places the states compiled; its stand-in (core/pipeline/_checks.py) has no numba yet.
         place = getattr(self.spheres, "trajectory_states", certify.trajectory_states)
-        return self._first_collision(*place(trajectory, self.reach, CERTIFY_STEP_M))
+        states, travel = place(trajectory, self.reach, CERTIFY_STEP_M)
+        return self._first_collision(states, travel, (
+            certify.trajectory_between(trajectory, self.reach, CERTIFY_STEP_M) if between else None))
 
     def first_collision_on_path(self, waypoints: NDArray[np.float64]) -> NDArray[np.float64] | None:
-        """Return the first colliding state along the straight segments between waypoints, or None."""
-        return self._first_collision(*certify.path_states(waypoints, self.reach, CERTIFY_STEP_M))
+        """Return a colliding state along the straight segments between waypoints (the first found), or None."""
+        states, travel = certify.path_states(waypoints, self.reach, CERTIFY_STEP_M)
+        return self._first_collision(states, travel, certify.path_between(states, travel))
 
-    def _first_collision(self, states: NDArray[np.float64], travel: NDArray[np.float64]) -> NDArray[np.float64] | None:
-        """Return the first colliding state of a motion through `states` (`travel`: see certify.trajectory_states)."""
-        verdict, q = self._classified(states) if self.spheres is None else self.spheres.certify(states, travel)
-        free = self._decided(verdict, q)
-        return None if free.all() else states[int(np.argmin(free))]
+    def _first_collision(
+        self, states: NDArray[np.float64], travel: NDArray[np.float64], between: certify.Between | None
+    ) -> NDArray[np.float64] | None:
+        """Return the first colliding state of a motion through `states`, else one `between` them (if given), or None.
+
+        `travel`: see certify.trajectory_states. `between` gives the motion's states at travel values.
+        """
+        free, radius = self._judged(states, travel)
+        if not free.all():
+            return np.asarray(states[int(np.argmin(free))], dtype=np.float64)
+        if between is None:
+            return None
+        return uncovered_collision(states, travel, radius, between, self._judged, self._states_within)
+
+    def _judged(
+        self, states: NDArray[np.float64], travel: NDArray[np.float64], margin: NDArray[np.float64] | None = None
+    ) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
+        """Return per state of a motion whether it is free, and a lower bound [m] on its checked pairs' distance.
+
+        What the spheres leave unsure goes to coal first with a margin [m]: `margin`, else the
+        one that covers the gaps to its neighbours (core/collision/_cover.py). Most of those
+        states are that far from everything, and one check then says so.
+        """
+        if self.spheres is None:
+            verdict, q = self._classified(states)
+            radius = np.zeros(len(states))
+        else:
+            verdict, q, radius = self.spheres.certify(states, travel, CERTIFY_STEP_M)
+        free = verdict == CLEAR
+        radius = np.where(free, radius, 0.0)
+        maybe = np.flatnonzero(verdict == MAYBE)
+        if len(maybe) and (margin is not None or len(states) > 1):
+            wanted = needed(travel, radius, maybe) if margin is None else margin[maybe]
+            apart = self._free_within(q[maybe].T, wanted)
+            free[maybe[apart]], radius[maybe[apart]] = True, wanted[apart]
+        rest = np.flatnonzero(~free)
+        if len(rest):
+            free[rest] = self._decided(verdict[rest], q[rest])
+            radius[rest[free[rest]]] = CONTACT_M
+        return free, radius
+
+    def _free_within(self, q: NDArray[np.float64], margin: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """Return per configuration (columns of `q`) True if every checked pair is at least its `margin` [m] apart.
+
+        The hulls are asked first: a configuration they find that far apart is, under the meshes.
+        """
+        out = np.zeros(q.shape[1], dtype=bool)
+        for value in np.unique(margin):
+            rows = np.flatnonzero(margin == value)
+            out[rows] = self._stages[0].free_batch(q[:, rows], margin=float(value))
+            rest = rows[~out[rows]]  # too near under the hulls: only the meshes can tell
+            if len(rest) and len(self._stages) > 1:
+                out[rest] = self._stages[1].free_batch(q[:, rest], margin=float(value))
+        return out
+
+    def _states_within(self, values: NDArray[np.float64], margin: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """Return per group state (rows of `values`) True if every checked pair is at least its `margin` [m] apart."""
+        return self._free_within(self.robot.configurations(values, self.base), margin)
 
     def colliding_pair(self, values: NDArray[np.float64]) -> tuple[str, str] | None:
         """Return the names of a colliding pair at a group state, or None."""

@@ -114,7 +114,7 @@ class SphereFilter:
                              compiled=kernels_ready())
         self.classify(robot.values(base)[None, :])
         self.edge(robot.values(base), robot.values(base), 1.0)
-        self.certify(robot.values(base)[None, :], np.zeros(1))
+        self.certify(robot.values(base)[None, :], np.zeros(1), 0.0)
         still = np.zeros((2, robot.dof))
         self.trajectory_states(JointTrajectory(robot.joint_names, np.array([0.0, 1.0]), still, still, still),
                                np.ones(robot.dof), 1.0)
@@ -136,18 +136,21 @@ class SphereFilter:
         return out[:judged], q[:judged]
 
     def certify(
-        self, values: NDArray[np.float64], travel: NDArray[np.float64]
-    ) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
-        """Return per state along a motion (rows of `values`) CLEAR, MAYBE or COLLIDES, and the configurations (k, nq).
+        self, values: NDArray[np.float64], travel: NDArray[np.float64], floor: float
+    ) -> tuple[NDArray[np.int8], NDArray[np.float64], NDArray[np.float64]]:
+        """Return per state along a motion (rows of `values`) CLEAR, MAYBE or COLLIDES, the configurations, and radii.
 
         `travel[k]` bounds how far any robot point moves from the first state to state k. The
         states a CLEAR state's clearance proves free are not judged by the spheres (core/collision/
-        _clearance.py `certify`): they read CLEAR where the distance tables say apart.
+        _clearance.py `certify`): they read CLEAR where the distance tables say apart. A CLEAR
+        state's radius [m] bounds every checked pair's distance there from below (0 for the
+        rest); clearances are sought at least `floor` beyond the motion's end.
         """
         q = np.empty((len(values), self._nq))
         out = np.empty(len(values), dtype=np.int8)
-        self._clearance.certify(_plain(values), _plain(travel), CLEARANCE_CAP_M, *self._packed, q, out)
-        return out, q
+        radius = np.empty(len(values))
+        self._clearance.certify(_plain(values), _plain(travel), CLEARANCE_CAP_M, floor, *self._packed, q, out, radius)
+        return out, q, radius
 
     def trajectory_states(
         self, trajectory: JointTrajectory, reach_m: NDArray[np.float64], step_m: float

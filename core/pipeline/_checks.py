@@ -139,14 +139,14 @@ class OnDemandSpheres:
             return spheres.edge(a, b, resolution, stop)
         return MAYBE, np.full(len(states), MAYBE, dtype=np.int8), self._robot.configurations(states, self._base).T
 
-    def certify(self, states: NDArray[np.float64], travel: NDArray[np.float64]) -> tuple[
-            NDArray[np.int8], NDArray[np.float64]]:
-        """Return the filter's verdicts on a motion's states (its own walk when it has one), and the configurations."""
+    def certify(self, states: NDArray[np.float64], travel: NDArray[np.float64], floor: float) -> tuple[
+            NDArray[np.int8], NDArray[np.float64], NDArray[np.float64]]:
+        """Return the filter's verdicts on a motion's states, the configurations, and radii (0 until it is built)."""
         spheres = self._spheres(len(states))
-        if spheres is None:
-            return np.full(len(states), MAYBE, dtype=np.int8), self._robot.configurations(states, self._base).T
-        walk = getattr(spheres, "certify", None)
-        return walk(states, travel) if walk is not None else spheres.classify(states)
+        if spheres is not None:
+            return spheres.certify(states, travel, floor)
+        return (np.full(len(states), MAYBE, dtype=np.int8), self._robot.configurations(states, self._base).T,
+                np.zeros(len(states)))
 
     def settle(self) -> None:
         """Build the filter now if enough states were asked about, its time kept off any search's cap."""

@@ -143,7 +143,8 @@ def plan(
         referee = exact_checks(problem.checks, scene)
         for step in steps:
             began = time.perf_counter()
-            step.stats["exact_valid"] = float(referee.first_collision_on_trajectory(step.trajectory) is None)
+            hit = referee.first_collision_on_trajectory(step.trajectory, between=False)  # the states themselves
+            step.stats["exact_valid"] = float(hit is None)
             step.stats["exact_check_s"] = time.perf_counter() - began
     return assemble(request, config, robot, scene, base, steps)
 

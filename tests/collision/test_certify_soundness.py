@@ -113,7 +113,7 @@ def test_every_state_a_clearance_skips_is_one_the_spheres_clear(
     for states, travel in (certify.trajectory_states(_timed(robot, _waypoints(robot, fractions)), checks.reach,
                                                      CERTIFY_STEP_M),
                            certify.path_states(_waypoints(robot, fractions), checks.reach, CERTIFY_STEP_M / 10)):
-        walked, _ = spheres.certify(states, travel)
+        walked, _, _ = spheres.certify(states, travel, CERTIFY_STEP_M)
         judged, _ = spheres.classify(states)
         assert np.array_equal(walked, judged)
 
@@ -128,12 +128,37 @@ def test_a_trajectory_certified_free_has_every_state_free_under_the_exact_meshes
     waypoints = _waypoints(robot, fractions)
     trajectory = _timed(robot, waypoints)
     if checks.first_collision_on_trajectory(trajectory) is None:
-        states, _ = certify.trajectory_states(trajectory, checks.reach, CERTIFY_STEP_M)
+        states, travel = certify.trajectory_states(trajectory, checks.reach, CERTIFY_STEP_M)
         assert referee.free(states).all()
         assert referee.first_collision_on_trajectory(trajectory) is None
+        # Between the states too: ten times as dense.
+        between = certify.trajectory_between(trajectory, checks.reach, CERTIFY_STEP_M)
+        assert referee.free(between(np.linspace(0.0, travel[-1], 10 * len(states)))).all()
     if checks.first_collision_on_path(waypoints) is None:
-        states, _ = certify.path_states(waypoints, checks.reach, CERTIFY_STEP_M)
+        states, travel = certify.path_states(waypoints, checks.reach, CERTIFY_STEP_M)
         assert referee.free(states).all()
+        between = certify.path_between(states, travel)
+        assert referee.free(between(np.linspace(0.0, travel[-1], 10 * len(states)))).all()
+
+
+@_SETTINGS
+@given(fractions=_FRACTIONS)
+def test_every_radius_the_spheres_give_is_at_most_the_exact_distance(
+    shelf: tuple[MotionChecker, MotionChecker], fractions: list[list[float]]
+) -> None:
+    checks, referee = shelf
+    spheres = checks.spheres
+    assert isinstance(spheres, SphereFilter)
+    states, travel = certify.path_states(_waypoints(checks.robot, fractions), checks.reach, CERTIFY_STEP_M)
+    verdict, q, radius = spheres.certify(states, travel, CERTIFY_STEP_M)
+    model, checker = checks.robot.model, referee.checker
+    data = model.createData()
+    for k in np.linspace(0, len(states) - 1, 25).astype(int):
+        if radius[k] == 0.0:
+            continue
+        pin.computeDistances(model, data, checker.geometry, checker.data, q[k])
+        exact = min(result.min_distance for result in checker.data.distanceResults)
+        assert radius[k] <= exact + 1e-9
 
 
 def test_a_trajectory_through_the_shelf_is_found_colliding(shelf: tuple[MotionChecker, MotionChecker]) -> None:
