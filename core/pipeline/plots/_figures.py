@@ -7,10 +7,12 @@ wide with a row of panels per joint, at 100 dpi, its margins fixed in inches.
 
 from __future__ import annotations
 
+import functools
+import gc
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,8 +29,11 @@ if TYPE_CHECKING:
 __all__ = [
     "IN_RANGE", "POINTS_PER_SERIES", "blended", "check_plot_path", "corner_note", "finite_or_nan", "grid", "legend",
     "legend_line", "position_units", "prefixed", "step_budget", "step_lines", "symmetric_span", "time_axis",
-    "write_png",
+    "uncollected", "write_png",
 ]
+
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
 
 _WIDTH_IN = 12.0
 _ROW_IN = 1.9  # a joint's row of panels, with the gap below it
@@ -64,6 +69,25 @@ def check_plot_path(path: Path, flag: str = "--plot") -> None:
         raise UsageError(f"{flag} '{path}': expected a file name ending in .png (the plot is a PNG image)")
     if not path.parent.is_dir():
         raise InputError(f"{flag} '{path}': cannot write: folder '{path.parent}' does not exist")
+
+
+def uncollected(draw: Callable[_P, _R]) -> Callable[_P, _R]:
+    """Return `draw` run with the cyclic garbage collector held, and collecting again afterwards.
+
+    Importing matplotlib and drawing a figure make hundreds of thousands of small objects, and
+    the collector's passes over them cost a sixth of a plot (0.1 s of 0.6 s for the pick and place).
+    """
+    @functools.wraps(draw)
+    def held(*args: _P.args, **kwargs: _P.kwargs) -> _R:
+        enabled = gc.isenabled()
+        gc.disable()
+        try:
+            return draw(*args, **kwargs)
+        finally:
+            if enabled:
+                gc.enable()
+
+    return held
 
 
 def write_png(figure: Figure, path: Path) -> None:

@@ -33,6 +33,7 @@ from ._figures import (
     step_lines,
     symmetric_span,
     time_axis,
+    uncollected,
     write_png,
 )
 
@@ -112,6 +113,7 @@ def plan_figure(curves: PlanCurves) -> Figure:
     return figure
 
 
+@uncollected
 def write_plan_plot(plan: PlanFile | None, source: Path, path: Path) -> None:
     """Write a PNG of a plan's joints (position, velocity, acceleration against their limits) to `path`; return None.
 

@@ -31,7 +31,7 @@ from ..execution import (
     check,
     execute,
 )
-from ._figures import POINTS_PER_SERIES, position_units, step_budget, write_png
+from ._figures import POINTS_PER_SERIES, position_units, step_budget, uncollected, write_png
 from ._tracking import TrackedStep, Tracking, ViolationMark, tracking_figure
 
 if TYPE_CHECKING:
@@ -85,6 +85,7 @@ def check_plotted(request: CheckRequest, plot: Path) -> CheckReport:
 
     """
 
+    @uncollected
     def draw(checked: CheckedRecording) -> None:
         if checked.report.complete:
             write_png(tracking_figure(checked_tracking(checked, request)), plot)
@@ -118,6 +119,7 @@ class _ExecutionPlot:
                                        *series, _marks(report.violations, self._offset_s)))
         self._offset_s += report.duration_s
 
+    @uncollected
     def finish(self, execution: PlanExecution) -> None:
         """Draw the execution and write the PNG; return None."""
         controller = execution.controller

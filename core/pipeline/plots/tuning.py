@@ -8,11 +8,12 @@ import numpy as np
 
 from ...control import JointTuning
 from ..tuning import TuneResult
-from ._figures import write_png
+from ._figures import uncollected, write_png
 
 __all__ = ["write_tuning_plot"]
 
 
+@uncollected
 def write_tuning_plot(result: TuneResult, path: Path) -> None:
     """Write a PNG with one panel per tuned joint: each chosen stage's bump response over time; return None.
 
