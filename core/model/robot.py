@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 from ..config import Group, RobotConfig
 from ..errors import ConfigError, UnknownName
 from ..types import Frame, TfSamples
+from ._joint_transforms import JointTable, joint_table, joint_transforms
 
 __all__ = ["Mimic", "Robot"]
 
@@ -80,6 +81,9 @@ class Robot:
             Mimic(j.name, self.joint_names.index(j.mimic), int(self.model.idx_qs[self.model.getJointId(j.name)]),
                   j.mimic_multiplier, j.mimic_offset)
             for j in joints.values() if j.mimic in self.joint_names and self.model.existJointName(j.name))
+        self._moving = [j for j in joints.values() if j.type != "fixed"]  # what /tf carries
+        self._moving_frames = [(self.model.getFrameId(j.parent), self.model.getFrameId(j.child)) for j in self._moving]
+        self._joint_table: JointTable | None = joint_table(self.model, self._moving_frames)
 
     @property
     def dof(self) -> int:
@@ -150,14 +154,16 @@ class Robot:
         self, times_s: NDArray[np.float64], values: NDArray[np.float64], base: NDArray[np.float64]
     ) -> TfSamples:
         """Return `parent_T_child` of every moving URDF joint for group values (M, dof) at `times_s`."""
-        moving = [j for j in self.config.urdf_joints.values() if j.type != "fixed"]
-        pairs = [(self.model.getFrameId(j.parent), self.model.getFrameId(j.child)) for j in moving]
-        rows = np.empty((len(values), len(moving), 4, 4))
-        frames = self.data.oMf
-        # pinocchio's own inverse and product, not numpy's: a plan file is the same to the last bit.
-        for k, q in enumerate(self.configurations(np.asarray(values, dtype=float), base).T):
-            pin.framesForwardKinematics(self.model, self.data, q)
-            rows[k] = [(frames[parent].inverse() * frames[child]).homogeneous for parent, child in pairs]
+        moving = self._moving
+        q = self.configurations(np.asarray(values, dtype=float), base)
+        if self._joint_table is not None:
+            rows = joint_transforms(self._joint_table, q)
+        else:  # a joint kind not written out: pinocchio's own inverse and product, sample by sample
+            rows = np.empty((len(values), len(moving), 4, 4))
+            frames, pairs = self.data.oMf, self._moving_frames
+            for k, column in enumerate(q.T):
+                pin.framesForwardKinematics(self.model, self.data, column)
+                rows[k] = [(frames[parent].inverse() * frames[child]).homogeneous for parent, child in pairs]
         return TfSamples(times_s, tuple(j.parent for j in moving), tuple(j.child for j in moving), rows)
 
     def _relative(self, parent: str, child: str) -> NDArray[np.float64]:
