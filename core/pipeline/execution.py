@@ -279,7 +279,9 @@ def _step_tf(robot: Robot, report: ExecutionReport, offset_s: float) -> TfSample
         return None
     period = float(np.median(np.diff(times))) if len(times) > 1 else 1.0
     every = max(1, int(round(1.0 / (_TF_RATE_HZ * period))))
-    rows = np.unique(np.append(np.arange(0, len(times), every), len(times) - 1))
+    rows = np.arange(0, len(times), every)
+    if rows[-1] != len(times) - 1:  # the last sample too (np.unique's first call would import numpy.ma: 11 ms)
+        rows = np.append(rows, len(times) - 1)
     columns = [report.joint_names.index(j) for j in robot.joint_names]
     return robot.tf_samples(offset_s + times[rows], report.actual_positions[rows][:, columns], robot.neutral())
 
