@@ -23,6 +23,8 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
+from .._median import median
+
 __all__ = [
     "BAND_FLOOR", "NOISE_BANDS", "RINGING_OSCILLATIONS", "JointTracking", "crossings", "merged_tracking",
     "noise_level", "tracking",
@@ -81,7 +83,7 @@ def noise_level(values: npt.ArrayLike) -> NDArray[np.float64]:
     second = second[np.isfinite(second).all(axis=1)]
     if len(second) < 3:
         return np.zeros(array.shape[1])
-    deviation = np.median(np.abs(second - np.median(second, axis=0)), axis=0)
+    deviation = median(np.abs(second - median(second)))
     # 1.4826 turns a median absolute deviation into a normal standard deviation.
     return np.asarray(1.4826 * deviation / math.sqrt(6.0), dtype=np.float64)
 

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import bag as recording
+from .._median import median
 from ..bag import open_joint_states
 from ..config import ControllerConfig, JointGoal, RobotConfig, check_joint_units
 from ..control import (
@@ -277,7 +278,7 @@ def _step_tf(robot: Robot, report: ExecutionReport, offset_s: float) -> TfSample
     times = report.times_s
     if not len(times):
         return None
-    period = float(np.median(np.diff(times))) if len(times) > 1 else 1.0
+    period = float(median(np.diff(times))) if len(times) > 1 else 1.0
     every = max(1, int(round(1.0 / (_TF_RATE_HZ * period))))
     rows = np.arange(0, len(times), every)
     if rows[-1] != len(times) - 1:  # the last sample too (np.unique's first call would import numpy.ma: 11 ms)

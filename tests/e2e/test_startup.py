@@ -132,3 +132,17 @@ def test_inspect_reads_a_plans_end_states_without_loading_kinematics(tmp_path: P
     result = _run(code)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == '["tool0", "tool0", "tool0"] False'
+
+
+def test_plan_execute_and_check_never_load_numpy_ma(tmp_path: Path) -> None:
+    """np.median and np.unique import numpy.ma on their first call: 10-40 ms of a command that needs none of it."""
+    plan, executed = tmp_path / "plan.mcap", tmp_path / "executed.mcap"
+    commands = [["plan", "samples/ur10e_tool_up.yaml", "-o", str(plan)],
+                ["execute", str(plan), "--fake", "-o", str(executed)],
+                ["check-tolerances", str(plan), str(executed)]]
+    for argv in commands:
+        code = (f"import sys\nsys.argv = ['moveplan', *{argv!r}]\nfrom moveplan.cli.app import main\ntry:\n    main()\n"
+                "except SystemExit as exc:\n    assert not exc.code, exc.code\nprint('numpy.ma' in sys.modules)")
+        result = _run(code)
+        assert result.returncode == 0, result.stderr
+        assert result.stdout.strip().splitlines()[-1] == "False", argv[0]

@@ -19,6 +19,7 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
 
+from ..._median import median
 from ...errors import InputError, known
 from ...trajectory import shortest_angular_distance
 from ...types import JointStateSeries
@@ -273,11 +274,7 @@ def _time_index(source: SampleSource) -> tuple[NDArray[np.float64], float, float
         steps.append(before[ends - at + 1] - before[ends - at])
         previous = times[-1]
     step = np.concatenate(steps) if steps else np.zeros(0)
-    step = np.sort(step[step > 0.0])
-    period = 0.0
-    if len(step):
-        # np.median's rule: np.median itself imports numpy.ma, 40 ms of every command's start-up.
-        middle = len(step) // 2
-        period = float(step[middle] if len(step) % 2 else (step[middle - 1] + step[middle]) / 2)
+    step = step[step > 0.0]
+    period = float(median(step)) if len(step) else 0.0
     mark_times = np.concatenate(marks) if marks else np.zeros(0)
     return mark_times, period, first, last
