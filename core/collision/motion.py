@@ -186,7 +186,8 @@ class MotionChecker:
 
         `travel`: see certify.trajectory_states. `between` gives the motion's states at travel values.
         """
-        free, radius = self._judged(states, travel)
+        # The states alone need no radius beyond coal's contact distance: no margin is asked of coal then.
+        free, radius = self._judged(states, travel, None if between is not None else np.full(len(states), CONTACT_M))
         if not free.all():
             return np.asarray(states[int(np.argmin(free))], dtype=np.float64)
         if between is None:
