@@ -7,6 +7,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from conftest import ROOT, TABLE_SCENE, Cli
 
@@ -58,6 +59,24 @@ def test_a_hull_sinking_a_fraction_of_a_millimetre_into_a_box_collides_as_its_me
         checker = CollisionChecker(robot, scene.objects, scene.source, geometry=geometry, allowed=scene.allowed)
         assert not checker.free_batch(q[:, None])[0], geometry
         assert checker.colliding_pair(q) == ("panda_hand", "Object4")
+
+
+@pytest.mark.parametrize("geometry", ["convex", "exact"])
+def test_a_margin_finds_what_is_nearer_than_it_as_coals_distance_says(geometry: str) -> None:
+    """free_batch(margin=m) is "every checked pair at least m apart": the broadphase widens its boxes by m."""
+    robot = Robot(load_robot_config(ROOT / "configs" / "panda"))
+    q = robot.configuration(np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.6, 0.8]), robot.neutral())
+    hand = robot.frame_pose(q, "panda_hand")[:3, 3]
+    place = np.eye(4)
+    place[:3, 3] = hand + [0.0, 0.0, -0.15]  # a plate a few centimetres below the fingertips
+    plate = CollisionObject("plate", Shape("box", (0.3, 0.3, 0.01)), place)
+    checker = CollisionChecker(robot, (plate,), geometry=geometry)
+    pin.computeDistances(robot.model, robot.data, checker.geometry, checker.data, q)
+    distance = min(result.min_distance for result in checker.data.distanceResults)
+    assert 0.001 < distance < 0.1
+    assert checker.free_batch(q[:, None], margin=0.99 * distance)[0]
+    assert not checker.free_batch(q[:, None], margin=1.01 * distance)[0]
+    assert checker.free_batch(q[:, None])[0]  # the margin is the call's own
 
 
 def test_a_robot_without_collision_geometry_plans(cli: Cli, tmp_path: Path) -> None:
