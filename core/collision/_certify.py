@@ -31,6 +31,10 @@ Between = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 
 PIECE = 4  # states at the peak speed per piece whose speed bound is taken from its ends
 
+# farthest_point of a mesh file's shape by (file, scale, placement): its hull's is the same (the
+# extreme vertices are on the hull).
+_FARTHEST: dict[tuple[str, tuple[float, ...], bytes], float] = {}
+
 MAX_REACH_M = 1_000.0
 """Farthest [m] collision geometry may lie from a group joint's axis, prismatic travel below it included:
 a 50 m crane boom is far within; a kilometre is a description not in metres, whose every motion would
@@ -101,13 +105,21 @@ def is_prismatic(kind: str) -> bool:
 
 def farthest_point(obj: pin.GeometryObject) -> float:
     """Return the largest distance from its joint's origin to a point of a collision shape."""
+    placement = obj.placement
+    # A mesh file's answer is kept for the process: a benchmark asks for a robot's once a problem.
+    key = (str(obj.meshPath), tuple(float(v) for v in obj.meshScale), np.asarray(placement.homogeneous).tobytes()) \
+        if obj.meshPath else None
+    if key is not None and key in _FARTHEST:
+        return _FARTHEST[key]
     geometry = obj.geometry
     geometry.computeLocalAABB()  # pinocchio has already scaled a mesh when it loaded it
     lo, hi = np.asarray(geometry.aabb_local.min_), np.asarray(geometry.aabb_local.max_)
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    placement = obj.placement
     points = corners @ np.asarray(placement.rotation).T + np.asarray(placement.translation)
-    return float(np.max(np.linalg.norm(points, axis=1)))
+    farthest = float(np.max(np.linalg.norm(points, axis=1)))
+    if key is not None:
+        _FARTHEST[key] = farthest
+    return farthest
 
 
 def segment_states(
