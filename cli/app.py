@@ -442,7 +442,8 @@ def benchmark(
              "with benchmark-merge.")] = None,
     exact_check: Annotated[bool, typer.Option(
         "--exact-check/--no-exact-check",
-        help="Re-check every plan against the meshes at 1 mm (exact_valid); off: faster runs, exact_valid empty.")]
+        help="Re-check every plan's certified states on the exact meshes (exact_valid); off: faster runs, "
+             "exact_valid empty.")]
         = True,
     csv: Annotated[Path | None, typer.Option(help="Write one CSV row per run here.")] = None,
     plot: Annotated[Path | None, typer.Option(help="Write a PNG of the time distributions here.")] = None,
