@@ -323,6 +323,7 @@ def _check_fleet(manifest: Path, flags: tuple[Any, ...], jobs: int | None, csv: 
         CheckFlags,
         ResultsFile,
         batch_exit_code,
+        check_engine,
         check_html_path,
         check_items,
         judged_pairs,
@@ -335,8 +336,7 @@ def _check_fleet(manifest: Path, flags: tuple[Any, ...], jobs: int | None, csv: 
     if resume and csv is None:
         raise UsageError("--resume reads and extends the results of --csv RESULTS.csv: give --csv")
     engine, ray_address, html = where
-    if engine not in ("local", "ray"):
-        raise UsageError(f"--engine: expected local or ray, got '{engine}'")
+    check_engine(engine)
     if html is not None:
         check_html_path(html)
     items = read_manifest(manifest)
@@ -465,8 +465,8 @@ def benchmark(
     """Plan many problems with several planners and seeds; report success, times, path quality, exact validity."""
     setup_logging(False, quiet)
     with exit_codes(as_json):
-        from ..core.errors import UsageError
         from ..core.pipeline import (
+            check_engine,
             check_planning_time,
             find_problems,
             run_benchmark,
@@ -484,8 +484,7 @@ def benchmark(
             from ..core.pipeline import check_plot_path
 
             check_plot_path(plot)
-        if engine not in ("local", "ray"):
-            raise UsageError(f"--engine: expected local or ray, got '{engine}'")
+        check_engine(engine)
         seed_list = parse_seeds(seeds)
         time_s = check_planning_time(parse_number(planning_time, "--planning-time"))
         timeout_s = parse_optional(parse_number, timeout, "--timeout")

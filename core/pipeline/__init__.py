@@ -14,6 +14,7 @@ from .._faces import lazy_exports
 
 if TYPE_CHECKING:
     from ._checks import Problem
+    from ._engines import check_engine
     from .benchmark import (
         ProblemFiles,
         Run,
@@ -100,6 +101,7 @@ __all__ = [
     "benchmark_document",
     "cartesian_motion",
     "check",
+    "check_engine",
     "check_document",
     "check_html_path",
     "check_execution",
@@ -169,6 +171,7 @@ __getattr__ = lazy_exports(__name__, {
     "TuneRequest": "tuning",
     "TuneResult": "tuning",
     "benchmark_document": "documents",
+    "check_engine": "_engines",
     "cartesian_motion": "session",
     "check": "execution",
     "check_document": "report",

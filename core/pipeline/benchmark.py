@@ -26,6 +26,7 @@ import numpy as np
 
 from ..bag import atomic_file
 from ..errors import ConfigError, InputError, NoPlan, UsageError
+from ._engines import spread
 from .request import RobotSource
 
 __all__ = [
@@ -164,19 +165,8 @@ def run_benchmark(
         if on_run is not None:
             on_run(run)
 
-    if engine == "ray":
-        from ._ray_engine import ray_cluster, ray_map
-
-        make = functools.partial(Solver, robot, tuple(problems), (planning_time, timeout), exact_check)
-        with ray_cluster(ray_address) as ray:
-            ray_map(ray, make, work, jobs, arrived)
-    elif engine != "local":
-        raise UsageError(f"--engine: expected local or ray, got '{engine}'")
-    else:
-        from ._local_engine import process_map
-
-        process_map(functools.partial(Solver, robot, tuple(problems), (planning_time, timeout), exact_check), work,
-                    jobs or 1, arrived)
+    spread(functools.partial(Solver, robot, tuple(problems), (planning_time, timeout), exact_check), work, jobs,
+           engine, ray_address, arrived)
     return sorted(runs, key=lambda r: (list(planners).index(r.planner), r.seed, order[r.problem]))
 
 

@@ -22,13 +22,14 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import InputError, MoveplanError, UsageError
+from ..errors import InputError, MoveplanError
+from ._engines import check_engine, spread
 
 if TYPE_CHECKING:
     from ..bag import PlanFile
 
 __all__ = [
-    "ENGINES", "RESULT_COLUMNS", "CheckFlags", "FleetItem", "ItemChecker", "ItemResult", "ResultsFile",
+    "RESULT_COLUMNS", "CheckFlags", "FleetItem", "ItemChecker", "ItemResult", "ResultsFile",
     "batch_exit_code", "check_item",
     "check_items", "fleet_summary", "judged_pairs", "read_manifest", "result_row", "sha256_of", "unresumed_items",
     "write_fleet_html",
@@ -175,10 +176,6 @@ class CheckFlags:
     hashes: bool = False  # each result carries its files' SHA-256 (a results file keys its rows by them)
 
 
-ENGINES = ("local", "ray")
-"""Where a batch runs: processes on this machine, or actors on an existing Ray cluster."""
-
-
 def check_items(
     items: Sequence[FleetItem], flags: CheckFlags, jobs: int | None = None,
     on_result: Callable[[ItemResult], None] | None = None, engine: str = "local", ray_address: str | None = None,
@@ -202,20 +199,12 @@ def check_items(
         if on_result is not None:
             on_result(result)
 
-    if engine == "ray":
-        from ._ray_engine import ray_cluster, ray_map
-
-        with ray_cluster(ray_address) as ray:
-            ray_map(ray, functools.partial(ItemChecker, flags), items, jobs, arrived)
-    elif engine != "local":
-        raise UsageError(f"--engine: expected one of {', '.join(ENGINES)}, got '{engine}'")
-    elif (jobs or 1) <= 1 or len(items) <= 1:
+    check_engine(engine)
+    if engine == "local" and ((jobs or 1) <= 1 or len(items) <= 1):
         for item in items:
             arrived(check_item(item, flags))
     else:
-        from ._local_engine import process_map
-
-        process_map(functools.partial(ItemChecker, flags), items, jobs or 1, arrived)
+        spread(functools.partial(ItemChecker, flags), items, jobs, engine, ray_address, arrived)
     return sorted(results, key=lambda r: r.item.index)
 
 
