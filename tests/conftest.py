@@ -32,6 +32,22 @@ NOETIC = Path(os.environ.get("MOVEPLAN_NOETIC")
               or ROOT.parent / "shared" / "peers" / "moveit_resources_noetic").resolve()
 
 
+
+def fleet_manifest(folder: Path, column: str, values: tuple[str, str, str, str, str]) -> Path:
+    """Return a manifest in `folder` of five items (a pass, a violation, a corrupt file, a missing one, a glob's
+    match), its third column `column` holding `values`; the recordings it names are copied beside it."""
+    import shutil
+
+    for name in ("tool_up_plan", "tool_up_ok", "tool_up_path_violation", "tool_up_goal_missed"):
+        shutil.copy(SAMPLES / "recordings" / f"{name}.mcap", folder / f"{name}.mcap")
+    (folder / "corrupt.mcap").write_bytes(b"\x89MCAP0\r\n" + b"\x00" * 40)
+    recordings = ("tool_up_ok.mcap", "tool_up_path_violation.mcap", "corrupt.mcap", "missing.mcap",
+                  "tool_up_goal_*.mcap")
+    manifest = folder / "fleet.csv"
+    manifest.write_text(f"plan,recording,{column}\n" + "".join(
+        f"tool_up_plan.mcap,{recording},{value}\n" for recording, value in zip(recordings, values, strict=True)))
+    return manifest
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Leave out the real-world tier where its workspace is missing; under CI=true, fail the run instead."""
     tier = [item for item in items if item.get_closest_marker("realworld")]

@@ -5,13 +5,12 @@ from __future__ import annotations
 import csv
 import json
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
-from conftest import SAMPLES, Cli
+from conftest import SAMPLES, Cli, fleet_manifest
 
 RECORDINGS = SAMPLES / "recordings"
 
@@ -19,17 +18,7 @@ RECORDINGS = SAMPLES / "recordings"
 @pytest.fixture()
 def fleet(tmp_path: Path) -> Path:
     """Return a manifest of five items: a pass, a violation, a corrupt file, a missing one and a glob's match."""
-    for name in ("tool_up_plan", "tool_up_ok", "tool_up_path_violation", "tool_up_goal_missed"):
-        shutil.copy(RECORDINGS / f"{name}.mcap", tmp_path / f"{name}.mcap")
-    (tmp_path / "corrupt.mcap").write_bytes(b"\x89MCAP0\r\n" + b"\x00" * 40)
-    manifest = tmp_path / "fleet.csv"
-    manifest.write_text("plan,recording,robot\n"
-                        "tool_up_plan.mcap,tool_up_ok.mcap,cell-1\n"
-                        "tool_up_plan.mcap,tool_up_path_violation.mcap,cell-2\n"
-                        "tool_up_plan.mcap,corrupt.mcap,cell-3\n"
-                        "tool_up_plan.mcap,missing.mcap,cell-4\n"
-                        "tool_up_plan.mcap,tool_up_goal_*.mcap,cell-5\n")
-    return manifest
+    return fleet_manifest(tmp_path, "robot", ("cell-1", "cell-2", "cell-3", "cell-4", "cell-5"))
 
 
 def _rows(path: Path) -> list[dict[str, str]]:

@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import subprocess
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import ROOT, SAMPLES, Cli
+from conftest import ROOT, Cli, fleet_manifest
 
 CHROMIUM, CHROMEDRIVER = Path("/usr/bin/chromium"), Path("/usr/bin/chromedriver")
 
@@ -71,16 +70,8 @@ def _rows(browser: Any) -> list[Any]:
 def fleet_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """Return the report of a batch of five items: a pass, a violation, a corrupt and a missing file, a glob's."""
     folder = tmp_path_factory.mktemp("fleet")
-    for name in ("tool_up_plan", "tool_up_ok", "tool_up_path_violation", "tool_up_goal_missed"):
-        shutil.copy(SAMPLES / "recordings" / f"{name}.mcap", folder / f"{name}.mcap")
-    (folder / "corrupt.mcap").write_bytes(b"\x89MCAP0\r\n" + b"\x00" * 40)
-    manifest = folder / "fleet.csv"
-    manifest.write_text("plan,recording,note\n"
-                        "tool_up_plan.mcap,tool_up_ok.mcap,cell-1\n"
-                        "tool_up_plan.mcap,tool_up_path_violation.mcap,<script>alert('x')</script>\n"
-                        "tool_up_plan.mcap,corrupt.mcap,cell-3\n"
-                        "tool_up_plan.mcap,missing.mcap,cell-4\n"
-                        "tool_up_plan.mcap,tool_up_goal_*.mcap,</script><b>bold</b>\n")
+    manifest = fleet_manifest(folder, "note", ("cell-1", "<script>alert('x')</script>", "cell-3", "cell-4",
+                                                "</script><b>bold</b>"))
     report = folder / "night.html"
     result = Cli()("check-tolerances", "--manifest", manifest, "--html", report, "-q")
     assert result.exit_code == 3, result.stderr
