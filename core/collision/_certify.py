@@ -10,7 +10,9 @@ states placed by it certify a motion at a resolution given in metres, not radian
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -186,10 +188,19 @@ def trajectory_states(
 
 
 def trajectory_between(trajectory: JointTrajectory, reach_m: NDArray[np.float64], step_m: float) -> Between:
-    """Return the states of the interpolated trajectory at travel values, as `trajectory_states` places them."""
-    at_travel, _ = _travel_clock(trajectory, reach_m, step_m)
-    at = sampler(trajectory)
-    return lambda travel: at(at_travel(travel), 0)[0]
+    """Return the states of the interpolated trajectory at travel values, as `trajectory_states` places them.
+
+    The pieces are worked out on the first call: most certified trajectories need no state between.
+    """
+    @functools.cache
+    def clock() -> tuple[Callable[[NDArray[np.float64]], NDArray[np.float64]], Any]:
+        return _travel_clock(trajectory, reach_m, step_m)[0], sampler(trajectory)
+
+    def between(travel: NDArray[np.float64]) -> NDArray[np.float64]:
+        at_travel, at = clock()
+        return np.asarray(at(at_travel(travel), 0)[0])
+
+    return between
 
 
 def _travel_clock(
