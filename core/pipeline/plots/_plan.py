@@ -34,6 +34,7 @@ from ._figures import (
     symmetric_span,
     time_axis,
     uncollected,
+    value_axes,
     write_png,
 )
 
@@ -106,6 +107,7 @@ def plan_figure(curves: PlanCurves) -> Figure:
             if row == 0:
                 axis.set_title(what, fontsize=10)
     axes[0, 0].set_title("position", fontsize=10)
+    value_axes(axes)
     for column in range(3):
         time_axis(axes[:, column], 0.0, end)
     step_lines(axes, [(name, start) for name, start, _ in curves.steps])
@@ -204,7 +206,6 @@ def _position_range(axis: Axes, values: NDArray[np.float64], lower: float | None
     span = max(high - low, _LEAST_SPAN)
     middle = 0.5 * (low + high)
     axis.set_ylim(middle - 0.56 * span, middle + 0.56 * span)
-    axis.ticklabel_format(axis="y", useOffset=False)
     if off:
         named = " and ".join(f"{bound:.3g}" for bound in off)
         corner_note(axis, f"limit{'s' if len(off) > 1 else ''} {named} {unit}: off-scale")

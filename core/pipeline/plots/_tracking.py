@@ -27,6 +27,7 @@ from ._figures import (
     step_lines,
     symmetric_span,
     time_axis,
+    value_axes,
 )
 
 if TYPE_CHECKING:
@@ -138,6 +139,7 @@ def tracking_figure(tracking: Tracking) -> Figure:
         _violations((position, error), (1.0, scale), tracking.steps, joint, label=row == 0)
         if last is not None:
             _goal_zoom(goal, tracking, last, row)
+    value_axes(axes)
     for column in (0, 1):
         time_axis(axes[:, column], begin, end + 0.01 * (end - begin) if end > begin else begin + 1.0)
     if last is not None and last.end_s >= _window(tracking, last)[0]:
@@ -251,8 +253,7 @@ def _error_curve(axis: Axes, step: TrackedStep, row: int, scale: float) -> None:
 
 
 def _least_span(axis: Axes) -> None:
-    """Widen a position panel to at least _LEAST_SPAN, without an offset: a joint at rest reads as a flat line."""
-    axis.ticklabel_format(axis="y", useOffset=False)
+    """Widen a position panel to at least _LEAST_SPAN: a joint at rest reads as a flat line."""
     low, high = axis.get_ylim()
     if high - low < _LEAST_SPAN:
         middle = 0.5 * (low + high)
