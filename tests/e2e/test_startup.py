@@ -146,3 +146,26 @@ def test_plan_execute_and_check_never_load_numpy_ma(tmp_path: Path) -> None:
         result = _run(code)
         assert result.returncode == 0, result.stderr
         assert result.stdout.strip().splitlines()[-1] == "False", argv[0]
+
+
+_LEAVE = ("import atexit, sys, threading, time\n"
+          "atexit.register(lambda: print('exit handler ran', flush=True))\n"
+          "sys.argv = ['moveplan', *{argv!r}]\n"
+          "{before}\n"
+          "from moveplan.cli.app import run\nrun()\n")
+
+
+@pytest.mark.parametrize(("argv", "code"), [(["--version"], 0), (["inspect", "/no/such.mcap"], 3), (["--bogus"], 2)])
+def test_the_program_leaves_with_its_exit_code_its_output_and_its_exit_handlers(argv: list[str], code: int) -> None:
+    result = _run(_LEAVE.format(argv=argv, before=""))
+    assert result.returncode == code, result.stderr
+    assert result.stdout.rstrip().endswith("exit handler ran")
+    assert (code == 0) == ("moveplan" in result.stdout), result.stdout
+
+
+def test_the_program_waits_for_a_thread_still_working() -> None:
+    # Leaving without the interpreter's teardown would cut the thread off before it prints.
+    before = "threading.Thread(target=lambda: (time.sleep(0.5), print('thread finished', flush=True))).start()"
+    result = _run(_LEAVE.format(argv=["--version"], before=before))
+    assert result.returncode == 0, result.stderr
+    assert "thread finished" in result.stdout
