@@ -14,6 +14,7 @@ overlaps, surely collides under the hulls. Anything else is "maybe": the caller 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any, NamedTuple, cast
 
 import numpy as np
@@ -29,7 +30,7 @@ from ._inner_spheres import inner_spheres
 from ._pair_tables import PairTable, pair_tables
 from ._sphere_fit import SphereSet, fit_shape, robot_spheres
 from ._verdicts import CLEAR, COLLIDES, MAYBE
-from .compiled import kernels_ready, mark_kernels_loaded
+from .compiled import kernels_loaded, kernels_ready, mark_kernels_loaded
 
 __all__ = ["CLEAR", "COLLIDES", "MAYBE", "SphereFilter", "UnsupportedJoint"]
 
@@ -78,18 +79,11 @@ class SphereFilter:
             UnsupportedJoint: The robot has a joint kind the kernel does not handle.
         """
         model = robot.model
-        joints = _joint_arrays(model)  # first: an unsupported joint fails before the spheres are fitted
-        spheres, touch = _owned_spheres(robot, geometry, objects)
-        names = spheres.names
-        owner_joint, owner_centre, owner_radius = _owner_balls(spheres)
-        disabled = robot.config.srdf.disabled_pairs | allowed
-        # Pairs whose distance depends on one or two joints (a wrist's links) are looked up in tables.
-        tables = [t for t in pair_tables(model, hulls or geometry, robot.config.srdf.disabled_pairs, robot.config.urdf)
-                  if frozenset((t.upper, t.lower)) not in disabled]
-        pairs = _owner_pairs(names, owner_joint, disabled, touch, tables)
-        self.tabulated = tuple((t.upper, t.lower) for t in tables)
+        base = robot.neutral() if base is None else base
+        part = _robot_part(robot, geometry, tuple(obj for obj in objects if obj.link), allowed, base, hulls or geometry)
+        self.tabulated = part.tabulated
         world = [obj for obj in objects if not obj.link]
-        check = _world_checks(names, owner_joint, world, allowed)
+        check = _world_checks(part.names, part.owner_joint, world, allowed)
         # the peak rates the states are placed by, and the timing passes of a plan with a filter
         from ..timing import compiled_fastest_speeds, compiled_quintic_peak_rates
         from . import _clearance, _states  # numba too: the certification walk, the states it walks
@@ -97,18 +91,13 @@ class SphereFilter:
 
         self._kernels, self._clearance, self._states = sphere_kernels, _clearance, _states
         self._peak_rates = compiled_quintic_peak_rates
-        base = robot.neutral() if base is None else base
-        inner = inner_spheres(model, hulls or geometry, robot.config.urdf)
         # Packed once: the kernels run thousands of times per search, and a call costs per argument.
-        self._packed = sphere_kernels.pack({
-            "base": base, "group": robot.q_index, "continuous": robot.continuous, **_table_arrays(tables), **joints,
-            "centres": spheres.centre, "radii": spheres.radius, "sjoint": spheres.joint, "start": spheres.start,
-            "ojoint": owner_joint, "ocentre": owner_centre, "oradius": owner_radius,
-            **_inner_arrays(inner, names), "pairs": np.reshape(pairs, (-1, 2)), **_obstacles(world), "check": check,
-            **_mimic_arrays(robot)})
+        self._packed = sphere_kernels.pack({**part.arrays, **_obstacles(world), "check": check})
         self._nq = model.nq
         # Reused by every `edge` call: returning fresh arrays from compiled code costs more than judging a state.
         self._verdicts, self._unclear = np.empty(64, dtype=np.int8), np.empty((64, model.nq))
+        if kernels_loaded():
+            return
         # Compile (or load) the kernels now, not mid-search.
         announce_compilation("compiling the collision kernels (once per install; numba caches them)",
                              compiled=kernels_ready())
@@ -183,6 +172,58 @@ class SphereFilter:
             self._verdicts, self._unclear = np.empty(-kept, dtype=np.int8), np.empty((-kept, self._nq))
             return self.edge(a, b, resolution, stop)
         return worst, self._verdicts[:kept], self._unclear[:kept]
+
+
+class _RobotPart(NamedTuple):
+    """What a filter of one robot holds whatever the world: owners, tabulated pairs and the kernels' robot arrays."""
+
+    names: tuple[str, ...]  # owners: links, then attached objects
+    owner_joint: NDArray[np.int64]
+    tabulated: tuple[tuple[str, str], ...]
+    arrays: dict[str, Any]
+
+
+_ROBOT_PARTS: dict[tuple[Any, ...], _RobotPart] = {}
+_ROBOT_PARTS_KEPT = 8
+
+
+def _robot_part(
+    robot: Robot, geometry: pin.GeometryModel, attached: tuple[CollisionObject, ...],
+    allowed: frozenset[frozenset[str]], base: NDArray[np.float64], hulls: pin.GeometryModel,
+) -> _RobotPart:
+    """Return the robot's part of a filter: the same for every scene with nothing attached, so built once for them.
+
+    A benchmark plans hundreds of scenes of one robot: fitting, grouping and packing its spheres
+    and tables again for each was half of a filter's 2 ms set-up. The key holds the geometry
+    models themselves (compared by identity: core/collision/checker.py builds them once per
+    config), the URDF and SRDF, the group and the other joints' values.
+    """
+    key = (geometry, hulls, robot.config.urdf, robot.config.srdf.disabled_pairs, robot.joint_names, allowed,
+           base.tobytes())
+    if not attached and key in _ROBOT_PARTS:
+        return _ROBOT_PARTS[key]
+    model = robot.model
+    joints = _joint_arrays(model)  # first: an unsupported joint fails before the spheres are fitted
+    spheres, touch = _owned_spheres(robot, geometry, attached)
+    names = spheres.names
+    owner_joint, owner_centre, owner_radius = _owner_balls(spheres)
+    disabled = robot.config.srdf.disabled_pairs | allowed
+    # Pairs whose distance depends on one or two joints (a wrist's links) are looked up in tables.
+    tables = [t for t in pair_tables(model, hulls, robot.config.srdf.disabled_pairs, robot.config.urdf)
+              if frozenset((t.upper, t.lower)) not in disabled]
+    pairs = _owner_pairs(names, owner_joint, disabled, touch, tables)
+    inner = inner_spheres(model, hulls, robot.config.urdf)
+    arrays = {
+        "base": base, "group": robot.q_index, "continuous": robot.continuous, **_table_arrays(tables), **joints,
+        "centres": spheres.centre, "radii": spheres.radius, "sjoint": spheres.joint, "start": spheres.start,
+        "ojoint": owner_joint, "ocentre": owner_centre, "oradius": owner_radius, **_inner_arrays(inner, names),
+        "pairs": np.reshape(pairs, (-1, 2)), **_mimic_arrays(robot)}
+    part = _RobotPart(tuple(names), owner_joint, tuple((t.upper, t.lower) for t in tables), arrays)
+    if not attached:
+        if len(_ROBOT_PARTS) >= _ROBOT_PARTS_KEPT:
+            del _ROBOT_PARTS[next(iter(_ROBOT_PARTS))]
+        _ROBOT_PARTS[key] = part
+    return part
 
 
 def _joint_arrays(model: pin.Model) -> dict[str, Any]:
@@ -265,7 +306,8 @@ def _owner_pairs(
 
 
 def _world_checks(
-    names: list[str], owner_joint: NDArray[np.int64], world: list[CollisionObject], allowed: frozenset[frozenset[str]]
+    names: Sequence[str], owner_joint: NDArray[np.int64], world: list[CollisionObject],
+    allowed: frozenset[frozenset[str]],
 ) -> NDArray[np.bool_]:
     """Return per owner and world obstacle whether a state must check them, shape (owners, obstacles)."""
     # A link fixed to the world (a base) never moves relative to world obstacles: the collision
