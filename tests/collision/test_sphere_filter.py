@@ -17,6 +17,7 @@ from moveplan.core.collision.sphere_filter import CLEAR, COLLIDES, SphereFilter
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.model.robot import Robot
 from moveplan.core.model.scene_file import load_scene
+from moveplan.core.types import CollisionObject, Shape
 
 PANDA = ROOT / "configs" / "panda"
 MBM = ROOT / "tests" / "data" / "mbm"
@@ -182,3 +183,29 @@ def test_a_base_resting_on_a_table_leaves_the_other_links_to_decide() -> None:
     cleared = spheres.classify(values)[0] == CLEAR
     assert not np.any(cleared & ~free)
     assert cleared[free].mean() > 0.5
+
+
+def test_a_filter_for_the_next_scene_of_a_robot_judges_as_one_built_from_nothing() -> None:
+    # A benchmark's process builds the robot's part of a filter once and reuses it for every
+    # scene with nothing attached; a scene that attaches an object, or allows other pairs, gets its own.
+    from moveplan.core.collision import sphere_filter
+
+    robot = Robot(load_robot_config(PANDA))
+    first, second = (load_scene(MBM / "problems" / "box_panda" / f"scene000{k}.yaml", robot) for k in (1, 2))
+    held = CollisionObject("tray", Shape("box", (0.3, 0.3, 0.02)), np.eye(4), link="panda_hand",
+                           touch_links=("panda_hand", "panda_leftfinger", "panda_rightfinger"))
+    checker = CollisionChecker(robot)
+    scenes = [(first.objects, first.allowed), (second.objects, second.allowed),
+              ((*second.objects, held), second.allowed),
+              (second.objects, second.allowed | {frozenset(("panda_link5", "panda_link7"))}),
+              (first.objects, first.allowed)]
+    values = np.random.default_rng(5).uniform(robot.lower, robot.upper, size=(3000, robot.dof))
+    reused = [SphereFilter(robot, checker.robot_geometry, objects, allowed).classify(values)[0]
+              for objects, allowed in scenes]
+    for (objects, allowed), verdicts in zip(scenes, reused, strict=True):
+        sphere_filter._ROBOT_PARTS.clear()
+        fresh = SphereFilter(robot, checker.robot_geometry, objects, allowed).classify(values)[0]
+        np.testing.assert_array_equal(verdicts, fresh)
+    # Each scene judged as itself: the walls moved, the tray held; the first scene again as the first time.
+    assert not np.array_equal(reused[0], reused[1]) and not np.array_equal(reused[1], reused[2])
+    np.testing.assert_array_equal(reused[0], reused[4])
