@@ -218,6 +218,7 @@ class CollisionChecker:
             touch.append(frozenset((obj.link, *obj.touch_links)) if obj.link else frozenset())
             geom.addGeometryObject(self._placed(obj, source))
         self.owner = tuple(owner)
+        self.attached = any(obj.link for obj in objects)
         robot_count = len(owner) - len(objects)
         moving_pairs, fixed_pairs = _pairs_to_check(owner, touch, [g.parentJoint for g in geom.geometryObjects],
                                                     robot_count, config.srdf.disabled_pairs | allowed)
@@ -226,10 +227,11 @@ class CollisionChecker:
             active[tuple(np.transpose(moving_pairs))] = True
         geom.setCollisionPairs(active)  # in (i, j) order, as colliding_pair reports the first
         self.geometry = geom
-        self.data = geom.createData()
         # A broadphase (AABB tree) culls most pairs: 3-4x faster per state than testing each pair.
         self._pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(model, geom, 1)
-        self._margins(CONTACT_M, (self.data, *self._pool.getGeometryDatas()))
+        # The pool's own data answers single states too (the broadphase resyncs it every batch): one fewer to make.
+        self.data = self._pool.getGeometryData(0)
+        self._margins(CONTACT_M, self._pool.getGeometryDatas())
         self._check_fixed_pairs(fixed_pairs, robot_count)
 
     def _placed(self, obj: CollisionObject, source: str) -> pin.GeometryObject:

@@ -18,7 +18,7 @@ Then the states' clearances must cover the motion between them (core/collision/_
 from __future__ import annotations
 
 import logging
-from typing import Protocol
+from typing import Any, Protocol
 
 import coal
 import numpy as np
@@ -85,7 +85,7 @@ class MotionChecker:
         self.checker = checker
         self.base = base
         self.spheres = spheres
-        self.reach = certify.reach(robot, checker.geometry)
+        self.reach = _reach(robot, checker)
         self._stages: tuple[CollisionChecker, ...] = (checker,) if hulls is None else (hulls, checker)
         self.conservative_available = hulls is not None
 
@@ -263,6 +263,27 @@ def exact_checks(checks: MotionChecker, scene: Scene) -> MotionChecker:
     if checker.mode != "exact":
         checker = CollisionChecker(checks.robot, scene.objects, scene.source, geometry="exact", allowed=scene.allowed)
     return MotionChecker(checks.robot, checker, checks.base)
+
+
+_REACH: dict[tuple[Any, ...], NDArray[np.float64]] = {}
+_REACH_KEPT = 8
+
+
+def _reach(robot: Robot, checker: CollisionChecker) -> NDArray[np.float64]:
+    """Return certify.reach of the robot's geometry in `checker`, worked out once per robot unless objects are attached.
+
+    World objects do not move, so the reach is the robot's alone in every scene that attaches nothing.
+    """
+    if checker.attached:
+        return certify.reach(robot, checker.geometry)
+    key = (checker.robot_geometry, robot.config.urdf, robot.joint_names)  # geometry built once per config
+    if key not in _REACH:
+        if len(_REACH) >= _REACH_KEPT:
+            del _REACH[next(iter(_REACH))]
+        reach = certify.reach(robot, checker.robot_geometry)
+        reach.setflags(write=False)
+        _REACH[key] = reach
+    return _REACH[key]
 
 
 def build_sphere_filter(

@@ -47,19 +47,7 @@ class Robot:
         self.config = config
         self.group: Group = config.group(group)
         config.srdf.plannable(self.group.name, config.srdf_path)  # a floating or planar base: refused
-        error: Exception | None = None
-        with _stderr_of_c_code() as log:
-            try:
-                self.model = pin.buildModelFromXML(config.urdf)
-            except (RuntimeError, ValueError) as exc:
-                error = exc
-        # urdfdom says what is wrong only in its log (the exception names nothing), and logs an element it
-        # drops (a collision shape it cannot read) yet loads the rest: a robot missing a shape.
-        errors = list(dict.fromkeys(line.removeprefix("Error:").strip() for line in log if line.startswith("Error:")))
-        if error is not None:
-            raise ConfigError(f"{config.urdf_path}: pinocchio cannot load the URDF: {_joined(errors) or error}")
-        if errors:
-            raise ConfigError(f"{config.urdf_path}: urdfdom cannot read part of the URDF: {_joined(errors)}")
+        self.model = _model(config)  # shared per process: never modify
         self.data = self.model.createData()
         joints = config.urdf_joints
         # The group's variables (MoveIt's) include its mimic joints; its active joints, which are planned, do not.
@@ -199,6 +187,36 @@ def _readonly(values: list[float]) -> NDArray[np.float64]:
     array = np.array(values, dtype=float)
     array.setflags(write=False)
     return array
+
+
+_MODELS: dict[str, pin.Model] = {}
+_MODELS_KEPT = 8
+
+
+def _model(config: RobotConfig) -> pin.Model:
+    """Return pinocchio's model of the config's URDF, built once per process and URDF text.
+
+    A benchmark makes a Robot per problem: parsing the URDF again was half a millisecond of each.
+    """
+    if config.urdf in _MODELS:
+        return _MODELS[config.urdf]
+    error: Exception | None = None
+    with _stderr_of_c_code() as log:
+        try:
+            model = pin.buildModelFromXML(config.urdf)
+        except (RuntimeError, ValueError) as exc:
+            error = exc
+    # urdfdom says what is wrong only in its log (the exception names nothing), and logs an element it
+    # drops (a collision shape it cannot read) yet loads the rest: a robot missing a shape.
+    errors = list(dict.fromkeys(line.removeprefix("Error:").strip() for line in log if line.startswith("Error:")))
+    if error is not None:
+        raise ConfigError(f"{config.urdf_path}: pinocchio cannot load the URDF: {_joined(errors) or error}")
+    if errors:
+        raise ConfigError(f"{config.urdf_path}: urdfdom cannot read part of the URDF: {_joined(errors)}")
+    if len(_MODELS) >= _MODELS_KEPT:
+        del _MODELS[next(iter(_MODELS))]
+    _MODELS[config.urdf] = model
+    return model
 
 
 def _joined(errors: list[str]) -> str:
