@@ -10,7 +10,6 @@ from importlib.resources import files
 from pathlib import Path
 from typing import Any
 
-import mcap.writer
 import numpy as np
 import pytest
 from mcap.reader import make_reader
@@ -21,6 +20,7 @@ from rosbags.interfaces import ConnectionExtRosbag2, QosDurability
 from moveplan.core.bag.cdr import messages as msgs
 from moveplan.core.bag.cdr.bulk import controller_states_cdr
 from moveplan.core.bag.cdr.joint_state import encode_joint_states
+from moveplan.core.bag.container._mcap_writer import McapWriter
 from moveplan.core.bag.container.summary import summarize
 from moveplan.core.bag.execution_file import EXECUTION_RESULT_TOPIC
 from moveplan.core.bag.plan_file import PlanFile, read_plan
@@ -466,7 +466,7 @@ def test_failed_write_leaves_no_file_behind(
     def fail(*args: Any, **kwargs: Any) -> None:
         raise RuntimeError("disk on fire")
 
-    monkeypatch.setattr(mcap.writer.Writer, "add_metadata", fail)
+    monkeypatch.setattr(McapWriter, "add_metadata", fail)
     with pytest.raises(RuntimeError, match="disk on fire"):
         write_execution(tmp_path / "executed.mcap", two_steps)
     assert list(tmp_path.iterdir()) == []
@@ -477,7 +477,7 @@ def test_failed_write_keeps_the_previous_file(
 ) -> None:
     path = tmp_path / "executed.mcap"
     path.write_bytes(b"previous run")
-    monkeypatch.setattr(mcap.writer.Writer, "finish", lambda self: 1 / 0)
+    monkeypatch.setattr(McapWriter, "finish", lambda self: 1 / 0)
     with pytest.raises(ZeroDivisionError):
         write_execution(path, two_steps)
     assert [p.name for p in tmp_path.iterdir()] == ["executed.mcap"]

@@ -19,6 +19,7 @@ from rosbags.interfaces import ConnectionExtRosbag2, QosDurability
 
 from moveplan.core.bag.cdr import bulk as message_cdr
 from moveplan.core.bag.cdr import messages as msgs
+from moveplan.core.bag.container._mcap_writer import McapWriter
 from moveplan.core.bag.container.summary import summarize
 from moveplan.core.bag.plan_file import PlanFile, read_plan
 from moveplan.core.bag.plan_writer import write_plan
@@ -563,7 +564,7 @@ def test_failed_write_leaves_no_file_behind(
     def fail(*args: Any, **kwargs: Any) -> None:
         raise RuntimeError("disk on fire")
 
-    monkeypatch.setattr(mcap.writer.Writer, "add_attachment", fail)
+    monkeypatch.setattr(McapWriter, "add_attachment", fail)
     out = tmp_path / "out"
     out.mkdir()
     with pytest.raises(RuntimeError, match="disk on fire"):
@@ -576,7 +577,7 @@ def test_failed_write_keeps_the_previous_file(
 ) -> None:
     path = tmp_path / "plan.mcap"
     path.write_bytes(b"previous plan")
-    monkeypatch.setattr(mcap.writer.Writer, "finish", lambda self: 1 / 0)
+    monkeypatch.setattr(McapWriter, "finish", lambda self: 1 / 0)
     with pytest.raises(ZeroDivisionError):
         write_plan(path, plan)
     assert [p.name for p in tmp_path.iterdir()] == ["plan.mcap"]

@@ -1,4 +1,4 @@
-"""A ROS 2 bag written to MCAP, atomically: the mcap Writer's lifecycle, channels, metadata, attachments.
+"""A ROS 2 bag written to MCAP, atomically: the writer's lifecycle, channels, metadata, attachments.
 
 The container half of writing, as rosbag2 lays it out so that `ros2 bag`, Foxglove and
 rosbags open the files: profile ros2, ros2msg schemas, CDR channels with their QoS in
@@ -16,10 +16,9 @@ from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import BinaryIO
 
-from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
-
 from ...errors import InputError, UsageError
 from ...version import moveplan_version
+from ._mcap_writer import McapWriter
 from ._qos import offered_qos_profiles
 
 __all__ = ["BagStream", "atomic_file", "open_bag", "output_problem", "staged_file", "write_bag"]
@@ -58,7 +57,7 @@ def write_bag(
 class BagStream:
     """A ROS 2 bag being written (`open_bag`): messages added as they come, then metadata and attachments."""
 
-    def __init__(self, writer: Writer, channel_ids: Mapping[str, int]) -> None:
+    def __init__(self, writer: McapWriter, channel_ids: Mapping[str, int]) -> None:
         self._writer = writer
         self._channel_ids = dict(channel_ids)
 
@@ -86,7 +85,7 @@ def open_bag(
     """Yield a ROS 2 bag on a temporary file beside `path`, channels registered; finish and rename after the block.
 
     `topics` maps topic -> (message type, latched), in channel order; `schemas` maps message
-    type -> schema text. Nothing is kept per message (the mcap writer holds one chunk), so a
+    type -> schema text. Nothing is kept per message (the writer holds one chunk), so a
     file of any length is written in bounded memory. On any error the temporary file is
     removed and `path` is left as it was (`atomic_file`).
 
@@ -194,11 +193,10 @@ def _create_beside(path: Path) -> tuple[Path, BinaryIO]:
 
 
 @contextmanager
-def _atomic_writer(path: Path) -> Iterator[Writer]:
-    """Yield a started mcap Writer on a temporary file beside `path`; finish, then rename (`atomic_file`)."""
-    library = f"moveplan {moveplan_version()}; {LIBRARY_IDENTIFIER}"
+def _atomic_writer(path: Path) -> Iterator[McapWriter]:
+    """Yield a started MCAP writer on a temporary file beside `path`; finish, then rename (`atomic_file`)."""
     with atomic_file(path) as stream:
-        writer = Writer(stream, compression=CompressionType.ZSTD, enable_data_crcs=True)
-        writer.start(profile="ros2", library=library)
+        writer = McapWriter(stream)
+        writer.start("ros2", f"moveplan {moveplan_version()}")
         yield writer
-        writer.finish()  # type: ignore[no-untyped-call]  # mcap leaves it unannotated
+        writer.finish()
