@@ -13,7 +13,7 @@ from .cdr import (
     display_trajectory_cdr,
     encoder,
     joint_trajectory_cdr,
-    marker_array,
+    marker_array_cdr,
     schema_text,
     seconds_to_ns,
     string_message,
@@ -65,8 +65,8 @@ def write_plan(path: Path, plan: Plan, distro: str = "jazzy") -> None:
 def _plan_messages(plan: Plan, schemas: dict[str, bytes]) -> list[tuple[str, int, bytes]]:
     """Return (topic, log time [ns], CDR message) for every message of `plan`, in log-time order.
 
-    Trajectories and transforms take the fast `*_cdr` encoders; the two small messages
-    take the generic encoder built from `schemas` (message type -> schema text).
+    Trajectories, transforms and markers take the fast `*_cdr` encoders; the URDF's string
+    takes the generic encoder built from `schemas` (message type -> schema text).
     """
     if not plan.steps:
         raise ValueError("a plan needs at least one step")
@@ -84,7 +84,7 @@ def _plan_messages(plan: Plan, schemas: dict[str, bytes]) -> list[tuple[str, int
     messages = [
         (ROBOT_DESCRIPTION, 0, generic(ROBOT_DESCRIPTION, string_message(plan.urdf))),
         ("/tf_static", 0, tf_static),
-        ("/planning_scene_markers", 0, generic("/planning_scene_markers", marker_array(plan.objects, frame))),
+        ("/planning_scene_markers", 0, marker_array_cdr(plan.objects, frame)),
         ("/display_planned_path", 0, display_trajectory_cdr(plan.robot_name, trajectories, frame)),
     ]
     # Starts add up integer durations, so a step starts exactly where the previous one's

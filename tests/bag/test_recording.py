@@ -732,3 +732,18 @@ def test_same_edge_plan_written_twice_gives_identical_bytes(
     write_plan(tmp_path / "a.mcap", edge_plan)
     write_plan(tmp_path / "b.mcap", edge_plan)
     assert (tmp_path / "a.mcap").read_bytes() == (tmp_path / "b.mcap").read_bytes()
+
+
+@pytest.mark.parametrize("distro", DISTROS)
+@pytest.mark.parametrize("count", [0, 1, 6])
+def test_fast_markers_match_the_generic_encoder(distro: str, count: int, tmp_path: Path) -> None:
+    mesh = tmp_path / "tray.obj"  # a mesh file becomes a mesh_resource URI; an inline mesh, its triangles
+    inline = Shape("mesh", vertices=np.eye(3), triangles=np.array([[0, 1, 2]]))
+    shapes = [Shape("box", (1.2, 0.8, 0.05)), Shape("cylinder", (0.05, 0.6)), Shape("sphere", (0.04,)),
+              Shape("mesh", mesh_path=str(mesh), scale=(0.001, 0.001, 0.002)), inline,
+              Shape("mesh", mesh_path="package://tray/tray.stl")]
+    objects = [CollisionObject(f"object {k}", shapes[k], transform((0.1 * k, -0.2, 0.3), (1, 1, 0), 0.3 * k),
+                               link="tool0" if k % 2 else "", touch_links=("tool0",) if k % 2 else ())
+               for k in range(count)]
+    expected = generic("visualization_msgs/msg/MarkerArray", distro, msgs.marker_array(objects, "world"))
+    assert message_cdr.marker_array_cdr(objects, "world") == expected

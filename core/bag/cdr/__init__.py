@@ -10,7 +10,13 @@ from typing import TYPE_CHECKING
 from ..._faces import lazy_exports
 
 if TYPE_CHECKING:
-    from .bulk import controller_states_cdr, display_trajectory_cdr, joint_trajectory_cdr, tf_messages_cdr
+    from .bulk import (
+        controller_states_cdr,
+        display_trajectory_cdr,
+        joint_trajectory_cdr,
+        marker_array_cdr,
+        tf_messages_cdr,
+    )
     from .definitions import CONTROLLER_STATE, schema_text
     from .generic import encoder
     from .joint_state import JOINT_STATE_TYPE, JointStateLayout, check_definition, encode_joint_states, parse_layout
@@ -28,6 +34,7 @@ __all__ = [
     "encoder",
     "joint_trajectory_cdr",
     "marker_array",
+    "marker_array_cdr",
     "parse_layout",
     "schema_text",
     "seconds_to_ns",
@@ -49,6 +56,7 @@ __getattr__ = lazy_exports(__name__, {
     "encoder": "generic",
     "joint_trajectory_cdr": "bulk",
     "marker_array": "messages",
+    "marker_array_cdr": "bulk",
     "parse_layout": "joint_state",
     "schema_text": "definitions",
     "seconds_to_ns": "messages",

@@ -16,12 +16,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...rotations import quaternions_xyzw
-from ...types import ControllerStates, JointTrajectory, PointSeries
+from ...types import CollisionObject, ControllerStates, JointTrajectory, PointSeries
 from ._primitives import CdrWriter, patched_copies, time_array
 from .definitions import POINT_SOURCES, controller_state_fields
-from .messages import seconds_to_ns
+from .messages import marker_array, seconds_to_ns
 
-__all__ = ["controller_states_cdr", "display_trajectory_cdr", "joint_trajectory_cdr", "tf_messages_cdr"]
+__all__ = [
+    "controller_states_cdr", "display_trajectory_cdr", "joint_trajectory_cdr", "marker_array_cdr", "tf_messages_cdr",
+]
 
 
 def joint_trajectory_cdr(trajectory: JointTrajectory, frame_id: str) -> bytes:
@@ -61,6 +63,39 @@ def display_trajectory_cdr(
         writer.uint32(0)
     writer.uint32(0)  # attached_collision_objects[]
     writer.boolean(False)  # is_diff
+    return writer.data()
+
+
+def marker_array_cdr(objects: Sequence[CollisionObject], planning_frame: str) -> bytes:
+    """Return `messages.marker_array(objects, planning_frame)` encoded as CDR (Marker's layout is every distro's)."""
+    writer = CdrWriter()
+    markers = marker_array(objects, planning_frame)["markers"]
+    writer.uint32(len(markers))
+    for marker in markers:
+        stamp, pose = marker["header"]["stamp"], marker["pose"]
+        writer.scalars("i", 4, [stamp["sec"]])
+        writer.scalars("I", 4, [stamp["nanosec"]])
+        writer.string(marker["header"]["frame_id"])
+        writer.string(marker["ns"])
+        writer.scalars("i", 4, [marker["id"], marker["type"], marker["action"]])
+        writer.scalars("d", 8, [*pose["position"].values(), *pose["orientation"].values(), *marker["scale"].values()])
+        writer.scalars("f", 4, list(marker["color"].values()))
+        writer.scalars("i", 4, [0, 0])  # lifetime: forever
+        writer.boolean(marker["frame_locked"])
+        writer.uint32(len(marker["points"]))
+        writer.scalars("d", 8, [value for point in marker["points"] for value in point.values()])
+        writer.uint32(0)  # colors[]
+        writer.string("")  # texture_resource
+        writer.scalars("i", 4, [0, 0])  # texture: a sensor_msgs/CompressedImage, empty: header stamp,
+        writer.string("")  # its frame_id,
+        writer.string("")  # format
+        writer.uint32(0)  # and data[]
+        writer.uint32(0)  # uv_coordinates[]
+        writer.string(marker["text"])
+        writer.string(marker["mesh_resource"])
+        writer.string("")  # mesh_file: filename,
+        writer.uint32(0)  # data[]
+        writer.boolean(False)  # mesh_use_embedded_materials
     return writer.data()
 
 
