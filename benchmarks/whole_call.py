@@ -4,11 +4,12 @@ Run from the repository root with moveplan installed:
     python benchmarks/whole_call.py [--mbm DIR] [--count 30] [--seeds 1] [--one-shot 5]
 Each problem is solved as `moveplan benchmark` solves it (one warm process, the robot config loaded
 once, the plan written to a file), with the pipeline's phases timed where they are called: reading
-the request, the scene, setting up the collision checks, the step (its planning_time_s), assembling
-the plan (its /tf samples apart), /tf, writing the file. Prints the median of each phase and of the
-whole call, and the whole call over the step. With --one-shot N, also the first N problems planned
-by a fresh `moveplan plan` process each, whose step starts without the sphere filter (its
-planning_time_s against the warm one's). Machines are shared and noisy: compare ratios and medians.
+the request, the robot's group, the scene, setting up the collision checks, the step (its
+planning_time_s), assembling the plan (its /tf samples apart), /tf, writing the file. Prints the
+median of each phase and of the whole call, and the whole call over the step. With --one-shot N,
+also the first N problems planned by a fresh `moveplan plan` process each, whose step starts
+without the sphere filter (its planning_time_s against the warm one's). Machines are shared and
+noisy: compare ratios and medians.
 """
 
 from __future__ import annotations
@@ -31,8 +32,8 @@ from moveplan.core.pipeline import benchmark
 from moveplan.core.pipeline import plan as pipeline
 
 ROOT = Path(__file__).resolve().parents[1]
-PHASES = ("request", "scene", "checks", "step", "assemble", "tf", "write")
-_TIMED = {"request": (pipeline, "resolve_request"), "scene": (pipeline, "load_scene"),
+PHASES = ("request", "robot", "scene", "checks", "step", "assemble", "tf", "write")
+_TIMED = {"request": (pipeline, "resolve_request"), "robot": (pipeline, "_robot"), "scene": (pipeline, "load_scene"),
           "checks": (pipeline, "build_problem"), "assemble": (pipeline, "assemble"), "tf": (pipeline, "_tf_samples"),
           "write": (bag, "write_plan")}
 
