@@ -246,14 +246,14 @@ def test_the_output_gets_the_users_umask_permissions(
 _SLOW_WRITER = """
 import sys, time
 from pathlib import Path
-from mcap.writer import Writer
+from moveplan.core.bag.container._mcap_writer import McapWriter
 from moveplan.cli.app import main
 
 started = Path(sys.argv[1])
 def slow_metadata(self, *args, **kwargs):
     started.touch()
     time.sleep(120)
-Writer.add_metadata = slow_metadata
+McapWriter.add_metadata = slow_metadata
 sys.argv = ["moveplan", *sys.argv[2:]]
 main()
 """
