@@ -24,6 +24,7 @@ import coal
 import numpy as np
 from numpy.typing import NDArray
 
+from .._kept import kept
 from ..errors import ConfigError
 from ..model import Robot, Scene
 from ..trajectory import interpolate
@@ -266,7 +267,6 @@ def exact_checks(checks: MotionChecker, scene: Scene) -> MotionChecker:
 
 
 _REACH: dict[tuple[Any, ...], NDArray[np.float64]] = {}
-_REACH_KEPT = 8
 
 
 def _reach(robot: Robot, checker: CollisionChecker) -> NDArray[np.float64]:
@@ -276,14 +276,14 @@ def _reach(robot: Robot, checker: CollisionChecker) -> NDArray[np.float64]:
     """
     if checker.attached:
         return certify.reach(robot, checker.geometry)
-    key = (checker.robot_geometry, robot.config.urdf, robot.joint_names)  # geometry built once per config
-    if key not in _REACH:
-        if len(_REACH) >= _REACH_KEPT:
-            del _REACH[next(iter(_REACH))]
+
+    def worked_out() -> NDArray[np.float64]:
         reach = certify.reach(robot, checker.robot_geometry)
         reach.setflags(write=False)
-        _REACH[key] = reach
-    return _REACH[key]
+        return reach
+
+    # The geometry is built once per config: its identity stands for the robot's shapes.
+    return kept(_REACH, (checker.robot_geometry, robot.config.urdf, robot.joint_names), worked_out)
 
 
 def build_sphere_filter(

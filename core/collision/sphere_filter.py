@@ -21,6 +21,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from .._kept import kept
 from ..errors import UnsupportedJoint
 from ..model import Robot
 from ..types import CollisionObject, JointTrajectory
@@ -184,7 +185,6 @@ class _RobotPart(NamedTuple):
 
 
 _ROBOT_PARTS: dict[tuple[Any, ...], _RobotPart] = {}
-_ROBOT_PARTS_KEPT = 8
 
 
 def _robot_part(
@@ -198,10 +198,21 @@ def _robot_part(
     models themselves (compared by identity: core/collision/checker.py builds them once per
     config), the URDF and SRDF, the group and the other joints' values.
     """
+    def built() -> _RobotPart:
+        return _built_part(robot, geometry, attached, allowed, base, hulls)
+
+    if attached:
+        return built()
     key = (geometry, hulls, robot.config.urdf, robot.config.srdf.disabled_pairs, robot.joint_names, allowed,
            base.tobytes())
-    if not attached and key in _ROBOT_PARTS:
-        return _ROBOT_PARTS[key]
+    return kept(_ROBOT_PARTS, key, built)
+
+
+def _built_part(
+    robot: Robot, geometry: pin.GeometryModel, attached: tuple[CollisionObject, ...],
+    allowed: frozenset[frozenset[str]], base: NDArray[np.float64], hulls: pin.GeometryModel,
+) -> _RobotPart:
+    """Return the robot's part of a filter, fitted, grouped and packed (see `_robot_part`)."""
     model = robot.model
     joints = _joint_arrays(model)  # first: an unsupported joint fails before the spheres are fitted
     spheres, touch = _owned_spheres(robot, geometry, attached)
@@ -218,12 +229,7 @@ def _robot_part(
         "centres": spheres.centre, "radii": spheres.radius, "sjoint": spheres.joint, "start": spheres.start,
         "ojoint": owner_joint, "ocentre": owner_centre, "oradius": owner_radius, **_inner_arrays(inner, names),
         "pairs": np.reshape(pairs, (-1, 2)), **_mimic_arrays(robot)}
-    part = _RobotPart(tuple(names), owner_joint, tuple((t.upper, t.lower) for t in tables), arrays)
-    if not attached:
-        if len(_ROBOT_PARTS) >= _ROBOT_PARTS_KEPT:
-            del _ROBOT_PARTS[next(iter(_ROBOT_PARTS))]
-        _ROBOT_PARTS[key] = part
-    return part
+    return _RobotPart(tuple(names), owner_joint, tuple((t.upper, t.lower) for t in tables), arrays)
 
 
 def _joint_arrays(model: pin.Model) -> dict[str, Any]:

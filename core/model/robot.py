@@ -21,6 +21,7 @@ import numpy.typing as npt
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from .._kept import kept
 from ..config import Group, RobotConfig
 from ..errors import ConfigError, UnknownName
 from ..types import Frame, TfSamples
@@ -190,7 +191,6 @@ def _readonly(values: list[float]) -> NDArray[np.float64]:
 
 
 _MODELS: dict[str, pin.Model] = {}
-_MODELS_KEPT = 8
 
 
 def _model(config: RobotConfig) -> pin.Model:
@@ -198,8 +198,11 @@ def _model(config: RobotConfig) -> pin.Model:
 
     A benchmark makes a Robot per problem: parsing the URDF again was half a millisecond of each.
     """
-    if config.urdf in _MODELS:
-        return _MODELS[config.urdf]
+    return kept(_MODELS, config.urdf, lambda: _parsed(config))
+
+
+def _parsed(config: RobotConfig) -> pin.Model:
+    """Return pinocchio's model of the config's URDF; ConfigError names the file and urdfdom's complaint."""
     error: Exception | None = None
     with _stderr_of_c_code() as log:
         try:
@@ -213,9 +216,6 @@ def _model(config: RobotConfig) -> pin.Model:
         raise ConfigError(f"{config.urdf_path}: pinocchio cannot load the URDF: {_joined(errors) or error}")
     if errors:
         raise ConfigError(f"{config.urdf_path}: urdfdom cannot read part of the URDF: {_joined(errors)}")
-    if len(_MODELS) >= _MODELS_KEPT:
-        del _MODELS[next(iter(_MODELS))]
-    _MODELS[config.urdf] = model
     return model
 
 
