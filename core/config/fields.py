@@ -12,17 +12,19 @@ import operator
 import os
 import re
 import stat
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Hashable, Mapping
 from pathlib import Path
 from typing import Any
 
 import yaml
 
 from ..errors import ConfigError, MoveplanError, known
+from ._plain_yaml import DECLINED, read_plain
 
 __all__ = [
     "DEGREES", "MAX_ALIAS_EXPANSION", "MAX_EXPRESSION_LENGTH", "MAX_MAGNITUDE", "MAX_YAML_BYTES", "MAX_YAML_EVENTS",
-    "TURN", "angle", "beyond_a_turn", "boolean", "check_keys", "coordinate", "expression", "load_yaml", "mapping",
+    "TURN", "angle", "beyond_a_turn", "boolean", "check_keys", "coordinate", "coordinates", "expression", "load_yaml",
+    "mapping",
     "read_input", "read_input_text",
     "more_than_a_turn", "number", "parse_yaml", "pose_angle", "pose_angles", "string_list",
 ]
@@ -100,6 +102,9 @@ class _MergingLoader(_Loader):
         merged: dict[Any, Any] = {}
         for key_node, value_node in node.value:
             key = self.construct_object(key_node, deep=True)
+            if not isinstance(key, Hashable):  # as PyYAML's own construct_mapping refuses it
+                raise yaml.constructor.ConstructorError("while constructing a mapping", node.start_mark,
+                                                        "found unhashable key", key_node.start_mark)
             value = self.construct_object(value_node, deep=True)  # deep: a lazily built mapping would merge empty
             merged[key] = _merged(merged[key], value) if key in merged else value
         return merged
@@ -172,7 +177,9 @@ def parse_yaml(text: str, path: Path, after: str = "", merge: bool = False) -> A
         if events > MAX_YAML_EVENTS:
             raise ConfigError(f"{path}: more than {MAX_YAML_EVENTS:,} YAML values (lists and mappings count twice); "
                               "moveplan reads at most that many per file (a 10,000-shape scene has ~350,000)")
-        content = yaml.load(text, Loader=_MergingLoader if merge else _Loader)  # noqa: S506 - safe loaders
+        content = read_plain(text, _Loader, _merged if merge else None)
+        if content is DECLINED:
+            content = yaml.load(text, Loader=_MergingLoader if merge else _Loader)  # noqa: S506 - safe loaders
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" line {mark.line + 1}" if mark is not None else ""
@@ -264,6 +271,18 @@ def number(value: Any, where: str, positive: bool = False, bound: float | None =
 def coordinate(value: Any, where: str) -> float:
     """Return a position in [rad] or [m] or a time in [s], checked to be finite and within MAX_MAGNITUDE."""
     return number(value, where, bound=MAX_MAGNITUDE)
+
+
+def coordinates(values: list[Any] | tuple[Any, ...], where: str) -> list[float]:
+    """Return a list's numbers as `coordinate` checks each, the first bad one named `where[i]`."""
+    # A scene has hundreds of numbers: checked in one pass, each error message made only when one is bad.
+    try:
+        floats = [float(v) for v in values if type(v) is float or type(v) is int]  # not bool, a subclass of int
+    except OverflowError:  # an integer of hundreds of digits: coordinate names it
+        floats = []
+    if len(floats) == len(values) and all(-MAX_MAGNITUDE <= v <= MAX_MAGNITUDE for v in floats):  # NaN is not
+        return floats
+    return [coordinate(v, f"{where}[{i}]") for i, v in enumerate(values)]
 
 
 def expression(text: str, where: str, error: type[MoveplanError] = ConfigError) -> float:
