@@ -9,7 +9,7 @@ from numpy.typing import NDArray
 
 from ..errors import ConfigError
 from ..rotations import matrix_from_quaternion, matrix_from_rpy
-from .fields import MAX_MAGNITUDE, number
+from .fields import coordinates
 
 __all__ = ["pose_matrix", "vector"]
 
@@ -36,4 +36,4 @@ def vector(value: Any, size: int, where: str) -> NDArray[np.float64]:
         shown = repr(value) if len(repr(value)) <= 80 else f"{repr(value)[:77]}..."
         raise ConfigError(f"{where}: expected a list of {size} numbers, got {shown}")
     # A coordinate of 1e18 m breaks the collision library's bounding volumes: a thousand kilometres is plenty.
-    return np.array([number(v, f"{where}[{i}]", bound=MAX_MAGNITUDE) for i, v in enumerate(value)])
+    return np.array(coordinates(value, where))

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import ConfigError
-from .fields import check_keys, coordinate, mapping
+from .fields import check_keys, coordinate, coordinates, mapping
 from .poses import pose_matrix
 
 __all__ = [
@@ -103,7 +103,7 @@ def point(value: Any, where: str) -> list[float]:
     if isinstance(value, list):
         if len(value) != 3:
             raise ConfigError(f"{where}: expected [x, y, z], got {value!r}")
-        return [coordinate(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        return coordinates(value, where)
     entry = mapping(value, where)
     check_keys(entry, {"x", "y", "z"}, where)
     return [coordinate(entry.get(axis, 0.0), f"{where}.{axis}") for axis in "xyz"]
@@ -130,7 +130,7 @@ def _quaternion_values(value: Any, where: str) -> list[float]:
     if isinstance(value, list):
         if len(value) != 4:
             raise ConfigError(f"{where}: expected [x, y, z, w], got {value!r}")
-        return [coordinate(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        return coordinates(value, where)
     entry = mapping(value, where)
     check_keys(entry, {"x", "y", "z", "w"}, where)
     return [coordinate(entry.get(axis, 1.0 if axis == "w" else 0.0), f"{where}.{axis}") for axis in "xyzw"]
