@@ -84,7 +84,7 @@ class McapWriter:
         self._schemas: list[bytes] = []
         self._channels: list[bytes] = []
         self._chunk: list[bytes] = []
-        self._chunk_size = self._chunk_messages = self._chunk_start = self._chunk_end = 0
+        self._chunk_size = 0
         self._message_index: dict[int, list[tuple[int, int]]] = {}
         self._chunk_indexes: list[_ChunkIndex] = []
         self._attachment_indexes: list[bytes] = []
@@ -115,18 +115,11 @@ class McapWriter:
 
     def add_message(self, channel_id: int, log_time_ns: int, data: bytes, publish_time_ns: int) -> None:
         """Add a message to the open chunk (sequence 0); return None."""
-        if self._messages == 0:
-            self._start_ns = log_time_ns
-        self._start_ns = min(self._start_ns, log_time_ns)
-        self._end_ns = max(self._end_ns, log_time_ns)
-        self._counts[channel_id] = self._counts.get(channel_id, 0) + 1
-        self._messages += 1
-        if self._chunk_messages == 0:
-            self._chunk_start = log_time_ns
-        self._chunk_start = min(self._chunk_start, log_time_ns)
-        self._chunk_end = max(self._chunk_end, log_time_ns)
-        self._message_index.setdefault(channel_id, []).append((log_time_ns, self._chunk_size))
-        self._chunk_messages += 1
+        # Only what the chunk needs is kept per message: times and counts are summed when it closes.
+        entries = self._message_index.get(channel_id)
+        if entries is None:
+            entries = self._message_index[channel_id] = []
+        entries.append((log_time_ns, self._chunk_size))
         self._chunk.append(_MESSAGE_HEAD.pack(MESSAGE, 22 + len(data), channel_id, 0, log_time_ns, publish_time_ns))
         self._chunk.append(data)
         self._chunk_size += _MESSAGE_HEAD.size + len(data)
@@ -191,11 +184,19 @@ class McapWriter:
 
     def _close_chunk(self) -> None:
         """Write the open chunk, compressed, and its message indexes, if it holds a message; return None."""
-        if self._chunk_messages == 0:
+        if not self._message_index:
             return  # schemas and channels wait for the first message's chunk, as in mcap's Writer
+        times = [time for entries in self._message_index.values() for time, _ in entries]
+        chunk_start, chunk_end = min(times), max(times)
+        if self._messages == 0:
+            self._start_ns, self._end_ns = chunk_start, chunk_end
+        self._start_ns, self._end_ns = min(self._start_ns, chunk_start), max(self._end_ns, chunk_end)
+        self._messages += len(times)
+        for channel_id, entries in self._message_index.items():
+            self._counts[channel_id] = self._counts.get(channel_id, 0) + len(entries)
         content = b"".join(self._chunk)
         compressed = zstandard.compress(content)
-        chunk = _record(CHUNK, struct.pack("<QQQI", self._chunk_start, self._chunk_end, len(content),
+        chunk = _record(CHUNK, struct.pack("<QQQI", chunk_start, chunk_end, len(content),
                                            zlib.crc32(content)), _string("zstd"), _U64.pack(len(compressed)),
                         compressed)
         chunk_at = self._offset
@@ -209,10 +210,9 @@ class McapWriter:
             at += len(record)
         written = b"".join(indexes)
         self._emit(written)
-        self._chunk_indexes.append(_ChunkIndex(self._chunk_start, self._chunk_end, chunk_at, len(chunk), offsets,
+        self._chunk_indexes.append(_ChunkIndex(chunk_start, chunk_end, chunk_at, len(chunk), offsets,
                                                len(written), len(compressed), len(content)))
-        self._chunk, self._message_index = [], {}
-        self._chunk_size = self._chunk_messages = self._chunk_start = self._chunk_end = 0
+        self._chunk, self._message_index, self._chunk_size = [], {}, 0
 
     def _emit(self, data: bytes) -> None:
         """Write `data` to the data section, keeping its offset and CRC."""
