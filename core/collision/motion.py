@@ -88,6 +88,9 @@ class MotionChecker:
         self.spheres = spheres
         self.reach = _reach(robot, checker)
         self._stages: tuple[CollisionChecker, ...] = (checker,) if hulls is None else (hulls, checker)
+        # The first stage checks what the spheres leave unsure in nearly every search: its broadphase is
+        # set up here, not in the search's time; the meshes' behind the hulls only if a state needs them.
+        self._stages[0].prepare_batches()
         self.conservative_available = hulls is not None
 
     @property
