@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 __all__ = [
     "MIN_QUATERNION_NORM", "matrix_from_quaternion", "matrix_from_rpy", "matrix_from_rotation_vector",
-    "quaternion_from_matrix", "quaternions_xyzw", "rotation_angle", "rotation_vector", "rpy_from_matrix",
+    "quaternion_from_matrix", "quaternions_xyzw", "rotation_angle", "rotation_vector", "rpy_from_matrix", "tf_poses",
 ]
 
 MIN_QUATERNION_NORM = 1e-9
@@ -89,6 +89,11 @@ def matrix_from_rotation_vector(vector: NDArray[np.float64]) -> NDArray[np.float
 
     rotation: NDArray[np.float64] = pin.exp3(vector)
     return rotation
+
+
+def tf_poses(transforms: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Return the /tf poses (..., 7) of 4x4 transforms (..., 4, 4): translation xyz, then quaternion xyzw, w >= 0."""
+    return np.concatenate((transforms[..., :3, 3], quaternions_xyzw(transforms)), axis=-1)
 
 
 def quaternions_xyzw(transforms: NDArray[np.float64]) -> NDArray[np.float64]:

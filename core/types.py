@@ -218,19 +218,19 @@ class TfSamples:
         times_s: Sample times on the plan's timeline in [s], shape (M,).
         parents: Parent frame of each transform, length L.
         children: Child frame of each transform, length L.
-        transforms: `parent_T_child` per sample, shape (M, L, 4, 4).
+        poses: `parent_T_child` per sample as /tf carries it, shape (M, L, 7): translation xyz in
+            [m], then the rotation's unit quaternion xyzw (w >= 0).
     """
 
     times_s: NDArray[np.float64]
     parents: tuple[str, ...]
     children: tuple[str, ...]
-    transforms: NDArray[np.float64]
+    poses: NDArray[np.float64]
 
     def __post_init__(self) -> None:
         times = frozen_array(self.times_s, (None,), "times_s")
         object.__setattr__(self, "times_s", times)
-        shape = (len(times), len(self.children), 4, 4)
-        object.__setattr__(self, "transforms", frozen_array(self.transforms, shape, "transforms"))
+        object.__setattr__(self, "poses", frozen_array(self.poses, (len(times), len(self.children), 7), "poses"))
 
 
 @dataclass(frozen=True)

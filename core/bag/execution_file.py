@@ -127,7 +127,7 @@ class ExecutionWriter:
             return
         self._advance(_TF_SAMPLES, times_ns)
         stamps = times_ns.tolist()
-        encoded = tf_messages_cdr(tf.parents, tf.children, tf.transforms, stamps)
+        encoded = tf_messages_cdr(tf.parents, tf.children, tf.poses, stamps)
         self._pending += [(stamp, _TF_SAMPLES, "/tf", data) for stamp, data in zip(stamps, encoded, strict=True)]
         self._flush()
 

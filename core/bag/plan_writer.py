@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..rotations import tf_poses
 from ..types import Plan
 from .cdr import (
     Message,
@@ -80,7 +81,8 @@ def _plan_messages(plan: Plan, schemas: dict[str, bytes]) -> list[tuple[str, int
     statics = plan.static_frames
     # reshape, not np.array alone: no static frames must still give shape (1, 0, 4, 4).
     static_transforms = np.reshape([f.transform for f in statics], (1, len(statics), 4, 4))
-    [tf_static] = tf_messages_cdr([f.parent for f in statics], [f.name for f in statics], static_transforms, [0])
+    [tf_static] = tf_messages_cdr([f.parent for f in statics], [f.name for f in statics], tf_poses(static_transforms),
+                                  [0])
     messages = [
         (ROBOT_DESCRIPTION, 0, generic(ROBOT_DESCRIPTION, string_message(plan.urdf))),
         ("/tf_static", 0, tf_static),
@@ -96,7 +98,7 @@ def _plan_messages(plan: Plan, schemas: dict[str, bytes]) -> list[tuple[str, int
     if plan.tf is not None:
         tf = plan.tf
         stamps_ns = [seconds_to_ns(float(time_s)) for time_s in tf.times_s]
-        encoded = tf_messages_cdr(tf.parents, tf.children, tf.transforms, stamps_ns)
+        encoded = tf_messages_cdr(tf.parents, tf.children, tf.poses, stamps_ns)
         messages += [("/tf", stamp, data) for stamp, data in zip(stamps_ns, encoded, strict=True)]
     # A stable sort: messages logged at the same time keep the order above.
     return sorted(messages, key=lambda item: item[1])

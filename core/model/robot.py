@@ -24,8 +24,9 @@ from numpy.typing import NDArray
 from .._kept import kept
 from ..config import Group, RobotConfig
 from ..errors import ConfigError, UnknownName
+from ..rotations import tf_poses
 from ..types import Frame, TfSamples
-from ._joint_transforms import JointTable, joint_table, joint_transforms
+from ._joint_transforms import JointTable, joint_poses, joint_table
 
 __all__ = ["Mimic", "Robot"]
 
@@ -142,18 +143,19 @@ class Robot:
     def tf_samples(
         self, times_s: NDArray[np.float64], values: NDArray[np.float64], base: NDArray[np.float64]
     ) -> TfSamples:
-        """Return `parent_T_child` of every moving URDF joint for group values (M, dof) at `times_s`."""
+        """Return `parent_T_child` of every moving URDF joint for group values (M, dof) at `times_s`, as /tf poses."""
         moving = self._moving
         q = self.configurations(np.asarray(values, dtype=float), base)
         if self._joint_table is not None:
-            rows = joint_transforms(self._joint_table, q)
+            poses = joint_poses(self._joint_table, q)
         else:  # a joint kind not written out: pinocchio's own inverse and product, sample by sample
             rows = np.empty((len(values), len(moving), 4, 4))
             frames, pairs = self.data.oMf, self._moving_frames
             for k, column in enumerate(q.T):
                 pin.framesForwardKinematics(self.model, self.data, column)
                 rows[k] = [(frames[parent].inverse() * frames[child]).homogeneous for parent, child in pairs]
-        return TfSamples(times_s, tuple(j.parent for j in moving), tuple(j.child for j in moving), rows)
+            poses = tf_poses(rows)
+        return TfSamples(times_s, tuple(j.parent for j in moving), tuple(j.child for j in moving), poses)
 
     def _relative(self, parent: str, child: str) -> NDArray[np.float64]:
         """Return `parent_T_child` from the last forward kinematics."""

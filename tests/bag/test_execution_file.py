@@ -415,9 +415,9 @@ def test_plan_without_urdf_writes_no_robot_description(
 
 def test_tf_samples_are_written_at_their_times(tmp_path: Path, two_steps: PlanExecution) -> None:
     times = np.array([0.0, 0.25, 0.537, 0.837])
-    transforms = np.tile(np.eye(4), (4, 2, 1, 1))
-    transforms[:, 1, 0, 3] = times  # link_2 moves along x
-    tf = TfSamples(times, ("base_link", "link_1"), ("link_1", "link_2"), transforms)
+    poses = np.tile([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0], (4, 2, 1))
+    poses[:, 1, 0] = times  # link_2 moves along x
+    tf = TfSamples(times, ("base_link", "link_1"), ("link_1", "link_2"), poses)
     path = write(tmp_path, two_steps, tf=tf)
     messages = on(read_all(path), "/tf")
     assert [t for t, _ in messages] == [0, 250_000_000, 537_000_000, 837_000_000]

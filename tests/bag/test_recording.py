@@ -24,6 +24,7 @@ from moveplan.core.bag.container.summary import summarize
 from moveplan.core.bag.plan_file import PlanFile, read_plan
 from moveplan.core.bag.plan_writer import write_plan
 from moveplan.core.errors import InputError, UsageError
+from moveplan.core.rotations import tf_poses
 from moveplan.core.types import (
     CollisionObject,
     Frame,
@@ -111,12 +112,12 @@ def plan() -> Plan:
         tf_times,
         ("base_link", "link_1"),
         ("link_1", "link_2"),
-        np.array(
+        tf_poses(np.array(
             [
                 [transform((0, 0, 0.1), (0, 0, 1), t), transform((0.3, 0, 0), (0, 1, 0), -t)]
                 for t in tf_times
             ]
-        ),
+        )),
     )
     return Plan(
         robot_name="twolink",
@@ -658,13 +659,13 @@ def test_fast_display_trajectory_matches_the_generic_encoder(
 def test_fast_tf_messages_match_the_generic_encoder(distro: str, samples: int, count: int) -> None:
     parents = tuple(ODD_NAMES[(i + 3) % len(ODD_NAMES)] for i in range(count))
     children = tuple(ODD_NAMES[i % len(ODD_NAMES)] for i in range(count))
-    transforms = random_transforms(samples, count, seed=samples + count)
+    poses = tf_poses(random_transforms(samples, count, seed=samples + count))
     stamps_ns = [i * 987_654_321 for i in range(samples)]  # seconds and nanoseconds
-    encoded = message_cdr.tf_messages_cdr(parents, children, transforms, stamps_ns)
+    encoded = message_cdr.tf_messages_cdr(parents, children, poses, stamps_ns)
     assert len(encoded) == samples
     messages = [
         msgs.tf_message(parents, children, list(sample), stamp_ns)
-        for sample, stamp_ns in zip(transforms, stamps_ns, strict=True)
+        for sample, stamp_ns in zip(poses, stamps_ns, strict=True)
     ]
     assert encoded == reference_cdr("tf2_msgs/msg/TFMessage", distro, messages)
 
@@ -677,7 +678,7 @@ def edge_plan(plan: Plan) -> Plan:
         StepResult(f"step_{i}", {}, "RRTConnect", 0.01, random_trajectory(names, count, seed=i))
         for i, count in enumerate([1, 5, 2, 30])
     )
-    tf = TfSamples(np.zeros(0), ("odd",), ("frame",), np.zeros((0, 1, 4, 4)))
+    tf = TfSamples(np.zeros(0), ("odd",), ("frame",), np.zeros((0, 1, 7)))
     changes = {"steps": steps, "tf": tf, "planning_frame": "wor", "static_frames": ()}
     return Plan(**{**vars(plan), **changes})
 
@@ -698,7 +699,7 @@ def test_every_written_message_is_what_the_generic_encoder_writes(
             msgs.tf_message(
                 [f.parent for f in statics],
                 [f.name for f in statics],
-                [f.transform for f in statics],
+                list(tf_poses(np.reshape([f.transform for f in statics], (len(statics), 4, 4)))),
                 stamp_ns=0,
             )
         ],
@@ -709,7 +710,7 @@ def test_every_written_message_is_what_the_generic_encoder_writes(
             msgs.tf_message(
                 plan.tf.parents, plan.tf.children, list(sample), round(float(time_s) * 1e9)
             )
-            for time_s, sample in zip(plan.tf.times_s, plan.tf.transforms, strict=True)
+            for time_s, sample in zip(plan.tf.times_s, plan.tf.poses, strict=True)
         ],
     }
     written: dict[str, list[bytes]] = {topic: [] for topic in TYPES}

@@ -15,7 +15,6 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from ...rotations import quaternions_xyzw
 from ...types import CollisionObject, ControllerStates, JointTrajectory, PointSeries
 from ._primitives import CdrWriter, patched_copies, time_array
 from .definitions import POINT_SOURCES, controller_state_fields
@@ -102,10 +101,10 @@ def marker_array_cdr(objects: Sequence[CollisionObject], planning_frame: str) ->
 def tf_messages_cdr(
     parents: Sequence[str],
     children: Sequence[str],
-    transforms: NDArray[np.float64],
+    poses: NDArray[np.float64],
     stamps_ns: Sequence[int],
 ) -> list[bytes]:
-    """Return one CDR `messages.tf_message` per stamp; `transforms` has shape (stamps, children, 4, 4)."""
+    """Return one CDR `messages.tf_message` per stamp; `poses` (stamps, children, 7) are xyz then quaternion xyzw."""
     # The messages differ only in stamps and poses: one template written field by field,
     # then copies of it patched in bulk (a plan has ~180 messages of ~7 transforms).
     template = CdrWriter()
@@ -118,8 +117,7 @@ def tf_messages_cdr(
         template.string(parent)
         template.string(child)
         pose_at.append(template.float64_array(np.zeros(7)))
-    poses = np.concatenate([transforms[..., :3, 3], quaternions_xyzw(transforms)], axis=-1)
-    poses = poses.astype("<f8", copy=False)
+    poses = np.asarray(poses).astype("<f8", copy=False)
     stamps = time_array(stamps_ns)
     patches: list[tuple[int, NDArray[np.generic]]] = [(start, stamps) for start in stamp_at]
     patches += [(start, poses[:, child]) for child, start in enumerate(pose_at)]

@@ -111,21 +111,21 @@ def display_trajectory(
 def tf_message(
     parents: Sequence[str],
     children: Sequence[str],
-    transforms: Sequence[NDArray[np.float64]],
+    poses: Sequence[NDArray[np.float64]],
     stamp_ns: int,
 ) -> Message:
-    """Return a tf2_msgs/TFMessage with one `parent_T_child` transform per child."""
+    """Return a tf2_msgs/TFMessage with one `parent_T_child` pose (xyz, then quaternion xyzw) per child."""
     return {
         "transforms": [
             {
                 "header": {"stamp": time_msg(stamp_ns), "frame_id": parent},
                 "child_frame_id": child,
                 "transform": {
-                    "translation": _xyz(transform),
-                    "rotation": _quaternion(transform),
+                    "translation": dict(zip("xyz", np.asarray(pose)[:3].tolist(), strict=True)),
+                    "rotation": dict(zip("xyzw", np.asarray(pose)[3:].tolist(), strict=True)),
                 },
             }
-            for parent, child, transform in zip(parents, children, transforms, strict=True)
+            for parent, child, pose in zip(parents, children, poses, strict=True)
         ]
     }
 
@@ -223,12 +223,6 @@ def _marker(obj: CollisionObject, marker_id: int, planning_frame: str, orientati
 def _xyz(transform: NDArray[np.float64]) -> Message:
     x, y, z = transform[:3, 3].tolist()
     return {"x": x, "y": y, "z": z}
-
-
-def _quaternion(transform: NDArray[np.float64]) -> Message:
-    """Return the rotation of a 4x4 transform as a unit quaternion with w >= 0."""
-    x, y, z, w = quaternions_xyzw(transform).tolist()
-    return {"x": x, "y": y, "z": z, "w": w}
 
 
 def trajectory_from_message(message: Any) -> JointTrajectory:
