@@ -73,7 +73,9 @@ class Robot:
             for j in joints.values() if j.mimic in self.joint_names and self.model.existJointName(j.name))
         self._moving = [j for j in joints.values() if j.type != "fixed"]  # what /tf carries
         self._moving_frames = [(self.model.getFrameId(j.parent), self.model.getFrameId(j.child)) for j in self._moving]
-        self._joint_table: JointTable | None = joint_table(self.model, self._moving_frames)
+        # Per URDF text, as the model: a benchmark makes a Robot per problem.
+        self._joint_table: JointTable | None = kept(_JOINT_TABLES, config.urdf,
+                                                    lambda: joint_table(self.model, self._moving_frames))
 
     @property
     def dof(self) -> int:
@@ -193,6 +195,7 @@ def _readonly(values: list[float]) -> NDArray[np.float64]:
 
 
 _MODELS: dict[str, pin.Model] = {}
+_JOINT_TABLES: dict[str, JointTable | None] = {}
 
 
 def _model(config: RobotConfig) -> pin.Model:
