@@ -64,7 +64,7 @@ def read_plain(text: str, loader: type[Any], merge: Any = None) -> Any:
         return DECLINED  # document markers
     try:
         return _Reader(loader, merge).document(text)
-    except _Outside:
+    except (_Outside, RecursionError):  # a few hundred levels of nesting: PyYAML's loader is not recursive
         return DECLINED
 
 

@@ -185,6 +185,8 @@ def parse_yaml(text: str, path: Path, after: str = "", merge: bool = False) -> A
         where = f" line {mark.line + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
         raise ConfigError(f"{path}:{where} malformed YAML{after}: {problem}") from None
+    except ValueError as exc:  # a date YAML resolves but the calendar refuses (2024-02-30)
+        raise ConfigError(f"{path}: malformed YAML{after}: {exc}") from None
     if "*" in text:  # an alias is written *name: without one, nothing is shared (half of a scene's parse)
         _check_aliases(content, path)
     return content

@@ -160,6 +160,21 @@ def test_text_outside_the_plain_part_is_left_to_pyyaml(text: str) -> None:
     assert agrees(text) is DECLINED
 
 
+@pytest.mark.parametrize("text", [
+    "".join(" " * k + "k:\n" for k in range(600)) + " " * 600 + "k: 1\n",  # past Python's recursion limit
+    "a: " + "[" * 990 + "]" * 990 + "\n",                                   # just inside libyaml's nesting limit
+])
+def test_deeply_nested_documents_read_as_pyyaml_reads_them(tmp_path: Path, text: str) -> None:
+    path = tmp_path / "deep.yaml"
+    path.write_text(text)
+    got, expected = load_yaml(path), pyyaml(text)
+    while isinstance(expected, dict | list) and expected:  # one level at a time: == would recurse as deep
+        key = next(iter(expected)) if isinstance(expected, dict) else 0
+        assert type(got) is type(expected) and len(got) == len(expected)
+        got, expected = got[key], expected[key]
+    assert got == expected
+
+
 def test_merging_repeated_keys_reads_as_rcl_merges_a_parameter_file(tmp_path: Path) -> None:
     path = tmp_path / "params.yaml"
     path.write_text("/**:\n  a: 1\n")  # `*` goes to PyYAML; the same merge without it reads on the fast path
@@ -173,6 +188,14 @@ def test_a_malformed_file_is_reported_by_pyyaml_with_its_line(tmp_path: Path) ->
     path = tmp_path / "scene.yaml"
     path.write_text("world:\n  collision_objects: [1, 2\n")
     with pytest.raises(ConfigError, match=r"scene\.yaml: line 3 malformed YAML"):
+        load_yaml(path)
+
+
+@pytest.mark.parametrize("text", ["name: 2002-13-45\n", "when: &d 2024-02-30\n"])  # the fast path, PyYAML's
+def test_a_date_the_calendar_refuses_is_an_error_naming_the_file(tmp_path: Path, text: str) -> None:
+    path = tmp_path / "scene.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=r"scene\.yaml: malformed YAML: (month|day) "):
         load_yaml(path)
 
 
