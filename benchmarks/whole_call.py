@@ -92,8 +92,10 @@ def _one_shot(problems: list[benchmark.ProblemFiles], robot: Path, config: Any, 
     """Print each problem's planning_time_s from a fresh process against the warm process's, same seed."""
     ratios = []
     for problem in problems:
+        # The warm process plans with RRTConnect as the benchmark does: so must the fresh one (not the request's).
         command = [sys.executable, "-m", "moveplan.cli.app", "plan", "--robot", str(robot), "--scene",
-                   str(problem.scene), "--request", str(problem.request), "--seed", "0", "-o", str(output), "--json"]
+                   str(problem.scene), "--request", str(problem.request), "--planner", "RRTConnect", "--seed", "0",
+                   "-o", str(output), "--json"]
         result = subprocess.run(command, capture_output=True, text=True, check=True)
         fresh = sum(step["planning_time_s"] for step in json.loads(result.stdout)["steps"])
         warm = benchmark._solve(problem, config, "RRTConnect", 0, (1.0, None), False, output).planning_time_s
