@@ -1,10 +1,10 @@
-"""The plain YAML of scenes, requests and configs read line by line: PyYAML's values, ~3x faster, or DECLINED.
+"""The plain YAML of scenes, requests and configs read line by line: PyYAML's values, 2-2.5x faster, or DECLINED.
 
 PyYAML over libyaml builds a MotionBenchMaker scene in ~1 ms, of which libyaml's parse is 0.06:
 the rest is a Python node, two marks and a resolver call per value, then a constructor call
 per node (benchmarks/yaml_read.py). Most robot files use a small part of YAML: block mappings and
 sequences of one-line values, flow lists and mappings, plain or simply quoted scalars, comments.
-That part is read here with string methods and a regular expression per line (0.3 ms); any text
+That part is read here with string methods and a regular expression per line (0.4 ms); any text
 outside it (anchors, tags, block scalars, multi-line values, escapes, merge keys, non-ASCII,
 tabs) is DECLINED and goes to PyYAML, which also reports every error. A scalar takes the tag
 and value PyYAML's resolvers and constructors give it (the loader's own tables, the ROS float
@@ -47,7 +47,6 @@ _FLOW_KEY = re.compile(rf"([A-Za-z0-9_./][{_SAFE}]*): ")
 _DECIMAL = re.compile(r"[-+]?(?:0|[1-9][0-9]*)")
 _STR, _NULL, _BOOL, _INT, _FLOAT = (f"tag:yaml.org,2002:{kind}" for kind in ("str", "null", "bool", "int", "float"))
 _UNSEEN = object()
-_RESOLVERS: dict[tuple[type[Any], str], tuple[re.Pattern[str], list[str]]] = {}
 _CONSTRUCTED = frozenset((_STR, _NULL, _BOOL, _INT, _FLOAT, "tag:yaml.org,2002:timestamp"))
 
 
@@ -235,9 +234,10 @@ class _Reader:
         value = self._scalars.get(text, _UNSEEN)
         if value is not _UNSEEN:
             return value
-        pattern, tags = _RESOLVERS.get((self._loader, text[0])) or _resolver(self._loader, text[0])
-        match = pattern.match(text)
-        tag = tags[int(match.lastgroup[1:])] if match is not None and match.lastgroup else _STR
+        resolvers = self._loader.yaml_implicit_resolvers
+        # The first resolver whose pattern matches gives the tag, as PyYAML's BaseResolver.resolve.
+        tag = next((tag for tag, pattern in (*resolvers.get(text[0], ()), *resolvers.get(None, ()))
+                    if pattern.match(text)), _STR)
         if tag == _STR:
             value = text
         elif tag == _NULL:
@@ -259,25 +259,6 @@ class _Reader:
 def _line(indent: int, content: str) -> tuple[int, str, re.Match[str] | None, bool]:
     """Return what the reader keeps of a line: indent, content, its key match, whether it is a block entry."""
     return indent, content, _KEY.fullmatch(content), content[0] == "-" and (len(content) == 1 or content[1] == " ")
-
-
-def _resolver(loader: type[Any], first: str) -> tuple[re.Pattern[str], list[str]]:
-    """Return one pattern trying, in order, `loader`'s resolvers of scalars starting with `first`, and their tags.
-
-    Group `tK` of the pattern is tag K's: PyYAML takes the first resolver whose pattern matches, and
-    an alternation tries them in that order.
-    """
-    table = loader.yaml_implicit_resolvers
-    tried = [*table.get(first, ()), *table.get(None, ())]
-    pattern = re.compile("|".join(f"(?P<t{k}>(?{_flags(p)}:{p.pattern}))" for k, (_, p) in enumerate(tried)) or "(?!)")
-    _RESOLVERS[loader, first] = pattern, [tag for tag, _ in tried]
-    return _RESOLVERS[loader, first]
-
-
-def _flags(pattern: re.Pattern[str]) -> str:
-    """Return the inline letters of `pattern`'s flags that scope to a group (PyYAML writes verbose patterns)."""
-    return "".join(letter for flag, letter in ((re.IGNORECASE, "i"), (re.MULTILINE, "m"), (re.DOTALL, "s"),
-                                                (re.VERBOSE, "x")) if pattern.flags & flag) or "-i"
 
 
 def _quoted(text: str) -> str:
