@@ -97,6 +97,21 @@ def test_robot_model_name_that_is_not_a_name_is_an_input_error(cli: Cli, tmp_pat
     assert message.endswith("scene.yaml: robot_model_name: expected a robot name, got a list")
 
 
+def test_a_date_the_calendar_refuses_is_an_input_error(cli: Cli, tmp_path: Path) -> None:
+    scene = tmp_path / "scene.yaml"
+    scene.write_text("robot_model_name: ur10e\nname: 2002-13-45\n")  # YAML 1.1 reads a timestamp there
+    code, message = plan(cli, tmp_path, "--scene", scene, "--joints", "0,-1,0,0,0,0")
+    assert code == 3
+    assert message.endswith("scene.yaml: malformed YAML: month must be in 1..12")
+
+
+def test_a_list_as_a_parameter_files_key_is_an_input_error(tmp_path: Path) -> None:
+    path = tmp_path / "controllers.yaml"
+    path.write_text("controller_manager:\n  ros__parameters:\n    [a, b]: 1\n")
+    with pytest.raises(ConfigError, match=r"controllers.yaml: line 3 malformed YAML: found unhashable key"):
+        parse_controllers(path)
+
+
 # 2. numbers, expressions and seeds in flags and task files
 
 
