@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InputError, MoveplanError
-from ._engines import check_engine, spread
+from ._engines import spread
 
 if TYPE_CHECKING:
     from ..bag import PlanFile
@@ -199,7 +199,6 @@ def check_items(
         if on_result is not None:
             on_result(result)
 
-    check_engine(engine)
     if engine == "local" and ((jobs or 1) <= 1 or len(items) <= 1):
         for item in items:
             arrived(check_item(item, flags))
