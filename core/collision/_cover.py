@@ -23,12 +23,14 @@ from ..errors import InputError
 from ._certify import MAX_STATES, Between
 from .checker import CONTACT_M
 
-__all__ = ["Judge", "Within", "needed", "uncovered_collision"]
+__all__ = ["Judge", "RUN", "Within", "needed", "run_margins", "uncovered_collision"]
 
 Judge = Callable[[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]],
                  tuple[NDArray[np.bool_], NDArray[np.float64]]]
 """Per state (rows of group values, at the travel values given) whether it is free, and its radius [m] (0 if not);
 the third argument is the radius worth proving per state."""
+RUN = 5
+"""Consecutive states one check proves free where no filter gives clearances (`run_margins`)."""
 Within = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.bool_]]
 """Per state (rows of group values) whether every checked pair is at least its margin [m] apart."""
 
@@ -97,3 +99,20 @@ def needed(
 def _ladder(margin: NDArray[np.float64]) -> NDArray[np.float64]:
     """Return each margin [m] rounded up to a quarter power of two."""
     return np.maximum(margin, 2.0 ** (np.ceil(4.0 * np.log2(margin)) / 4.0))
+
+
+def run_margins(
+    travel: NDArray[np.float64], step_m: float
+) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]:
+    """Return per run of RUN states its middle state and the margin [m] proving the run free, and per state its offset.
+
+    A middle state whose checked pairs are all a margin apart proves every state of its run
+    free, with the margin less its offset (how far it is from the middle in travel) as radius.
+    The margin leaves the run's end states at least `step_m` / 2: with states at most `step_m`
+    apart, neighbouring runs that both pass cover the motion between them.
+    """
+    count = len(travel)
+    starts = np.arange(0, count, RUN)
+    middle = np.minimum(starts + RUN // 2, count - 1)
+    offset = np.abs(travel - travel[middle[np.arange(count) // RUN]])
+    return middle, _ladder(np.maximum.reduceat(offset, starts) + step_m / 2), offset

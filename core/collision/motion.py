@@ -12,11 +12,17 @@ Certification checks a trajectory as the controller interpolates it, at states s
 close that no point of the robot moves more than `step_m` between two of them
 (core/collision/_certify.py bounds that motion). The spheres skip the states a clearance
 proves free (core/collision/_clearance.py `certify`); coal decides the rest in one batch.
-Then the states' clearances must cover the motion between them (core/collision/_cover.py).
+Without the spheres, coal checks the middle state of each run of a few with a margin reaching
+the run's ends, and only the states of runs that fail one by one. Then the states' clearances
+must cover the motion between them (core/collision/_cover.py).
+
+An edge's states go to coal as OMPL's DiscreteMotionValidator checks them: the end state, then
+the middle, then the middles of the halves, so a blocked edge is refused after a few.
 """
 
 from __future__ import annotations
 
+import functools
 import logging
 from typing import Any, Protocol
 
@@ -30,7 +36,7 @@ from ..model import Robot, Scene
 from ..trajectory import interpolate
 from ..types import JointTrajectory
 from . import _certify as certify
-from ._cover import needed, uncovered_collision
+from ._cover import RUN, needed, run_margins, uncovered_collision
 from .checker import CONTACT_M, CollisionChecker, GeometryMode
 from .sphere_filter import CLEAR, COLLIDES, MAYBE, SphereFilter, UnsupportedJoint
 
@@ -147,7 +153,8 @@ class MotionChecker:
         if worst == CLEAR:
             return True
         if final:
-            return worst != COLLIDES and bool(self._stages[0].free_batch(q.T, stop_at_first=True).all())
+            halving = q[_halving(len(q))].T
+            return worst != COLLIDES and bool(self._stages[0].free_batch(halving, stop_at_first=True).all())
         free = np.zeros(len(verdict), dtype=bool)
         maybe = verdict == MAYBE
         if maybe.any():
@@ -214,7 +221,13 @@ class MotionChecker:
             verdict, q, radius = self.spheres.certify(states, travel, CERTIFY_STEP_M)
         free = verdict == CLEAR
         radius = np.where(free, radius, 0.0)
-        maybe = np.flatnonzero(verdict == MAYBE)
+        if margin is None and not self.compiled and len(states) > RUN:
+            # No clearances from the spheres: one coal check a run proves the run's states free.
+            middle, run_margin, offset = run_margins(travel, CERTIFY_STEP_M)
+            apart = self._free_within(q[middle].T, run_margin, meshes=False)[np.arange(len(states)) // RUN]
+            free |= apart
+            radius = np.where(apart, run_margin[np.arange(len(states)) // RUN] - offset, radius)
+        maybe = np.flatnonzero((verdict == MAYBE) & ~free)
         if len(maybe) and (margin is not None or len(states) > 1):
             wanted = needed(travel, radius, maybe) if margin is None else margin[maybe]
             apart = self._free_within(q[maybe].T, wanted)
@@ -225,17 +238,20 @@ class MotionChecker:
             radius[rest[free[rest]]] = CONTACT_M
         return free, radius
 
-    def _free_within(self, q: NDArray[np.float64], margin: NDArray[np.float64]) -> NDArray[np.bool_]:
+    def _free_within(
+        self, q: NDArray[np.float64], margin: NDArray[np.float64], meshes: bool = True
+    ) -> NDArray[np.bool_]:
         """Return per configuration (columns of `q`) True if every checked pair is at least its `margin` [m] apart.
 
         The hulls are asked first: a configuration they find that far apart is, under the meshes.
+        Without `meshes`, the hulls' answer is final (False may then be a mesh that far apart).
         """
         out = np.zeros(q.shape[1], dtype=bool)
         for value in sorted(set(margin.tolist())):  # not np.unique: its first call imports numpy.ma, 11 ms
             rows = np.flatnonzero(margin == value)
             out[rows] = self._stages[0].free_batch(q[:, rows], margin=float(value))
             rest = rows[~out[rows]]  # too near under the hulls: only the meshes can tell
-            if len(rest) and len(self._stages) > 1:
+            if len(rest) and len(self._stages) > 1 and meshes:
                 out[rest] = self._stages[1].free_batch(q[:, rest], margin=float(value))
         return out
 
@@ -267,6 +283,21 @@ def exact_checks(checks: MotionChecker, scene: Scene) -> MotionChecker:
     if checker.mode != "exact":
         checker = CollisionChecker(checks.robot, scene.objects, scene.source, geometry="exact", allowed=scene.allowed)
     return MotionChecker(checks.robot, checker, checks.base)
+
+
+@functools.cache
+def _halving(count: int) -> NDArray[np.intp]:
+    """Return 0..count-1 in halving order: the last, the middle, then the middles of the halves, and so on."""
+    order, spans = [count - 1], [(-1, count - 1)]
+    while spans:
+        later = []
+        for low, high in spans:
+            if high - low > 1:
+                middle = (low + high) // 2
+                order.append(middle)
+                later += [(low, middle), (middle, high)]
+        spans = later
+    return np.array(order, dtype=np.intp)
 
 
 _REACH: dict[tuple[Any, ...], NDArray[np.float64]] = {}

@@ -10,6 +10,7 @@ import pytest
 from conftest import ROOT
 
 from moveplan.core.collision import _certify as certify
+from moveplan.core.collision._cover import RUN
 from moveplan.core.collision.motion import CERTIFY_STEP_M, MotionChecker, scene_checks
 from moveplan.core.collision.sphere_filter import SphereFilter
 from moveplan.core.config.robot_config import load_robot_config
@@ -73,14 +74,16 @@ def _ball_centre(robot: Robot) -> Callable[[np.ndarray], np.ndarray]:
     return at
 
 
-def _grain(robot: Robot, kind: str, depth_m: float) -> tuple[CollisionObject, float, float]:
+def _grain(robot: Robot, kind: str, depth_m: float, at: int = 0) -> tuple[CollisionObject, float, float]:
     """Return a grain of grit the ball passes `depth_m` into (negative: that far clear) halfway between two states.
+
+    The two states are the motion's middle ones, moved `at` states on.
 
     Also returns the closest the ball comes to it at a certified state and over the whole motion [m].
     """
     states, travel, between = _motion(robot, kind)
     centre = _ball_centre(robot)
-    k = len(states) // 2
+    k = len(states) // 2 + at
     ends = centre(states[[k, k + 1]])
     middle = centre(between(np.array([(travel[k] + travel[k + 1]) / 2])))[0]
     along = (ends[1] - ends[0]) / np.linalg.norm(ends[1] - ends[0])
@@ -113,10 +116,12 @@ def _first_collision(checks: MotionChecker, robot: Robot, kind: str, between: bo
 
 @pytest.mark.parametrize("filtered", [True, False], ids=["sphere filter", "coal alone"])
 @pytest.mark.parametrize("kind", ["trajectory", "path"])
+@pytest.mark.parametrize("at", range(RUN), ids=lambda at: f"state {at} on")
 def test_a_graze_of_tens_of_micrometres_between_two_certified_states_is_found(
-    robot: Robot, kind: str, filtered: bool
+    robot: Robot, kind: str, filtered: bool, at: int
 ) -> None:
-    grain, at_states, closest = _grain(robot, kind, depth_m=20e-6)
+    # Coal alone proves a run of RUN states from its middle one: the grain sits at every place in a run.
+    grain, at_states, closest = _grain(robot, kind, depth_m=20e-6, at=at)
     assert at_states > 1e-4, "every certified state clears the grain by more than 0.1 mm"
     assert -30e-6 < closest < -10e-6, "between two of them the ball sinks 10-30 um into it"
     checks = _checks(robot, grain, filtered)
@@ -133,3 +138,43 @@ def test_a_motion_passing_twenty_micrometres_clear_is_certified_free(robot: Robo
     grain, _, closest = _grain(robot, kind, depth_m=-20e-6)
     assert 10e-6 < closest < 30e-6
     assert _first_collision(_checks(robot, grain, filtered), robot, kind) is None
+
+
+@pytest.mark.parametrize("kind", ["trajectory", "path"])
+def test_coal_alone_certifies_a_motion_clear_of_everything_with_a_check_per_run_of_states(
+    robot: Robot, kind: str
+) -> None:
+    states, _, _ = _motion(robot, kind)
+    checks = _checks(robot, _grain(robot, kind, depth_m=-0.1)[0], filtered=False)  # the grain 10 cm away
+    batches = _counting(checks)
+    assert _first_collision(checks, robot, kind) is None
+    checked = sum(batch.shape[1] for batch in batches)
+    assert checked <= len(states) / RUN + 1 < len(states) / 2, "one coal check proves a run of states"
+
+
+def test_coal_alone_checks_an_edge_halving_it_so_that_a_blocked_edge_fails_early(robot: Robot) -> None:
+    """OMPL's DiscreteMotionValidator::checkMotion checks the end state, then halves the edge again and again."""
+    states, _, _ = _motion(robot, "path")
+    checks = _checks(robot, _grain(robot, "path", depth_m=0.002)[0], filtered=False)
+    batches = _counting(checks)
+    a, b = states[0], states[-1]
+    resolution = float(np.max(np.abs(b - a))) / 64  # 64 states after a, the grain in the middle
+    assert not checks.edge_free(a, b, resolution, conservative=True)
+    [batch] = batches
+    end, middle = (robot.configuration(values, robot.neutral()) for values in (b, (a + b) / 2))
+    assert np.allclose(batch[:, 0], end) and np.allclose(batch[:, 1], middle)
+    assert not checks.state_free((a + b) / 2, conservative=True)  # the second state coal checks collides
+
+
+def _counting(checks: MotionChecker) -> list[np.ndarray]:
+    """Return a list that gets each batch of configurations (nq, k) the first coal stage judges, in order."""
+    batches: list[np.ndarray] = []
+    stage = checks._stages[0]
+    judge = stage.free_batch
+
+    def counted(q: np.ndarray, *args: object, **kwargs: object) -> np.ndarray:
+        batches.append(q)
+        return judge(q, *args, **kwargs)
+
+    stage.free_batch = counted  # type: ignore[method-assign]
+    return batches
