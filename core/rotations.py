@@ -98,6 +98,12 @@ def tf_poses(transforms: NDArray[np.float64]) -> NDArray[np.float64]:
 
 def quaternions_xyzw(transforms: NDArray[np.float64]) -> NDArray[np.float64]:
     """Return the rotations of 4x4 (or 3x3) transforms (..., 4, 4) as unit quaternions xyzw with w >= 0."""
+    if transforms.size <= _FEW * transforms.shape[-1] ** 2:
+        try:
+            return np.reshape([_quaternion_xyzw(*m) for m in transforms[..., :3, :3].reshape(-1, 9).tolist()],
+                              (*transforms.shape[:-2], 4))
+        except (ValueError, ZeroDivisionError):
+            pass  # not a rotation: numpy's nan and inf, below
     (m00, m01, m02), (m10, m11, m12), (m20, m21, m22) = np.moveaxis(
         transforms[..., :3, :3], (-2, -1), (0, 1)
     )
@@ -122,3 +128,32 @@ def quaternions_xyzw(transforms: NDArray[np.float64]) -> NDArray[np.float64]:
     xyzw /= np.linalg.norm(xyzw, axis=-1, keepdims=True)
     result: NDArray[np.float64] = np.where(xyzw[..., 3:] < 0.0, -xyzw, xyzw)
     return result
+
+
+_FEW = 64
+"""Up to this many transforms, each is worked out in plain floats: numpy's ~50 operations cost 0.07 ms at any count."""
+
+
+def _quaternion_xyzw(
+    m00: float, m01: float, m02: float, m10: float, m11: float, m12: float, m20: float, m21: float, m22: float
+) -> tuple[float, float, float, float]:
+    """Return `quaternions_xyzw` of one rotation, its operations in the same order: the same bits.
+
+    Raises ValueError or ZeroDivisionError where numpy would give nan or inf (not a rotation).
+    """
+    trace = m00 + m11 + m22
+    if trace > 0.0:
+        s = 2.0 * math.sqrt(1.0 + trace)
+        x, y, z, w = (m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s, s / 4
+    elif m00 > m11 and m00 > m22:
+        s = 2.0 * math.sqrt(1.0 + m00 - m11 - m22)
+        x, y, z, w = s / 4, (m01 + m10) / s, (m02 + m20) / s, (m21 - m12) / s
+    elif m11 > m22:
+        s = 2.0 * math.sqrt(1.0 + m11 - m00 - m22)
+        x, y, z, w = (m01 + m10) / s, s / 4, (m12 + m21) / s, (m02 - m20) / s
+    else:
+        s = 2.0 * math.sqrt(1.0 + m22 - m00 - m11)
+        x, y, z, w = (m02 + m20) / s, (m12 + m21) / s, s / 4, (m10 - m01) / s
+    norm = math.sqrt(x * x + y * y + z * z + w * w)
+    x, y, z, w = x / norm, y / norm, z / norm, w / norm
+    return (-x, -y, -z, -w) if w < 0.0 else (x, y, z, w)

@@ -6,8 +6,11 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from moveplan.commander.ros.tf import transformations
+from moveplan.core import rotations
 from moveplan.core.rotations import (
     matrix_from_quaternion,
     matrix_from_rotation_vector,
@@ -59,6 +62,30 @@ def test_round_trips_and_the_vectorised_path_agree() -> None:
         transforms[k, :3, :3] = rotation
     one_by_one = np.array([quaternion_from_matrix(t[:3, :3]) for t in transforms])
     np.testing.assert_allclose(quaternions_xyzw(transforms), one_by_one, atol=1e-12)
+
+
+@given(st.lists(st.tuples(*[st.floats(-1.0, 1.0)] * 4, st.sampled_from(["any", "axis", "half turn"])),
+                min_size=1, max_size=80))
+@settings(max_examples=200, deadline=None)
+def test_a_few_transforms_get_the_same_quaternions_to_the_bit_as_many(
+    quaternions: list[tuple[float, float, float, float, str]],
+) -> None:
+    """A plan's static frames and markers are a few transforms; its /tf samples many. Both ways, the same bits."""
+    transforms = np.tile(np.eye(4), (len(quaternions), 1, 1))
+    for k, (x, y, z, w, kind) in enumerate(quaternions):
+        q = np.array([x, y, z, w])
+        if kind == "axis":  # a rotation about one axis, or none: the branches' ties
+            q[np.argsort(np.abs(q))[:2]] = 0.0
+        elif kind == "half turn":  # w = 0: the trace is -1, every diagonal branch in play
+            q[3] = 0.0
+        if np.linalg.norm(q) < 1e-3:
+            q = np.array([0.0, 0.0, 0.0, 1.0])
+        transforms[k, :3, :3] = matrix_from_quaternion(q / np.linalg.norm(q))
+    few = [quaternions_xyzw(t[None]) for t in transforms]  # one at a time: plain floats
+    many = quaternions_xyzw(np.concatenate([transforms] * (rotations._FEW // len(transforms) + 1)))  # numpy's way
+    assert len(many) > rotations._FEW
+    assert np.concatenate(few).tobytes() == many[: len(transforms)].tobytes()
+    assert quaternions_xyzw(transforms).tobytes() == many[: len(transforms)].tobytes()
 
 
 def test_a_quaternion_of_any_length_is_normalised_and_a_zero_one_is_no_rotation() -> None:

@@ -107,18 +107,23 @@ def tf_messages_cdr(
     """Return one CDR `messages.tf_message` per stamp; `poses` (stamps, children, 7) are xyz then quaternion xyzw."""
     # The messages differ only in stamps and poses: one template written field by field,
     # then copies of it patched in bulk (a plan has ~180 messages of ~7 transforms).
+    poses = np.asarray(poses).astype("<f8", copy=False)
+    stamps = time_array(stamps_ns)
+    if not len(stamps):
+        return []
+    # The template is the first message: a plan's /tf_static is one message, and is then written.
     template = CdrWriter()
     template.uint32(len(children))
     stamp_at, pose_at = [], []
-    for parent, child in zip(parents, children, strict=True):
+    for child, (parent, name) in enumerate(zip(parents, children, strict=True)):
         # geometry_msgs/TransformStamped: header, child_frame_id, then a Transform of
         # translation xyz and rotation xyzw, seven float64 in a row.
-        stamp_at.append(template.time(0))
+        stamp_at.append(template.time(int(stamps_ns[0])))
         template.string(parent)
-        template.string(child)
-        pose_at.append(template.float64_array(np.zeros(7)))
-    poses = np.asarray(poses).astype("<f8", copy=False)
-    stamps = time_array(stamps_ns)
+        template.string(name)
+        pose_at.append(template.float64_array(poses[0, child]))
+    if len(stamps) == 1:
+        return [template.data()]
     patches: list[tuple[int, NDArray[np.generic]]] = [(start, stamps) for start in stamp_at]
     patches += [(start, poses[:, child]) for child, start in enumerate(pose_at)]
     messages = patched_copies(template.data(), len(stamps), patches)
