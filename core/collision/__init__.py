@@ -9,7 +9,7 @@ if TYPE_CHECKING:
     from .checker import CollisionChecker, GeometryMode
     from .compiled import add_setup_time, kernels_loaded, kernels_ready, setup_time_spent
     from .mesh_arrays import inline_mesh
-    from .motion import MotionChecker, build_sphere_filter, exact_checks, hull_checker
+    from .motion import MotionChecker, build_sphere_filter, exact_checks, scene_checkers
     from .sphere_filter import SphereFilter
 
 __all__ = [
@@ -21,10 +21,10 @@ __all__ = [
     "add_setup_time",
     "build_sphere_filter",
     "exact_checks",
-    "hull_checker",
     "inline_mesh",
     "kernels_loaded",
     "kernels_ready",
+    "scene_checkers",
     "setup_time_spent",
 ]
 
@@ -37,9 +37,9 @@ __getattr__ = lazy_exports(__name__, {
     "add_setup_time": "compiled",
     "build_sphere_filter": "motion",
     "exact_checks": "motion",
-    "hull_checker": "motion",
     "inline_mesh": "mesh_arrays",
     "kernels_loaded": "compiled",
     "kernels_ready": "compiled",
+    "scene_checkers": "motion",
     "setup_time_spent": "compiled",
 })

@@ -37,10 +37,11 @@ from ..trajectory import interpolate
 from ..types import JointTrajectory
 from . import _certify as certify
 from ._cover import RUN, needed, run_margins, uncovered_collision
-from .checker import CONTACT_M, CollisionChecker, GeometryMode
+from .checker import CONTACT_M, CollisionChecker, GeometryMode, robot_geometry
 from .sphere_filter import CLEAR, COLLIDES, MAYBE, SphereFilter, UnsupportedJoint
 
-__all__ = ["CERTIFY_STEP_M", "MotionChecker", "build_sphere_filter", "exact_checks", "hull_checker", "scene_checks"]
+__all__ = ["CERTIFY_STEP_M", "MotionChecker", "build_sphere_filter", "exact_checks", "hull_checker", "scene_checkers",
+           "scene_checks"]
 
 logger = logging.getLogger(__name__)
 
@@ -272,9 +273,20 @@ def scene_checks(robot: Robot, scene: Scene, geometry: GeometryMode, base: NDArr
     The sphere filter clears most states first; with meshes, their convex hulls judge what
     it leaves before the meshes do. Either stage is left out where the robot cannot have it.
     """
-    checker = CollisionChecker(robot, scene.objects, scene.source, geometry=geometry, allowed=scene.allowed)
-    hulls = hull_checker(robot, checker, scene)
+    checker, hulls = scene_checkers(robot, scene, geometry)
     return MotionChecker(robot, checker, base, build_sphere_filter(robot, checker, hulls, scene, base), hulls)
+
+
+def scene_checkers(
+    robot: Robot, scene: Scene, geometry: GeometryMode
+) -> tuple[CollisionChecker, CollisionChecker | None]:
+    """Return the checker of `robot` in `scene` by `geometry`, and the hulls' checker asked before it, if any.
+
+    The hulls are built first, and the checker takes their pairs: the same robot, objects and
+    allowed pairs give the same ones.
+    """
+    hulls = hull_checker(robot, geometry, scene)
+    return CollisionChecker(robot, scene.objects, scene.source, geometry, scene.allowed, hulls), hulls
 
 
 def exact_checks(checks: MotionChecker, scene: Scene) -> MotionChecker:
@@ -332,10 +344,10 @@ def build_sphere_filter(
         return None
 
 
-def hull_checker(robot: Robot, checker: CollisionChecker, scene: Scene) -> CollisionChecker | None:
-    """Return a checker of the robot's meshes as convex hulls in `scene` when `checker` has meshes, else None."""
-    meshes = any(isinstance(obj.geometry, coal.BVHModelBase) for obj in checker.robot_geometry.geometryObjects)
-    if checker.mode != "exact" or not meshes:
+def hull_checker(robot: Robot, geometry: GeometryMode, scene: Scene) -> CollisionChecker | None:
+    """Return a checker of the robot's meshes as convex hulls in `scene` if `geometry` is exact meshes, else None."""
+    if geometry != "exact" or not any(isinstance(obj.geometry, coal.BVHModelBase)
+                                      for obj in robot_geometry(robot, "exact").geometryObjects):
         return None  # the hulls would be the checker's own shapes, checked twice
     try:
         return CollisionChecker(robot, scene.objects, scene.source, geometry="convex", allowed=scene.allowed)

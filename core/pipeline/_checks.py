@@ -29,15 +29,14 @@ from numpy.typing import NDArray
 
 from ..collision import (
     MAYBE,
-    CollisionChecker,
     GeometryMode,
     MotionChecker,
     SphereFilter,
     add_setup_time,
     build_sphere_filter,
-    hull_checker,
     kernels_loaded,
     kernels_ready,
+    scene_checkers,
 )
 from ..model import Robot, Scene
 from ..trajectory import interpolate
@@ -92,8 +91,7 @@ def _checks(
     robot: Robot, scene: Scene, geometry: GeometryMode, base: NDArray[np.float64], after: int
 ) -> MotionChecker:
     """Return the checks of `robot` (other joints at `base`) in `scene`, the filter built after `after` states."""
-    checker = CollisionChecker(robot, scene.objects, scene.source, geometry=geometry, allowed=scene.allowed)
-    hulls = hull_checker(robot, checker, scene)
+    checker, hulls = scene_checkers(robot, scene, geometry)
 
     def build() -> SphereFilter | None:
         return build_sphere_filter(robot, checker, hulls, scene, base)

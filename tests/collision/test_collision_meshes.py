@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 from conftest import ROOT, SAMPLES, Cli
 
+from moveplan.core.collision import motion
 from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.config.robot_config import load_robot_config
-from moveplan.core.errors import ConfigError
+from moveplan.core.errors import ConfigError, StartInCollision
 from moveplan.core.model.robot import Robot
 from moveplan.core.model.scene_file import load_scene
-from moveplan.core.pipeline import _checks as checks
 
 PANDA = ROOT / "configs" / "panda"
 SHELF_SCENE = SAMPLES / "panda_shelf_scene.yaml"
@@ -116,7 +116,7 @@ def test_collision_key_in_moveplan_yaml_selects_convex_mode(
             super().__init__(*args, **kwargs)
             modes.append(self.mode)
 
-    monkeypatch.setattr(checks, "CollisionChecker", Spy)
+    monkeypatch.setattr(motion, "CollisionChecker", Spy)
     result = cli("plan", "--robot", folder, "--start-named", "ready", "--joints", "panda_joint1=0.3",
                  "-o", tmp_path / "out.mcap")
     assert result.exit_code == 0, result.stderr
@@ -181,3 +181,31 @@ def test_convex_mode_keeps_a_flat_robot_mesh_as_a_mesh(tmp_path: Path) -> None:
     kinds = {checker.owner[k]: type(g.geometry) for k, g in enumerate(checker.geometry.geometryObjects)}
     assert issubclass(kinds["base"], coal.BVHModelBase) and issubclass(kinds["tip"], coal.ConvexBase)
     assert checker.colliding_pair(robot.neutral()) is None
+
+
+def test_the_meshes_checker_built_after_the_hulls_checks_the_pairs_one_built_alone_does(panda: Robot) -> None:
+    scene = load_scene(SHELF_SCENE, panda)
+    checker, hulls = motion.scene_checkers(panda, scene, "exact")
+    alone = CollisionChecker(panda, scene.objects, scene.source, "exact", scene.allowed)
+    assert hulls is not None and hulls.mode == "convex" and checker.mode == "exact"
+    assert checker.owner == alone.owner
+    assert [(p.first, p.second) for p in checker.geometry.collisionPairs] == \
+        [(p.first, p.second) for p in alone.geometry.collisionPairs]
+    q = panda.configuration(np.array(BAY_GOALS[0]), panda.neutral())
+    assert checker.colliding_pair(q) == alone.colliding_pair(q)
+
+
+@pytest.mark.parametrize("through", ["panda_link0", "nothing"])
+def test_an_object_through_the_fixed_base_is_refused_at_every_state_with_the_hulls_first(
+    panda: Robot, tmp_path: Path, through: str
+) -> None:
+    # The base's mesh and hull both reach 0.1 m up from its origin; a box 1 cm across around
+    # a point 5 cm up is inside both, one 30 cm away touches neither.
+    x = 0.0 if through == "panda_link0" else -0.3
+    path = scene_file(tmp_path, f"  - {{name: grit, box: [0.01, 0.01, 0.01], xyz: [{x}, 0, 0.05]}}")
+    scene = load_scene(path, panda)
+    if through == "nothing":
+        motion.scene_checkers(panda, scene, "exact")
+        return
+    with pytest.raises(StartInCollision, match="panda_link0.*grit|grit.*panda_link0"):
+        motion.scene_checkers(panda, scene, "exact")
