@@ -16,8 +16,9 @@ Without the spheres, coal checks the middle state of each run of a few with a ma
 the run's ends, and only the states of runs that fail one by one. Then the states' clearances
 must cover the motion between them (core/collision/_cover.py).
 
-An edge's states go to coal as OMPL's DiscreteMotionValidator checks them: the end state, then
-the middle, then the middles of the halves, so a blocked edge is refused after a few.
+Without the spheres, an edge's states go to coal as OMPL's DiscreteMotionValidator checks them:
+the end state, then the middle, then the middles of the halves, so a blocked edge is refused
+after a few. (With them, coal gets the few states they leave unsure, in order.)
 """
 
 from __future__ import annotations
@@ -154,8 +155,9 @@ class MotionChecker:
         if worst == CLEAR:
             return True
         if final:
-            halving = q[_halving(len(q))].T
-            return worst != COLLIDES and bool(self._stages[0].free_batch(halving, stop_at_first=True).all())
+            if not self.compiled:  # coal judges every state: in halving order a blocked edge fails early
+                q = q[_halving(len(q))]
+            return worst != COLLIDES and bool(self._stages[0].free_batch(q.T, stop_at_first=True).all())
         free = np.zeros(len(verdict), dtype=bool)
         maybe = verdict == MAYBE
         if maybe.any():
