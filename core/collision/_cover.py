@@ -103,16 +103,18 @@ def _ladder(margin: NDArray[np.float64]) -> NDArray[np.float64]:
 
 def run_margins(
     travel: NDArray[np.float64], step_m: float
-) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]:
-    """Return per run of RUN states its middle state and the margin [m] proving the run free, and per state its offset.
+) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.intp], NDArray[np.float64]]:
+    """Return per run of RUN states its middle and the margin [m] proving it free; per state its run and radius.
 
     A middle state whose checked pairs are all a margin apart proves every state of its run
-    free, with the margin less its offset (how far it is from the middle in travel) as radius.
-    The margin leaves the run's end states at least `step_m` / 2: with states at most `step_m`
-    apart, neighbouring runs that both pass cover the motion between them.
+    free, with the margin less its distance in travel from the middle as radius. The margin
+    leaves the run's end states at least `step_m` / 2: with states at most `step_m` apart,
+    neighbouring runs that both pass cover the motion between them.
     """
     count = len(travel)
     starts = np.arange(0, count, RUN)
     middle = np.minimum(starts + RUN // 2, count - 1)
-    offset = np.abs(travel - travel[middle[np.arange(count) // RUN]])
-    return middle, _ladder(np.maximum.reduceat(offset, starts) + step_m / 2), offset
+    run = np.arange(count) // RUN
+    offset = np.abs(travel - travel[middle[run]])
+    margin = _ladder(np.maximum.reduceat(offset, starts) + step_m / 2)
+    return middle, margin, run, margin[run] - offset

@@ -226,10 +226,10 @@ class MotionChecker:
         radius = np.where(free, radius, 0.0)
         if margin is None and not self.compiled and len(states) > RUN:
             # No clearances from the spheres: one coal check a run proves the run's states free.
-            middle, run_margin, offset = run_margins(travel, CERTIFY_STEP_M)
-            apart = self._free_within(q[middle].T, run_margin, meshes=False)[np.arange(len(states)) // RUN]
+            middle, run_margin, run, proven = run_margins(travel, CERTIFY_STEP_M)
+            apart = self._free_within(q[middle].T, run_margin, meshes=False)[run]
             free |= apart
-            radius = np.where(apart, run_margin[np.arange(len(states)) // RUN] - offset, radius)
+            radius = np.where(apart, proven, radius)
         maybe = np.flatnonzero((verdict == MAYBE) & ~free)
         if len(maybe) and (margin is not None or len(states) > 1):
             wanted = needed(travel, radius, maybe) if margin is None else margin[maybe]
@@ -299,7 +299,7 @@ def exact_checks(checks: MotionChecker, scene: Scene) -> MotionChecker:
     return MotionChecker(checks.robot, checker, checks.base)
 
 
-@functools.cache
+@functools.lru_cache(maxsize=256)  # an edge's state count: a few hundred at most in a search
 def _halving(count: int) -> NDArray[np.intp]:
     """Return 0..count-1 in halving order: the last, the middle, then the middles of the halves, and so on."""
     order, spans = [count - 1], [(-1, count - 1)]
