@@ -57,7 +57,7 @@ if TYPE_CHECKING:
         parse_planning_scene,
     )
     from .plant import PLANT_MODELS, PlantSettings
-    from .poses import pose_matrix
+    from .poses import is_identity, pose_matrix
     from .robot_config import RobotConfig, load_robot_config
     from .scene_text import parse_scene_text
     from .scene_text_write import format_scene_text
@@ -126,6 +126,7 @@ __all__ = [
     "expression",
     "first_repeated",
     "format_scene_text",
+    "is_identity",
     "is_planning_time",
     "is_scaling",
     "launch_arguments",
@@ -213,6 +214,7 @@ __getattr__ = lazy_exports(__name__, {
     "expression": "fields",
     "first_repeated": "scene_yaml",
     "format_scene_text": "scene_text_write",
+    "is_identity": "poses",
     "is_planning_time": "motion",
     "is_scaling": "motion",
     "launch_arguments": "launch_files",

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from ..errors import ConfigError
 from .fields import check_keys, coordinate, coordinates, mapping
-from .poses import pose_matrix
+from .poses import is_identity, pose_matrix
 
 __all__ = [
     "header_frame",
@@ -59,7 +59,7 @@ def robot_state(value: Any, where: str) -> tuple[dict[str, float], list[Any]]:
     names = string_list(multi.get("joint_names"), f"{where}.multi_dof_joint_state.joint_names")
     for k, item in enumerate(yaml_list(multi.get("transforms"), f"{where}.multi_dof_joint_state.transforms")):
         at = f"{where}.multi_dof_joint_state.transforms[{k}]"
-        if not np.allclose(transform(item, at), np.eye(4), atol=1e-9):
+        if not is_identity(transform(item, at)):
             joint = names[k] if k < len(names) else "?"
             raise ConfigError(f"{at}: joint '{joint}' is away from the identity; moveplan plans in the URDF "
                               "root frame and cannot move a virtual joint")

@@ -42,6 +42,7 @@ from ..config import (
     attached_collision_object,
     check_shape_count,
     first_repeated,
+    is_identity,
     parse_planning_scene,
 )
 from ..errors import ConfigError, UnknownName
@@ -195,13 +196,13 @@ def _fixed_frames(entries: tuple[FixedTransform, ...], robot: Robot) -> list[Fra
     """
     # A frame given relative to itself is MoveIt's planning frame; robowflex leaves that header out.
     planning = set(planning_frame_names(robot)) | {
-        e.child for e in entries if e.header in ("", e.child) and np.allclose(e.header_T_child, np.eye(4), atol=1e-9)}
+        e.child for e in entries if e.header in ("", e.child) and is_identity(e.header_T_child)}
     aliases: dict[str, Frame] = {}
     frames = []
     for entry in entries:
         header, child, header_T_child = entry.header, entry.child, entry.header_T_child
         if child in planning and header in planning | {""}:
-            if not np.allclose(header_T_child, np.eye(4), atol=1e-9):
+            if not is_identity(header_T_child):
                 raise ConfigError(f"{entry.where}: '{header or child}' and '{child}' both name the planning frame; "
                                   "the transform between them can only be the identity")
             for name in {header, child} - {"", *robot.link_names}:
