@@ -92,8 +92,9 @@ class SphereFilter:
 
         self._kernels, self._clearance, self._states = sphere_kernels, _clearance, _states
         self._peak_rates = compiled_quintic_peak_rates
-        # Packed once: the kernels run thousands of times per search, and a call costs per argument.
-        self._packed = sphere_kernels.pack({**part.arrays, **_obstacles(world), "check": check})
+        # Packed once: the kernels run thousands of times per search, and a call costs per argument; the
+        # robot's arrays (660 kB with its distance tables) were packed with its part, only the world's are added.
+        self._packed = sphere_kernels.pack(part.packed, {**_obstacles(world), "check": check})
         self._nq = model.nq
         # Reused by every `edge` call: returning fresh arrays from compiled code costs more than judging a state.
         self._verdicts, self._unclear = np.empty(64, dtype=np.int8), np.empty((64, model.nq))
@@ -181,7 +182,7 @@ class _RobotPart(NamedTuple):
     names: tuple[str, ...]  # owners: links, then attached objects
     owner_joint: NDArray[np.int64]
     tabulated: tuple[tuple[str, str], ...]
-    arrays: dict[str, Any]
+    packed: tuple[Any, Any, Any]  # the kernels' robot arrays (_kernels.pack_robot)
 
 
 _ROBOT_PARTS: dict[tuple[Any, ...], _RobotPart] = {}
@@ -229,7 +230,9 @@ def _built_part(
         "centres": spheres.centre, "radii": spheres.radius, "sjoint": spheres.joint, "start": spheres.start,
         "ojoint": owner_joint, "ocentre": owner_centre, "oradius": owner_radius, **_inner_arrays(inner, names),
         "pairs": np.reshape(pairs, (-1, 2)), **_mimic_arrays(robot)}
-    return _RobotPart(tuple(names), owner_joint, tuple((t.upper, t.lower) for t in tables), arrays)
+    from ._kernels import pack_robot  # numba, which the filter these arrays are for loads next
+
+    return _RobotPart(tuple(names), owner_joint, tuple((t.upper, t.lower) for t in tables), pack_robot(arrays))
 
 
 def _joint_arrays(model: pin.Model) -> dict[str, Any]:
