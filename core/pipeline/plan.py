@@ -314,7 +314,7 @@ def _tf_samples(robot: Robot, base: NDArray[np.float64], steps: list[StepResult]
         trajectory = step.trajectory
         count = max(2, int(np.ceil(trajectory.duration_s * _TF_RATE_HZ)) + 1)
         local = np.linspace(0.0, trajectory.duration_s, count)
-        values.append(sample(trajectory, local)[0])
+        values.append(sample(trajectory, local, derivatives=0)[0])  # /tf carries positions alone
         times.append(offset + local)
         offset += trajectory.duration_s
     return robot.tf_samples(np.concatenate(times), np.concatenate(values), base)
