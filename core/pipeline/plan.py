@@ -11,7 +11,6 @@ from __future__ import annotations
 import json
 import logging
 import os
-import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -43,7 +42,8 @@ from ._step import plan_step
 from .request import PlanFlags, PlanRequest, resolve_request
 from .robot_state import RobotState, robot_state
 
-__all__ = ["PlanFlags", "PlanRequest", "PlanResult", "assemble", "plan", "plan_to_file", "resolve_request"]
+__all__ = ["PlanFlags", "PlanRequest", "PlanResult", "assemble", "exact_valid", "plan", "plan_to_file", "planned",
+           "resolve_request"]
 
 logger = logging.getLogger(__name__)
 
@@ -93,23 +93,25 @@ def _refuse_replacing_inputs(output: Path, request: PlanRequest, config: RobotCo
             raise UsageError(f"-o '{output}': is also {what} ({path}); an output must not replace an input")
 
 
-def plan(
-    request: PlanRequest, config: RobotConfig | None = None, exact_check: bool = False, filter_after: int = 0
-) -> PlanResult:
+def plan(request: PlanRequest, config: RobotConfig | None = None, filter_after: int = 0) -> PlanResult:
     """Return the timed, collision-free plan for every step of `request`, in order.
 
     `config` is the loaded `request.robot` when the caller has it (a benchmark plans many
     problems with one robot); a config loaded here also warns about the group's joints that
-    plan with the default acceleration limit (limits.DEFAULT_ACCELERATION). With `exact_check`,
-    each step's `stats["exact_valid"]` says whether its trajectory is free under the URDF's
-    exact meshes, checked independently of the planner's geometry (1.0 or 0.0), and
-    `stats["exact_check_s"]` how long that took [s] (the first step's with setting the check up). The sphere filter
+    plan with the default acceleration limit (limits.DEFAULT_ACCELERATION). The sphere filter
     is built after `filter_after` checked states (core/pipeline/_checks.py): 0, now.
 
     Raises:
         MoveplanError: Any error while planning a step carries the step's name (`step`), and
             the plan of the steps before it (`partial`, None if it is the first).
     """
+    return planned(request, config, filter_after)[0]
+
+
+def planned(
+    request: PlanRequest, config: RobotConfig | None = None, filter_after: int = 0
+) -> tuple[PlanResult, Problem]:
+    """Return `plan`'s plan and the problem it was planned in: the robot, the scene and their collision checks."""
     seed_planner(request.seed)
     loaded_here = config is None
     if config is None:
@@ -139,15 +141,13 @@ def plan(
         if steps:
             exc.partial = assemble(request, config, robot, scene, base, steps)
         raise
-    if exact_check:
-        began = time.perf_counter()  # the referee's set-up is the first step's check: no part of a plan's cost
-        referee = exact_checks(problem.checks, scene)
-        for step in steps:
-            hit = referee.first_collision_on_trajectory(step.trajectory, between=False)  # the states themselves
-            step.stats["exact_valid"] = float(hit is None)
-            step.stats["exact_check_s"] = time.perf_counter() - began
-            began = time.perf_counter()
-    return assemble(request, config, robot, scene, base, steps)
+    return assemble(request, config, robot, scene, base, steps), problem
+
+
+def exact_valid(plan: PlanResult, problem: Problem) -> bool:
+    """Return True if every step's certified states are free under the URDF's exact meshes, checked anew (a referee)."""
+    referee = exact_checks(problem.checks, problem.scene)
+    return all(referee.first_collision_on_trajectory(step.trajectory, between=False) is None for step in plan.steps)
 
 
 def _robot(request: PlanRequest, config: RobotConfig) -> Robot:
