@@ -66,6 +66,10 @@ class Robot:
         self.continuous = np.array([lim.continuous for lim in limits])
         ids = [self.model.getJointId(j) for j in self.joint_names]
         self.q_index = np.array([self.model.idx_qs[i] for i in ids])
+        # Worked out once: a search places thousands of edges' states in configurations.
+        self._plain = np.flatnonzero(~self.continuous)
+        self._turning = np.flatnonzero(self.continuous)
+        self._plain_q, self._turning_q = self.q_index[self._plain], self.q_index[self._turning]
         self.link_names = tuple(f.name for f in self.model.frames if f.type == pin.FrameType.BODY)
         self.mimics = tuple(
             Mimic(j.name, self.joint_names.index(j.mimic), int(self.model.idx_qs[self.model.getJointId(j.name)]),
@@ -92,11 +96,13 @@ class Robot:
         """Return configurations, shape (nq, k), for group values of shape (k, dof)."""
         base = self.neutral() if base is None else base
         q = np.repeat(base[:, None], len(values), axis=1)
-        plain = ~self.continuous
-        q[self.q_index[plain], :] = values[:, plain].T
-        # A continuous joint is stored by pinocchio as (cos, sin).
-        q[self.q_index[self.continuous], :] = np.cos(values[:, self.continuous]).T
-        q[self.q_index[self.continuous] + 1, :] = np.sin(values[:, self.continuous]).T
+        if len(self._turning):
+            q[self._plain_q, :] = values[:, self._plain].T
+            # A continuous joint is stored by pinocchio as (cos, sin).
+            q[self._turning_q, :] = np.cos(values[:, self._turning]).T
+            q[self._turning_q + 1, :] = np.sin(values[:, self._turning]).T
+        else:
+            q[self._plain_q, :] = values.T
         for mimic in self.mimics:
             q[mimic.q_index, :] = mimic.multiplier * values[:, mimic.leader] + mimic.offset
         return q
