@@ -25,7 +25,7 @@ __all__ = [
     "DEGREES", "MAX_ALIAS_EXPANSION", "MAX_EXPRESSION_LENGTH", "MAX_MAGNITUDE", "MAX_YAML_BYTES", "MAX_YAML_EVENTS",
     "TURN", "angle", "beyond_a_turn", "boolean", "check_keys", "coordinate", "coordinates", "expression", "load_yaml",
     "mapping",
-    "read_input", "read_input_text",
+    "read_input", "read_input_text", "text_of",
     "more_than_a_turn", "number", "parse_yaml", "pose_angle", "pose_angles", "string_list",
 ]
 
@@ -164,8 +164,13 @@ def read_input(path: Path, limit: int = MAX_YAML_BYTES) -> bytes:
 
 def read_input_text(path: Path, limit: int = MAX_YAML_BYTES) -> str:
     """Return the UTF-8 text of the regular file `path`, read as read_input reads it."""
+    return text_of(read_input(path, limit), path)
+
+
+def text_of(data: bytes, path: Path) -> str:
+    """Return the UTF-8 text of `data`, read from `path`; ConfigError names the file and the first bad byte."""
     try:
-        return read_input(path, limit).decode("utf-8")
+        return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise ConfigError(f"{path}: cannot read: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
 

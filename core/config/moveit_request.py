@@ -42,7 +42,7 @@ from numpy.typing import NDArray
 from ..errors import ConfigError, known
 from .collision_objects import attached_object
 from .constraints import ARC_POINTS, arc_point, path_constraints
-from .fields import MAX_MAGNITUDE, check_keys, coordinate, load_yaml, mapping, number, read_input
+from .fields import MAX_MAGNITUDE, check_keys, coordinate, mapping, number, parse_yaml, read_input, text_of
 from .goals import JointGoal, PoseGoal
 from .motion import MIN_SCALING, MotionSettings
 from .planners import PILZ_PLANNERS, PLANNERS
@@ -129,7 +129,8 @@ class MotionPlanRequest:
 def load_motion_plan_request(path: Path) -> MotionPlanRequest:
     """Return the MotionPlanRequest in a YAML file."""
     source = str(path)
-    top = mapping(load_yaml(path), source)
+    raw = read_input(path)  # once: what is parsed is what the plan embeds
+    top = mapping(parse_yaml(text_of(raw, path), path), source)
     check_keys(top, _REQUEST_KEYS, source)
     _check_unsupported(top, source)
 
@@ -175,7 +176,7 @@ def load_motion_plan_request(path: Path) -> MotionPlanRequest:
             velocity_scaling=_scaling(top, "max_velocity_scaling_factor", source),
             acceleration_scaling=_scaling(top, "max_acceleration_scaling_factor", source),
         ),
-        raw=read_input(path),
+        raw=raw,
         attached=tuple(attached),
     )
 
