@@ -10,6 +10,7 @@ from .._faces import lazy_exports
 
 if TYPE_CHECKING:
     from ._initial_state import default_position
+    from ._urdf import UrdfJoint
     from .collision_objects import AttachedMessage, ObjectMessage, attached_collision_object, collision_object
     from .constraints import (
         ARC_POINTS,
@@ -111,6 +112,7 @@ __all__ = [
     "StartFrom",
     "StepSpec",
     "TaskFile",
+    "UrdfJoint",
     "allowed_collisions",
     "angle",
     "arc_point",
@@ -199,6 +201,7 @@ __getattr__ = lazy_exports(__name__, {
     "StartFrom": "goals",
     "StepSpec": "tasks",
     "TaskFile": "tasks",
+    "UrdfJoint": "_urdf",
     "allowed_collisions": "planning_scene_yaml",
     "angle": "fields",
     "arc_point": "constraints",

@@ -14,6 +14,7 @@ so poses are the same to the bit on every machine.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -53,7 +54,7 @@ class JointTable:
     turn_sin: NDArray[np.float64]  # (J, 4) xyzw
 
 
-def joint_table(model: pin.Model, pairs: list[tuple[int, int]]) -> JointTable | None:
+def joint_table(model: pin.Model, pairs: Sequence[tuple[int, int]]) -> JointTable | None:
     """Return the joint table of frame pairs (parent link, child link), or None if one is not written out here.
 
     Written out: one moving joint of pinocchio's revolute, continuous or prismatic kinds, on any axis.

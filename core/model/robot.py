@@ -22,7 +22,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from .._kept import kept
-from ..config import Group, RobotConfig
+from ..config import Group, RobotConfig, UrdfJoint
 from ..errors import ConfigError, UnknownName
 from ..rotations import tf_poses
 from ..types import Frame, TfSamples
@@ -70,16 +70,13 @@ class Robot:
         self._plain = np.flatnonzero(~self.continuous)
         self._turning = np.flatnonzero(self.continuous)
         self._plain_q, self._turning_q = self.q_index[self._plain], self.q_index[self._turning]
-        self.link_names = tuple(f.name for f in self.model.frames if f.type == pin.FrameType.BODY)
+        facts = kept(_URDF_FACTS, config.urdf, lambda: _urdf_facts(self.model, config))
+        self.link_names = facts.link_names
         self.mimics = tuple(
             Mimic(j.name, self.joint_names.index(j.mimic), int(self.model.idx_qs[self.model.getJointId(j.name)]),
                   j.mimic_multiplier, j.mimic_offset)
             for j in joints.values() if j.mimic in self.joint_names and self.model.existJointName(j.name))
-        self._moving = [j for j in joints.values() if j.type != "fixed"]  # what /tf carries
-        self._moving_frames = [(self.model.getFrameId(j.parent), self.model.getFrameId(j.child)) for j in self._moving]
-        # Per URDF text, as the model: a benchmark makes a Robot per problem.
-        self._joint_table: JointTable | None = kept(_JOINT_TABLES, config.urdf,
-                                                    lambda: joint_table(self.model, self._moving_frames))
+        self._moving, self._moving_frames, self._joint_table = facts.moving, facts.moving_frames, facts.joint_table
 
     @property
     def dof(self) -> int:
@@ -201,7 +198,27 @@ def _readonly(values: list[float]) -> NDArray[np.float64]:
 
 
 _MODELS: dict[str, pin.Model] = {}
-_JOINT_TABLES: dict[str, JointTable | None] = {}
+
+
+@dataclass(frozen=True)
+class _UrdfFacts:
+    """What a Robot reads of its URDF alone, kept per URDF text as the model is (a benchmark makes one per problem)."""
+
+    link_names: tuple[str, ...]
+    moving: tuple[UrdfJoint, ...]  # what /tf carries
+    moving_frames: tuple[tuple[int, int], ...]  # each moving joint's parent and child frame ids
+    joint_table: JointTable | None
+
+
+_URDF_FACTS: dict[str, _UrdfFacts] = {}
+
+
+def _urdf_facts(model: pin.Model, config: RobotConfig) -> _UrdfFacts:
+    """Return the link names, moving joints, their frames and their /tf table of `model`, the URDF of `config`."""
+    moving = tuple(j for j in config.urdf_joints.values() if j.type != "fixed")
+    frames = tuple((model.getFrameId(j.parent), model.getFrameId(j.child)) for j in moving)
+    return _UrdfFacts(tuple(f.name for f in model.frames if f.type == pin.FrameType.BODY), moving, frames,
+                      joint_table(model, frames))
 
 
 def _model(config: RobotConfig) -> pin.Model:
