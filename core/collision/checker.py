@@ -215,10 +215,13 @@ class CollisionChecker:
         config = robot.config
         self.robot_geometry = robot_geometry(robot, geometry)  # shared per process: never modify
         geom = self.robot_geometry.copy()
-        for obj in objects:
-            geom.addGeometryObject(self._placed(obj, source))
+        # The hulls' checker placed the same objects: their shapes are taken, a scene's mesh files read once.
+        placed = (hulls.geometry.geometryObjects[len(hulls.robot_geometry.geometryObjects):] if hulls is not None
+                  else [self._placed(obj, source) for obj in objects])
+        for obj in placed:
+            geom.addGeometryObject(obj)
         self.attached = any(obj.link for obj in objects)
-        self.geometry = geom
+        self.geometry: pin.GeometryModel = geom
         self._data: pin.GeometryData | None = None
         self._pool: pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager | None = None
         self.owner: tuple[str, ...]

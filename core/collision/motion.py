@@ -338,9 +338,10 @@ def build_sphere_filter(
     robot: Robot, checker: CollisionChecker, hulls: CollisionChecker | None, scene: Scene, base: NDArray[np.float64]
 ) -> SphereFilter | None:
     """Return the fast conservative pre-check for `robot` (other joints at `base`) in `scene`, or None."""
+    placed = checker.geometry.geometryObjects[len(checker.robot_geometry.geometryObjects):]
     try:
         return SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed, base,
-                            (hulls or checker).robot_geometry)
+                            (hulls or checker).robot_geometry, {obj.name: obj.geometry for obj in placed})
     except UnsupportedJoint as exc:
         logger.info("no sphere filter (%s): every state is checked by coal", exc)
         return None

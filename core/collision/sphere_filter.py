@@ -14,9 +14,10 @@ overlaps, surely collides under the hulls. Anything else is "maybe": the caller 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, NamedTuple, cast
 
+import coal
 import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
@@ -69,12 +70,14 @@ class SphereFilter:
         allowed: frozenset[frozenset[str]] = frozenset(),
         base: NDArray[np.float64] | None = None,
         hulls: pin.GeometryModel | None = None,
+        shapes: Mapping[str, coal.CollisionGeometry] | None = None,
     ) -> None:
         """Fit spheres to `robot` (its `geometry`), add attached objects, and list what to check.
 
         States are the group's joint values; the other joints stay at `base` (default: the neutral
         configuration). Link pairs with distance tables are tabulated from `hulls` (the robot's
-        shapes as convex hulls; default `geometry`).
+        shapes as convex hulls; default `geometry`). `shapes` holds the objects' coal geometries
+        by name where a checker has made them: a mesh file is then not read again.
 
         Raises:
             UnsupportedJoint: The robot has a joint kind the kernel does not handle.
@@ -94,7 +97,7 @@ class SphereFilter:
         self._peak_rates = compiled_quintic_peak_rates
         # Packed once: the kernels run thousands of times per search, and a call costs per argument; the
         # robot's arrays (660 kB with its distance tables) were packed with its part, only the world's are added.
-        self._packed = sphere_kernels.pack(part.packed, {**_obstacles(world), "check": check})
+        self._packed = sphere_kernels.pack(part.packed, {**_obstacles(world, shapes or {}), "check": check})
         self._nq = model.nq
         # Reused by every `edge` call: returning fresh arrays from compiled code costs more than judging a state.
         self._verdicts, self._unclear = np.empty(64, dtype=np.int8), np.empty((64, model.nq))
@@ -366,7 +369,7 @@ def _table_arrays(tables: list[PairTable]) -> dict[str, NDArray[Any]]:
             "table_offset": offset, "table_margin": margin, "table_distance": flat}
 
 
-def _obstacles(world: list[CollisionObject]) -> dict[str, NDArray[Any]]:
+def _obstacles(world: list[CollisionObject], shapes: Mapping[str, coal.CollisionGeometry]) -> dict[str, NDArray[Any]]:
     """Return world obstacles as arrays: kind, centre, rotation, size, whether each is that solid, and a ball's radius.
 
     The ball, about the centre, encloses the obstacle: a sphere missing it misses the obstacle.
@@ -388,7 +391,7 @@ def _obstacles(world: list[CollisionObject]) -> dict[str, NDArray[Any]]:
             kind, size = _CYLINDER, np.array([shape.dims[0], shape.dims[1] / 2, 0.0])
         else:
             # A mesh counts as its bounding box in its own frame: it encloses the mesh.
-            mesh = coal_geometry(shape, obj.name)
+            mesh = shapes[obj.name] if obj.name in shapes else coal_geometry(shape, obj.name)
             mesh.computeLocalAABB()
             lo, hi = np.asarray(mesh.aabb_local.min_), np.asarray(mesh.aabb_local.max_)
             kind, size = _BOX, (hi - lo) / 2

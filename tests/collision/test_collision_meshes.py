@@ -11,7 +11,9 @@ import numpy as np
 import pytest
 from conftest import ROOT, SAMPLES, Cli
 
+from moveplan.core.collision import checker as checker_module
 from moveplan.core.collision import motion
+from moveplan.core.collision._verdicts import COLLIDES
 from moveplan.core.collision.checker import CollisionChecker
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.errors import ConfigError, StartInCollision
@@ -209,3 +211,23 @@ def test_an_object_through_the_fixed_base_is_refused_at_every_state_with_the_hul
         return
     with pytest.raises(StartInCollision, match="panda_link0.*grit|grit.*panda_link0"):
         motion.scene_checkers(panda, scene, "exact")
+
+
+def test_a_scene_mesh_file_is_read_once_for_all_its_checks(panda: Robot, monkeypatch: pytest.MonkeyPatch) -> None:
+    # The hulls' checker reads the tray; the meshes' checker and the sphere filter's bounding box take its shape.
+    read: list[str] = []
+    real = checker_module.coal_geometry
+
+    def counted(shape: Any, source: str = "scene") -> coal.CollisionGeometry:
+        read.append(shape.kind)
+        return real(shape, source)
+
+    monkeypatch.setattr(checker_module, "coal_geometry", counted)
+    scene = load_scene(SHELF_SCENE, panda)
+    checker, hulls = motion.scene_checkers(panda, scene, "exact")
+    spheres = motion.build_sphere_filter(panda, checker, hulls, scene, panda.neutral())
+    assert spheres is not None and read.count("mesh") == 1 and len(read) == len(scene.objects)
+    tray = next(obj for obj in checker.geometry.geometryObjects if obj.name == "tray")
+    assert isinstance(tray.geometry, coal.BVHModelBase)  # the meshes' checker holds the mesh itself
+    q = panda.configuration(np.array(BAY_GOALS[0]), panda.neutral())
+    assert checker.colliding_pair(q) is None and spheres.classify(np.array([BAY_GOALS[0]]))[0][0] != COLLIDES
