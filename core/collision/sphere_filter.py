@@ -185,7 +185,7 @@ class _RobotPart(NamedTuple):
     names: tuple[str, ...]  # owners: links, then attached objects
     owner_joint: NDArray[np.int64]
     tabulated: tuple[tuple[str, str], ...]
-    packed: tuple[Any, Any, Any]  # the kernels' robot arrays (_kernels.pack_robot)
+    packed: tuple[Any, Any]  # the kernels' robot arrays, before and after the world's (_kernels.pack_robot)
 
 
 _ROBOT_PARTS: dict[tuple[Any, ...], _RobotPart] = {}

@@ -209,3 +209,30 @@ def test_a_filter_for_the_next_scene_of_a_robot_judges_as_one_built_from_nothing
     # Each scene judged as itself: the walls moved, the tray held; the first scene again as the first time.
     assert not np.array_equal(reused[0], reused[1]) and not np.array_equal(reused[1], reused[2])
     np.testing.assert_array_equal(reused[0], reused[4])
+
+
+def test_the_robot_packed_once_and_a_world_added_are_the_arrays_packed_at_once() -> None:
+    # The kernels read every array where LAYOUT puts it: the robot's two pieces and a scene's obstacles,
+    # packed apart, must give the very arrays and head that packing all of them together gives.
+    from moveplan.core.collision import _kernels, sphere_filter
+
+    robot = Robot(load_robot_config(PANDA))
+    scene = load_scene(MBM / "problems" / "box_panda" / "scene0001.yaml", robot)
+    checker = CollisionChecker(robot, scene.objects, scene.source, "convex", scene.allowed)
+    built = SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed)
+    part = next(iter(sphere_filter._ROBOT_PARTS.values()))
+    arrays = {name: np.arange(7 * (k + 1)).reshape((-1, 7) if ndim == 2 else (-1, 1, 7) if ndim == 3 else (-1,))
+              for k, (name, ndim, _) in enumerate(_kernels.LAYOUT)}
+    robot_arrays = {name: value for name, value in arrays.items() if name not in _kernels.WORLD}
+    world = {name: arrays[name] for name in _kernels.WORLD}
+    together = _kernels._piece(arrays, range(len(_kernels.LAYOUT)))
+    for got, want in zip(_kernels.pack(_kernels.pack_robot(robot_arrays), world), together, strict=True):
+        np.testing.assert_array_equal(got, want)
+        assert got.dtype == want.dtype
+    # And a real filter's: the scene's obstacles sit where unpack reads them.
+    floats, _, head = built._packed
+    obstacles = sphere_filter._obstacles([obj for obj in scene.objects if not obj.link], {})
+    k = [name for name, _, _ in _kernels.LAYOUT].index("osize")
+    at, rows, columns = head[k, :3]
+    assert len(part.packed) == 2 and rows == len(obstacles["osize"]) > 0
+    np.testing.assert_array_equal(floats[at:at + rows * columns].reshape(rows, columns), obstacles["osize"])
