@@ -16,6 +16,10 @@ import numpy as np
 
 from ._verdicts import CLEAR, COLLIDES, MAYBE
 
+# numba caches a kernel by this file's bytes alone; the line below changes them with the sources its
+# kernels compile in (tests/foundation/test_kernel_inputs.py says what it must read).
+# Compiled in (sha256): collision/_verdicts.py 5c11907276b0
+
 __all__ = ["LAYOUT", "STRIDE", "WORLD", "Packed", "classify", "edge", "pack", "pack_robot", "tabled",
            "tabled_clearance"]
 

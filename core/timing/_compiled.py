@@ -19,6 +19,10 @@ from .. import trajectory
 from ..errors import PlanningFailed
 from ._topp import STILL, SpeedProfile
 
+# numba caches a kernel by this file's bytes alone; the line below changes them with the sources its
+# kernels compile in (tests/foundation/test_kernel_inputs.py says what it must read).
+# Compiled in (sha256): trajectory.py 3f2cffe29b89, timing/_topp.py bd237749bcf1
+
 __all__ = ["compiled_fastest_speeds", "compiled_quintic_peak_rates"]
 
 
