@@ -49,7 +49,9 @@ class Robot:
         self.config = config
         self.group: Group = config.group(group)
         config.srdf.plannable(self.group.name, config.srdf_path)  # a floating or planar base: refused
-        self.model = _model(config)  # shared per process: never modify
+        # Per URDF text, once per process: a benchmark makes a Robot per problem.
+        facts = kept(_URDFS, config.urdf, lambda: _urdf_facts(config))
+        self.model = facts.model  # shared per process: never modify
         self.data = self.model.createData()
         joints = config.urdf_joints
         # The group's variables (MoveIt's) include its mimic joints; its active joints, which are planned, do not.
@@ -70,7 +72,6 @@ class Robot:
         self._plain = np.flatnonzero(~self.continuous)
         self._turning = np.flatnonzero(self.continuous)
         self._plain_q, self._turning_q = self.q_index[self._plain], self.q_index[self._turning]
-        facts = kept(_URDF_FACTS, config.urdf, lambda: _urdf_facts(self.model, config))
         self.link_names = facts.link_names
         self.mimics = tuple(
             Mimic(j.name, self.joint_names.index(j.mimic), int(self.model.idx_qs[self.model.getJointId(j.name)]),
@@ -197,36 +198,27 @@ def _readonly(values: list[float]) -> NDArray[np.float64]:
     return array
 
 
-_MODELS: dict[str, pin.Model] = {}
-
-
 @dataclass(frozen=True)
 class _UrdfFacts:
-    """What a Robot reads of its URDF alone, kept per URDF text as the model is (a benchmark makes one per problem)."""
+    """What a Robot reads of its URDF alone: pinocchio's model, link names, moving joints and their /tf table."""
 
+    model: pin.Model
     link_names: tuple[str, ...]
     moving: tuple[UrdfJoint, ...]  # what /tf carries
     moving_frames: tuple[tuple[int, int], ...]  # each moving joint's parent and child frame ids
     joint_table: JointTable | None
 
 
-_URDF_FACTS: dict[str, _UrdfFacts] = {}
+_URDFS: dict[str, _UrdfFacts] = {}
 
 
-def _urdf_facts(model: pin.Model, config: RobotConfig) -> _UrdfFacts:
-    """Return the link names, moving joints, their frames and their /tf table of `model`, the URDF of `config`."""
+def _urdf_facts(config: RobotConfig) -> _UrdfFacts:
+    """Return the model of the config's URDF, its link names, moving joints, their frames and their /tf table."""
+    model = _parsed(config)
     moving = tuple(j for j in config.urdf_joints.values() if j.type != "fixed")
     frames = tuple((model.getFrameId(j.parent), model.getFrameId(j.child)) for j in moving)
-    return _UrdfFacts(tuple(f.name for f in model.frames if f.type == pin.FrameType.BODY), moving, frames,
+    return _UrdfFacts(model, tuple(f.name for f in model.frames if f.type == pin.FrameType.BODY), moving, frames,
                       joint_table(model, frames))
-
-
-def _model(config: RobotConfig) -> pin.Model:
-    """Return pinocchio's model of the config's URDF, built once per process and URDF text.
-
-    A benchmark makes a Robot per problem: parsing the URDF again was half a millisecond of each.
-    """
-    return kept(_MODELS, config.urdf, lambda: _parsed(config))
 
 
 def _parsed(config: RobotConfig) -> pin.Model:
