@@ -294,12 +294,16 @@ def _start_with(names: list[str]) -> dict[str, Any]:
     (request_with(goal_constraint=[]), "{file}: unknown key 'goal_constraint'"),
     (request_with(start_state={"attached_collision_objects": [{"link_name": "panda_hand"}]}),
      "{file}: start_state.attached_collision_objects[0].object.id: expected an object name, got None"),
+    (b"group_name: panda_arm\nplanner_id: \xff\n",  # read once, for the plan and its embedded copy alike
+     "{file}: cannot read: not UTF-8 text (invalid start byte at byte 34)"),
 ])
 def test_bad_motion_plan_request_exits_3_naming_file_and_key(
     cli: Cli, tmp_path: Path, content: Any, message: str
 ) -> None:
     path = tmp_path / "bad_request.yaml"
-    if isinstance(content, str):
+    if isinstance(content, bytes):
+        path.write_bytes(content)
+    elif isinstance(content, str):
         path.write_text(content)
     else:
         write(path, content)
