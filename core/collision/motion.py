@@ -41,7 +41,7 @@ from ._cover import RUN, needed, run_margins, uncovered_collision
 from .checker import CONTACT_M, CollisionChecker, GeometryMode, robot_geometry
 from .sphere_filter import CLEAR, COLLIDES, MAYBE, SphereFilter, UnsupportedJoint
 
-__all__ = ["CERTIFY_STEP_M", "MotionChecker", "build_sphere_filter", "exact_checks", "hull_checker", "scene_checkers",
+__all__ = ["CERTIFY_STEP_M", "MotionChecker", "build_sphere_filter", "exact_checks", "scene_checkers",
            "scene_checks"]
 
 logger = logging.getLogger(__name__)
@@ -287,7 +287,7 @@ def scene_checkers(
     The hulls are built first, and the checker takes their pairs: the same robot, objects and
     allowed pairs give the same ones.
     """
-    hulls = hull_checker(robot, geometry, scene)
+    hulls = _hull_checker(robot, geometry, scene)
     return CollisionChecker(robot, scene.objects, scene.source, geometry, scene.allowed, hulls), hulls
 
 
@@ -347,7 +347,7 @@ def build_sphere_filter(
         return None
 
 
-def hull_checker(robot: Robot, geometry: GeometryMode, scene: Scene) -> CollisionChecker | None:
+def _hull_checker(robot: Robot, geometry: GeometryMode, scene: Scene) -> CollisionChecker | None:
     """Return a checker of the robot's meshes as convex hulls in `scene` if `geometry` is exact meshes, else None."""
     if geometry != "exact" or not any(isinstance(obj.geometry, coal.BVHModelBase)
                                       for obj in robot_geometry(robot, "exact").geometryObjects):
