@@ -38,6 +38,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -168,20 +169,32 @@ def _job(problems: list[Any], robot: Any, seed: int, args: argparse.Namespace) -
 
 def main() -> None:
     """Plan the problems with both tools, seed by seed in turn, and print the table (or --json)."""
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = arguments(__doc__, "roboplan")
+    args = parser.parse_args()
+    if args.worker:
+        worker()
+        return
+    _check_python(args.roboplan_python)
+    compare(args, "roboplan", args.roboplan_python, __file__, _job)
+
+
+def arguments(doc: str | None, tool: str) -> argparse.ArgumentParser:
+    """Return the command line both comparisons take; `--TOOL-python` names the other tool's python."""
+    parser = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
-    parser.add_argument("--roboplan-python", type=Path, help="python of the virtual environment holding roboplan")
+    parser.add_argument(f"--{tool}-python", type=Path, help=f"python of the virtual environment holding {tool}")
     parser.add_argument("--mbm", type=Path, default=MBM, help="folder holding problems/ and panda_robot/")
     parser.add_argument("--count", type=int, default=10, help="first N problems of each scenario")
     parser.add_argument("--seeds", type=int, default=1, help="seeds 0..S-1 per problem")
     parser.add_argument("--time-limit", type=float, default=10.0, help="planning time limit per problem [s]")
     parser.add_argument("--step-mm", type=float, default=5.0, help="validity check: robot motion between states")
     parser.add_argument("--json", action="store_true", help="print one JSON document instead of the table")
-    args = parser.parse_args()
-    if args.worker:
-        worker()
-        return
-    _check_python(args.roboplan_python)
+    return parser
+
+
+def compare(args: argparse.Namespace, tool: str, python: Path, script: str,
+            job: Callable[[list[Any], Any, int, argparse.Namespace], dict[str, Any]]) -> None:
+    """Per seed in turn, run `moveplan benchmark` and `script --worker` under `python` on `job`; print the table."""
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     import pyroboplan_compare as shared  # problems, validity check and summary, shared with that comparison
 
@@ -191,38 +204,38 @@ def main() -> None:
     problems = shared.load_problems(args.mbm / "problems", args.count)
     robot = Robot(load_robot_config(args.mbm / "panda_robot"), GROUP)
     checks: dict[str, Any] = {}
-    runs: dict[str, list[dict[str, Any]]] = {"roboplan": [], "moveplan": []}
+    runs: dict[str, list[dict[str, Any]]] = {tool: [], "moveplan": []}
     for seed in range(args.seeds):
         command = shared.moveplan_command(args.mbm, args.count, 1, args.time_limit)
         command[command.index("--seeds") + 1] = str(seed)
         mine, note = shared.run_moveplan(command, {(p.name, seed) for p in problems})
         print(note, file=sys.stderr)
         runs["moveplan"] += mine
-        result = subprocess.run([str(args.roboplan_python), __file__, "--worker"], input=json.dumps(_job(
-            problems, robot, seed, args)), capture_output=True, text=True)
+        result = subprocess.run([str(python), script, "--worker"], input=json.dumps(job(problems, robot, seed, args)),
+                                capture_output=True, text=True)
         if result.returncode != 0:
             reason = (result.stderr.strip().splitlines() or ["?"])[-1]
-            sys.exit(f"roboplan_compare: roboplan could not plan these problems (exit {result.returncode}): {reason}")
+            sys.exit(f"{Path(script).stem}: {tool} could not plan these problems (exit {result.returncode}): {reason}")
         for run, problem in zip(json.loads(result.stdout), problems, strict=True):
             if problem.name not in checks:
-                checks[problem.name] = _checker(shared, robot, problem, run)
-            runs["roboplan"].append(_judge(shared, checks[problem.name], run, robot, args.step_mm / 1e3))
-    if runs["roboplan"] and not any(r["ok"] for r in runs["roboplan"]):
-        errors = {str(r.get("error")) for r in runs["roboplan"]}
-        print(f"roboplan_compare: roboplan solved none of the problems: {'; '.join(sorted(errors))}", file=sys.stderr)
+                checks[problem.name] = _checker(robot, problem, run, tool)
+            runs[tool].append(_judge(shared, checks[problem.name], run, robot, args.step_mm / 1e3))
+    if runs[tool] and not any(r["ok"] for r in runs[tool]):
+        errors = {str(r.get("error")) for r in runs[tool]}
+        print(f"{Path(script).stem}: {tool} solved none of the problems: {'; '.join(sorted(errors))}", file=sys.stderr)
     rows = []
     for scenario in (*shared.SCENARIOS, "overall"):
         row: dict[str, Any] = {"scenario": scenario}
-        for tool, tool_runs in runs.items():
+        for name, tool_runs in runs.items():
             chosen = [r for r in tool_runs if scenario == "overall" or r["problem"].startswith(f"{scenario}/")]
-            row[tool] = {**shared.summary([{"path_length": None, **r} for r in chosen]),
+            row[name] = {**shared.summary([{"path_length": None, **r} for r in chosen]),
                          **_whole([r for r in chosen if r["ok"]])}
         rows.append(row)
     if args.json:
         print(json.dumps({"problems": len(problems), "seeds": args.seeds, "summary": rows,
                           "runs": [{"tool": t, **r} for t, rs in runs.items() for r in rs]}, indent=1))
         return
-    _print(rows, args)
+    _print(rows, args, tool)
 
 
 def _check_python(python: Path | None) -> None:
@@ -234,18 +247,18 @@ def _check_python(python: Path | None) -> None:
                  "(python3.11 -m venv VENV && VENV/bin/pip install roboplan==0.7.0; see benchmarks/README.md)")
 
 
-def _checker(shared: Any, robot: Any, problem: Any, run: dict[str, Any]) -> tuple[Any, Any]:
-    """Return moveplan's exact checker of the problem and its reach; warn if roboplan's scene disagrees on it."""
+def _checker(robot: Any, problem: Any, run: dict[str, Any], tool: str) -> tuple[Any, Any]:
+    """Return moveplan's exact checker of the problem and its reach; warn if the tool's scene disagrees on it."""
     from moveplan.core.collision._certify import reach
     from moveplan.core.collision.checker import CollisionChecker
 
     checker = CollisionChecker(robot, tuple(o for _, o in problem.objects), str(problem.scene), "exact")
-    # The scene roboplan plans in must be the problem's: both checkers judge start and goal alike.
+    # The scene the tool plans in must be the problem's: both checkers judge start and goal alike.
     for state in ("start", "goal"):
         q = robot.configuration([getattr(problem, state)[j] for j in robot.joint_names])
         pair = checker.colliding_pair(q)
         if run[f"{state}_free"] != (pair is None):
-            print(f"roboplan_compare: {problem.name}: roboplan calls the {state} "
+            print(f"{tool}: {problem.name}: {tool} calls the {state} "
                   f"{'free' if run[f'{state}_free'] else 'in collision'}, moveplan "
                   f"{f'in collision ({pair[0]} - {pair[1]})' if pair else 'free'}", file=sys.stderr)
     return checker, reach(robot, checker.geometry)
@@ -271,7 +284,7 @@ def _whole(solved: list[dict[str, Any]]) -> dict[str, Any]:
             "whole_p95_s": float(np.percentile(values, 95)) if values else None}
 
 
-def _print(rows: list[dict[str, Any]], args: argparse.Namespace) -> None:
+def _print(rows: list[dict[str, Any]], args: argparse.Namespace, tool: str) -> None:
     """Print one line per scenario and tool."""
     def ms(seconds: float | None) -> str:
         return "-" if seconds is None else f"{1e3 * seconds:.1f}"
@@ -282,11 +295,11 @@ def _print(rows: list[dict[str, Any]], args: argparse.Namespace) -> None:
     print(f"{'scenario':<23}{'tool':<10}{'ok':>9}{'plan med':>10}{'plan+simpl med':>16}{'p95':>9}"
           f"{'whole med':>11}{'p95':>9}{'length':>8}{'valid':>7}")
     for row in rows:
-        for tool in ("moveplan", "roboplan"):
-            s = row[tool]
+        for name in ("moveplan", tool):
+            s = row[name]
             length = "-" if s["path_length_median"] is None else f"{s['path_length_median']:.2f}"
             solved = f"{s['ok']}/{s['runs']}"
-            print(f"{row['scenario']:<23}{tool:<10}{solved:>9}{ms(s['plan_median_s']):>10}"
+            print(f"{row['scenario']:<23}{name:<10}{solved:>9}{ms(s['plan_median_s']):>10}"
                   f"{ms(s['total_median_s']):>16}{ms(s['total_p95_s']):>9}{ms(s['whole_median_s']):>11}"
                   f"{ms(s['whole_p95_s']):>9}{length:>8}{s['valid']:>7}")
 

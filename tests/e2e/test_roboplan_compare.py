@@ -1,4 +1,4 @@
-"""benchmarks/roboplan_compare.py without roboplan: what it hands roboplan's worker, and a wrong --roboplan-python."""
+"""benchmarks/roboplan_compare.py and vamp_compare.py without their tools: what the worker gets, a wrong --X-python."""
 
 from __future__ import annotations
 
@@ -35,6 +35,16 @@ def test_a_python_without_roboplan_is_one_line_naming_the_flag(tmp_path: Path) -
     assert result.stderr.strip().splitlines() == [
         f"roboplan_compare: --roboplan-python {sys.executable}: not a python with roboplan "
         "(python3.11 -m venv VENV && VENV/bin/pip install roboplan==0.7.0; see benchmarks/README.md)"]
+    assert result.stdout == ""
+
+
+def test_a_python_without_vamp_is_one_line_naming_the_flag(tmp_path: Path) -> None:
+    result = subprocess.run([sys.executable, str(BENCHMARKS / "vamp_compare.py"), "--vamp-python",
+                             sys.executable, "--count", "1"], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 1
+    assert result.stderr.strip().splitlines() == [
+        f"vamp_compare: --vamp-python {sys.executable}: not a python with VAMP's Panda "
+        "(python3.11 -m venv VENV && VENV/bin/pip install vamp-planner==0.6.4; see benchmarks/README.md)"]
     assert result.stdout == ""
 
 
