@@ -425,7 +425,7 @@ def inspect(
 @app.command()
 def benchmark(
     problems: Annotated[list[Path], typer.Argument(
-        help="Folders of sceneNNNN.yaml/requestNNNN.yaml pairs (searched recursively), or task files.")],
+        help="Folders of sceneNNNN.yaml/requestNNNN.yaml pairs (searched recursively, links too), or task files.")],
     robot: Annotated[Path, typer.Option(help="Robot config the problems are for (as plan's --robot).")],
     planner: Annotated[list[str] | None, typer.Option(
         help="OMPL planner; repeatable or comma-separated (default: the config's).")] = None,

@@ -88,6 +88,25 @@ class Run:
         return {k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in asdict(self).items()}
 
 
+def _folders(root: Path) -> list[Path]:
+    """Return `root` and every folder below it, symbolic links followed, each real folder once."""
+    # rglob skips linked folders; a dataset is often a folder of links to scenarios kept elsewhere.
+    found, seen, stack = [], set(), [root]
+    while stack:
+        folder = stack.pop()
+        real = folder.resolve()
+        if real in seen:  # a link back up the tree, or two links to one folder
+            continue
+        seen.add(real)
+        found.append(folder)
+        try:
+            children = sorted((child for child in folder.iterdir() if child.is_dir()), reverse=True)
+        except PermissionError:  # as rglob: a folder that cannot be listed holds no problems
+            continue
+        stack.extend(children)  # popped in name order: of two links to one folder, the first name counts
+    return found
+
+
 def find_problems(paths: Sequence[Path], count: int | None = None) -> tuple[ProblemFiles, ...]:
     """Return the problems in `paths`: folders of scene/request pairs (searched recursively) or task files.
 
@@ -100,7 +119,8 @@ def find_problems(paths: Sequence[Path], count: int | None = None) -> tuple[Prob
             continue
         if not path.is_dir():
             raise ConfigError(f"{path}: no such problem folder or task file")
-        folders = sorted({p.parent for p in path.rglob("scene*.y*ml") if _PAIR.search(p.name)})
+        folders = sorted(folder for folder in _folders(path)
+                         if any(_PAIR.search(p.name) for p in folder.glob("scene*.y*ml")))
         if not folders:
             raise ConfigError(f"{path}: no sceneNNNN.yaml / requestNNNN.yaml pairs found")
         for folder in folders:

@@ -35,6 +35,19 @@ def test_problems_are_scene_request_pairs_named_by_folder_and_number(problems: P
     assert [p.name for p in find_problems([problems], count=1)] == ["box_panda/0001"]
 
 
+def test_scenario_folders_linked_into_the_problems_folder_are_found_once(problems: Path, tmp_path: Path) -> None:
+    # A dataset kept elsewhere and linked in (rglob skips links), two links to it, a link back up the tree.
+    kept = tmp_path / "kept" / "cage_panda"
+    kept.mkdir(parents=True)
+    shutil.copy(MBM / "scene0001.yaml", kept / "scene0007.yaml")
+    shutil.copy(MBM / "request0001.yaml", kept / "request0007.yaml")
+    (problems / "cage_panda").symlink_to(kept)
+    (problems / "again").symlink_to(kept)
+    (problems / "box_panda" / "up").symlink_to(problems)
+    # Of two links to one folder, the first by name counts.
+    assert [p.name for p in find_problems([problems])] == ["again/0007", "box_panda/0001", "box_panda/0002"]
+
+
 def test_benchmark_runs_every_problem_with_every_seed_and_writes_csv_and_plot(
     cli: Cli, problems: Path, tmp_path: Path
 ) -> None:
