@@ -89,10 +89,21 @@ class Problem:
     allowed: frozenset[frozenset[str]]
 
 
+def scenarios(problems: Path) -> list[str]:
+    """Return the scenario folders in `problems` holding requests: the shared set's three first, then the others."""
+    found = sorted(p.name for p in problems.iterdir() if p.is_dir() and any(p.glob("request*.yaml")))
+    return [s for s in SCENARIOS if s in found] + [s for s in found if s not in SCENARIOS]
+
+
+def scenario_names(problems: list[Problem]) -> list[str]:
+    """Return the scenarios of `problems`, in their order."""
+    return list(dict.fromkeys(p.name.split("/")[0] for p in problems))
+
+
 def load_problems(problems: Path, count: int) -> list[Problem]:
     """Return the first `count` problems of each scenario, scenario by scenario."""
     out = []
-    for scenario in SCENARIOS:
+    for scenario in scenarios(problems):
         for request_path in sorted((problems / scenario).glob("request*.yaml"))[:count]:
             number = request_path.stem.removeprefix("request")
             scene_path = request_path.with_name(f"scene{number}.yaml")
@@ -268,10 +279,10 @@ def summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
-def summaries(runs: dict[str, list[dict[str, Any]]]) -> list[dict[str, Any]]:
-    """Return per scenario and overall: each tool's summary and pyroboplan/moveplan of the median totals."""
+def summaries(runs: dict[str, list[dict[str, Any]]], names: list[str]) -> list[dict[str, Any]]:
+    """Return per scenario in `names` and overall: each tool's summary and pyroboplan/moveplan of the median totals."""
     rows = []
-    for scenario in (*SCENARIOS, "overall"):
+    for scenario in (*names, "overall"):
         row: dict[str, Any] = {"scenario": scenario}
         for tool, tool_runs in runs.items():
             chosen = [r for r in tool_runs if scenario == "overall" or r["problem"].startswith(f"{scenario}/")]
@@ -347,7 +358,7 @@ def main() -> None:
     runs = {"pyroboplan": pyroboplan_runs}
     if moveplan_runs:
         runs["moveplan"] = moveplan_runs
-    rows = summaries(runs)
+    rows = summaries(runs, scenario_names(problems))
     if args.json:
         document = {
             "problems": len(problems), "seeds": args.seeds, "time_limit_s": args.time_limit, "connect": args.connect,

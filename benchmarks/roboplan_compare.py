@@ -224,7 +224,7 @@ def compare(args: argparse.Namespace, tool: str, python: Path, script: str,
         errors = {str(r.get("error")) for r in runs[tool]}
         print(f"{Path(script).stem}: {tool} solved none of the problems: {'; '.join(sorted(errors))}", file=sys.stderr)
     rows = []
-    for scenario in (*shared.SCENARIOS, "overall"):
+    for scenario in (*shared.scenario_names(problems), "overall"):
         row: dict[str, Any] = {"scenario": scenario}
         for name, tool_runs in runs.items():
             chosen = [r for r in tool_runs if scenario == "overall" or r["problem"].startswith(f"{scenario}/")]
