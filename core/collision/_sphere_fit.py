@@ -35,9 +35,9 @@ __all__ = ["SphereSet", "fit_geometry", "fit_shape", "robot_spheres"]
 logger = logging.getLogger(__name__)
 
 _VERSION = 9  # bump when the fit changes, so cached models are rebuilt
-_EXCESS_M = 0.010  # how far a ball may reach past its shape's convex hull [m]; more when the budget binds
+_EXCESS_M = 0.015  # how far a ball may reach past its shape's convex hull [m]; more when the budget binds
 _DETAIL = 25  # a shape's excess is at least its extent over this: a big shape is fitted coarser
-_MOST = 32  # balls per link (the kernel's cost grows with them); a fit needing more is redone coarser
+_MOST = 24  # balls per link (the kernel's cost grows with them); a fit needing more is redone coarser
 _MARGIN_M = 1e-6
 _CACHE: dict[str, SphereSet] = {}
 
