@@ -119,16 +119,14 @@ def find_problems(paths: Sequence[Path], count: int | None = None) -> tuple[Prob
             continue
         if not path.is_dir():
             raise ConfigError(f"{path}: no such problem folder or task file")
-        folders = sorted(folder for folder in _folders(path)
-                         if any(_PAIR.search(p.name) for p in folder.glob("scene*.y*ml")))
+        scenes_in = {folder: [(scene, match) for scene in sorted(folder.glob("scene*.y*ml"))
+                              if (match := _PAIR.search(scene.name))] for folder in _folders(path)}
+        folders = sorted(folder for folder, scenes in scenes_in.items() if scenes)
         if not folders:
             raise ConfigError(f"{path}: no sceneNNNN.yaml / requestNNNN.yaml pairs found")
         for folder in folders:
             found = []
-            for scene in sorted(folder.glob("scene*.y*ml")):
-                match = _PAIR.search(scene.name)
-                if not match:
-                    continue
+            for scene, match in scenes_in[folder]:
                 request = folder / f"request{match.group(1)}{scene.suffix}"
                 if not request.is_file():
                     raise ConfigError(f"{scene}: no matching {request.name} beside it")
