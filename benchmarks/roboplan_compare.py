@@ -143,7 +143,7 @@ def _toppra(scene: Any, path: Any, group: str) -> float | None:
     return time.perf_counter() - mark
 
 
-def _job(problems: list[Any], robot: Any, seed: int, args: argparse.Namespace) -> dict[str, Any]:
+def job_of(problems: list[Any], robot: Any, seed: int, args: argparse.Namespace) -> dict[str, Any]:
     """Return the worker's input: the problems as plain data, the group's joints and their limits."""
     joints = list(robot.joint_names)
     out = []
@@ -175,7 +175,7 @@ def main() -> None:
         worker()
         return
     _check_python(args.roboplan_python)
-    compare(args, "roboplan", args.roboplan_python, __file__, _job)
+    compare(args, "roboplan", args.roboplan_python, __file__, job_of)
 
 
 def arguments(doc: str | None, tool: str) -> argparse.ArgumentParser:
@@ -258,7 +258,7 @@ def _checker(robot: Any, problem: Any, run: dict[str, Any], tool: str) -> tuple[
         q = robot.configuration([getattr(problem, state)[j] for j in robot.joint_names])
         pair = checker.colliding_pair(q)
         if run[f"{state}_free"] != (pair is None):
-            print(f"{tool}: {problem.name}: {tool} calls the {state} "
+            print(f"{tool}_compare: {problem.name}: {tool} calls the {state} "
                   f"{'free' if run[f'{state}_free'] else 'in collision'}, moveplan "
                   f"{f'in collision ({pair[0]} - {pair[1]})' if pair else 'free'}", file=sys.stderr)
     return checker, reach(robot, checker.geometry)

@@ -118,7 +118,7 @@ def main() -> None:
         worker()
         return
     _check_python(args.vamp_python)
-    common.compare(args, "vamp", args.vamp_python, __file__, common._job)
+    common.compare(args, "vamp", args.vamp_python, __file__, common.job_of)
 
 
 if __name__ == "__main__":

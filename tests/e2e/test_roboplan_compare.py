@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from moveplan.core.config.robot_config import load_robot_config
 from moveplan.core.model.robot import Robot
@@ -28,23 +29,15 @@ def _module(name: str):
     return module
 
 
-def test_a_python_without_roboplan_is_one_line_naming_the_flag(tmp_path: Path) -> None:
-    result = subprocess.run([sys.executable, str(BENCHMARKS / "roboplan_compare.py"), "--roboplan-python",
+@pytest.mark.parametrize(("tool", "lacking", "install"), [
+    ("roboplan", "roboplan", "roboplan==0.7.0"), ("vamp", "VAMP's Panda", "vamp-planner==0.6.4")])
+def test_a_python_without_the_tool_is_one_line_naming_the_flag(tool: str, lacking: str, install: str) -> None:
+    result = subprocess.run([sys.executable, str(BENCHMARKS / f"{tool}_compare.py"), f"--{tool}-python",
                              sys.executable, "--count", "1"], capture_output=True, text=True, timeout=120)
     assert result.returncode == 1
     assert result.stderr.strip().splitlines() == [
-        f"roboplan_compare: --roboplan-python {sys.executable}: not a python with roboplan "
-        "(python3.11 -m venv VENV && VENV/bin/pip install roboplan==0.7.0; see benchmarks/README.md)"]
-    assert result.stdout == ""
-
-
-def test_a_python_without_vamp_is_one_line_naming_the_flag(tmp_path: Path) -> None:
-    result = subprocess.run([sys.executable, str(BENCHMARKS / "vamp_compare.py"), "--vamp-python",
-                             sys.executable, "--count", "1"], capture_output=True, text=True, timeout=120)
-    assert result.returncode == 1
-    assert result.stderr.strip().splitlines() == [
-        f"vamp_compare: --vamp-python {sys.executable}: not a python with VAMP's Panda "
-        "(python3.11 -m venv VENV && VENV/bin/pip install vamp-planner==0.6.4; see benchmarks/README.md)"]
+        f"{tool}_compare: --{tool}-python {sys.executable}: not a python with {lacking} "
+        f"(python3.11 -m venv VENV && VENV/bin/pip install {install}; see benchmarks/README.md)"]
     assert result.stdout == ""
 
 
@@ -52,7 +45,7 @@ def test_the_worker_gets_the_problems_scene_group_joints_and_limits() -> None:
     compare, shared = _module("roboplan_compare"), _module("pyroboplan_compare")
     problems = shared.load_problems(MBM / "problems", 1)
     robot = Robot(load_robot_config(MBM / "panda_robot"), "panda_arm")
-    job = compare._job(problems, robot, 3, argparse.Namespace(mbm=MBM, time_limit=2.0))
+    job = compare.job_of(problems, robot, 3, argparse.Namespace(mbm=MBM, time_limit=2.0))
     assert job["seed"] == 3 and job["time_limit_s"] == 2.0 and job["group"] == "panda_arm"
     box = job["problems"][[p.name for p in problems].index("box_panda/0001")]
     assert box["joints"] == [f"panda_joint{k}" for k in range(1, 8)]
