@@ -2,11 +2,14 @@
 
 The counterpart of _ray_engine.ray_map: a worker is what `make()` builds, kept for every task
 its process takes; `run(task)` returns a task's result. Processes are spawned (no state of
-this one is inherited), so `make`, the tasks and the results must pickle.
+this one is inherited), so `make`, the tasks and the results must pickle. A worker logs at this
+process's levels, and its records are handled here, by this process's handlers: a notice of
+one-time work or a warning reads as the command's own.
 """
 
 from __future__ import annotations
 
+import logging
 import multiprocessing
 import queue as queue_module
 import traceback
@@ -28,7 +31,7 @@ def process_map(make: Callable[[], Any], tasks: Sequence[Any], jobs: int, arrive
     queued, results = context.Queue(), context.Queue()
     for task in tasks:
         queued.put(task)
-    workers = [context.Process(target=_serve, args=(make, queued, results), daemon=True)
+    workers = [context.Process(target=_serve, args=(make, queued, results, _levels()), daemon=True)
                for _ in range(max(1, min(jobs, len(tasks))))]
     for _ in workers:
         queued.put(None)  # one stop sign each, behind the work
@@ -46,6 +49,8 @@ def process_map(make: Callable[[], Any], tasks: Sequence[Any], jobs: int, arrive
                 continue
             if kind == "result":
                 arrived(payload)
+            elif kind == "log":
+                logging.getLogger(payload.name).handle(payload)
             elif kind == "done":
                 done += 1
             else:
@@ -65,8 +70,32 @@ def _rebuilt(payload: dict[str, Any]) -> Exception:
     return RuntimeError(f"worker process failed: {payload['message']}\n{payload['traceback']}")
 
 
-def _serve(make: Callable[[], Any], queued: Any, results: Any) -> None:
-    """Build the worker, run tasks from `queued` until a stop sign, putting each result on `results`."""
+def _levels() -> dict[str, int]:
+    """Return the logging levels set in this process: the root logger's (under "") and each other logger's set one."""
+    loggers = logging.Logger.manager.loggerDict.items()
+    return {"": logging.getLogger().level,
+            **{name: logger.level for name, logger in loggers if isinstance(logger, logging.Logger) and logger.level}}
+
+
+class _Forward(logging.Handler):
+    """Puts each record on the results queue, for the parent to handle."""
+
+    def __init__(self, results: Any) -> None:
+        """Forward to `results`."""
+        super().__init__()
+        self.results = results
+
+    def emit(self, record: logging.LogRecord) -> None:
+        """Put `record` on the queue, its message formatted and its arguments dropped (they may not pickle)."""
+        record.msg, record.args, record.exc_info, record.exc_text = record.getMessage(), None, None, None
+        self.results.put(("log", record))
+
+
+def _serve(make: Callable[[], Any], queued: Any, results: Any, levels: dict[str, int]) -> None:
+    """Build the worker, run tasks from `queued` until a stop sign, putting each result and log record on `results`."""
+    for name, level in levels.items():
+        logging.getLogger(name or None).setLevel(level)
+    logging.getLogger().addHandler(_Forward(results))
     try:
         worker = make()
         while (task := queued.get()) is not None:

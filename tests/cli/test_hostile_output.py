@@ -423,19 +423,29 @@ def test_partial_files_left_by_killed_runs_are_swept_when_the_entry_is_written(t
     assert sorted(p.name for p in tmp_path.iterdir()) == ["entry.pickle", young.name]
 
 
-# Plans enough states that the sphere filter is built, so that the cache is used (core/pipeline/_checks.py).
-CACHE_PLAN = (SAMPLES / "panda_shelf_bays.yaml", "--seed", "0")
+# The shelf sample planned with the sphere filter built at once, as `moveplan benchmark` builds it, so that the
+# cache is used: a one-shot `moveplan plan` builds it only past FILTER_AFTER_STATES (core/pipeline/_checks.py).
+FILTERED_PLAN = ("import sys\nfrom pathlib import Path\nfrom moveplan.cli.options import setup_logging\n"
+                 "from moveplan.core.bag import write_plan\nfrom moveplan.core.config.tasks import load_task\n"
+                 "from moveplan.core.pipeline.plan import PlanFlags, plan, resolve_request\n"
+                 "setup_logging(False, False)\n"
+                 "request = resolve_request(load_task(Path(sys.argv[1])), PlanFlags(seed=0))\n"
+                 "write_plan(Path(sys.argv[2]), plan(request, filter_after=0))\n")
+CACHE_BENCHMARK = ("benchmark", ROOT / "tests" / "data" / "mbm" / "problems" / "box_panda", "--robot",
+                   ROOT / "tests" / "data" / "mbm" / "panda_robot", "--count", "1")
 
 
-def _plan_process(out: Path, cache: Path, limit: int | None = None, args: tuple[Any, ...] = QUICK_PLAN
-                  ) -> subprocess.Popen[str]:
+def _plan_process(out: Path, cache: Path, limit: int | None = None, args: tuple[Any, ...] = QUICK_PLAN,
+                  filtered: bool = False) -> subprocess.Popen[str]:
+    """Return a running `moveplan plan` of `args` to `out` (`filtered`: FILTERED_PLAN), caching in `cache`."""
     def limited() -> None:
         if limit is not None:  # a full disk: writing past `limit` bytes fails with EFBIG (Python ignores SIGXFSZ)
             resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 
-    return subprocess.Popen([sys.executable, "-m", "moveplan.cli.app", "plan", *map(str, args), "-o", out],
-                            env={**os.environ, "MOVEPLAN_CACHE_DIR": str(cache)}, preexec_fn=limited,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    command = (["-c", FILTERED_PLAN, str(SAMPLES / "panda_shelf_bays.yaml"), str(out)] if filtered else
+               ["-m", "moveplan.cli.app", "plan", *map(str, args), "-o", str(out)])
+    return subprocess.Popen([sys.executable, *command], env={**os.environ, "MOVEPLAN_CACHE_DIR": str(cache)},
+                            preexec_fn=limited, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
 def test_a_full_disk_fails_the_plan_as_bad_input_and_leaves_no_partial_files(tmp_path: Path) -> None:
@@ -450,7 +460,7 @@ def test_a_full_disk_fails_the_plan_as_bad_input_and_leaves_no_partial_files(tmp
 
 def test_concurrent_cold_cache_runs_agree_byte_for_byte_with_warm_and_repaired_caches(tmp_path: Path) -> None:
     cache = tmp_path / "cache"
-    runs = [_plan_process(tmp_path / f"cold{i}.mcap", cache, args=CACHE_PLAN) for i in range(3)]
+    runs = [_plan_process(tmp_path / f"cold{i}.mcap", cache, filtered=True) for i in range(3)]
     for process in runs:
         _, stderr = process.communicate(timeout=300)
         assert process.returncode == 0, stderr
@@ -462,11 +472,11 @@ def test_concurrent_cold_cache_runs_agree_byte_for_byte_with_warm_and_repaired_c
         data = bytearray(entry.read_bytes())
         data[len(data) // 2] ^= 0x10
         entry.write_bytes(bytes(data))
-    repaired = _plan_process(tmp_path / "repaired.mcap", cache, args=CACHE_PLAN)
+    repaired = _plan_process(tmp_path / "repaired.mcap", cache, filtered=True)
     _, stderr = repaired.communicate(timeout=300)
     assert repaired.returncode == 0, stderr
     assert stderr.count("cannot be used (checksum mismatch") == len(entries), stderr
-    warm = _plan_process(tmp_path / "warm.mcap", cache, args=CACHE_PLAN)
+    warm = _plan_process(tmp_path / "warm.mcap", cache, filtered=True)
     _, stderr = warm.communicate(timeout=300)
     assert warm.returncode == 0 and "WARNING" not in stderr, stderr
     reference = (tmp_path / "cold0.mcap").read_bytes()
@@ -477,13 +487,13 @@ def test_concurrent_cold_cache_runs_agree_byte_for_byte_with_warm_and_repaired_c
 def test_json_stays_clean_when_the_cache_warns(tmp_path: Path) -> None:
     cache = tmp_path / "cache"
     cache.mkdir()
-    first = _plan_process(tmp_path / "a.mcap", cache, args=CACHE_PLAN)
-    assert first.communicate(timeout=300) and first.returncode == 0
+    command = [sys.executable, "-m", "moveplan.cli.app", *map(str, CACHE_BENCHMARK)]
+    env = {**os.environ, "MOVEPLAN_CACHE_DIR": str(cache)}
+    subprocess.run([*command, "-q"], env=env, check=True, capture_output=True, timeout=300)
+    assert list(cache.iterdir())
     for entry in cache.iterdir():
         entry.write_bytes(b"garbage")
-    result = subprocess.run(
-        [sys.executable, "-m", "moveplan.cli.app", "plan", *map(str, CACHE_PLAN), "-o", tmp_path / "b.mcap", "--json"],
-        env={**os.environ, "MOVEPLAN_CACHE_DIR": str(cache)}, capture_output=True, text=True, timeout=300)
+    result = subprocess.run([*command, "--json"], env=env, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
     assert json.loads(result.stdout)["ok"] is True
     assert "WARNING" in result.stderr
