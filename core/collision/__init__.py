@@ -7,7 +7,7 @@ from .._faces import lazy_exports
 if TYPE_CHECKING:
     from ._verdicts import MAYBE
     from .checker import CollisionChecker, GeometryMode
-    from .compiled import add_setup_time, kernels_loaded, kernels_ready, setup_time_spent
+    from .compiled import add_setup_time, count_unfiltered, kernels_loaded, kernels_ready, setup_time_spent
     from .mesh_arrays import inline_mesh
     from .motion import MotionChecker, build_sphere_filter, exact_checks, scene_checkers
     from .sphere_filter import SphereFilter
@@ -20,6 +20,7 @@ __all__ = [
     "SphereFilter",
     "add_setup_time",
     "build_sphere_filter",
+    "count_unfiltered",
     "exact_checks",
     "inline_mesh",
     "kernels_loaded",
@@ -36,6 +37,7 @@ __getattr__ = lazy_exports(__name__, {
     "SphereFilter": "sphere_filter",
     "add_setup_time": "compiled",
     "build_sphere_filter": "motion",
+    "count_unfiltered": "compiled",
     "exact_checks": "motion",
     "inline_mesh": "mesh_arrays",
     "kernels_loaded": "compiled",

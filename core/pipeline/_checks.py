@@ -1,12 +1,14 @@
 """A problem's collision checks, built once per robot and scene; the sphere filter only once it pays for itself.
 
 The sphere filter (core/collision/sphere_filter.py) clears a state in microseconds, but building
-it imports numba and loads its compiled kernels: 0.5-1.5 s on a warm machine, and a compilation
-of tens of seconds on a fresh one. A plan of a few steps checks a few thousand states, which the
-robot's convex hulls judge in ~14 us each: tens of milliseconds. So a one-shot command starts
-with coal alone and builds the filter once the states asked about pass `after` (a rent-or-buy
-rule: by then the hull checks have cost about what the filter's set-up does). Where numba has
-not compiled the kernels yet (a fresh install), the set-up costs a compilation, so the rule waits
+it imports numba and loads its compiled kernels: ~0.5 s in a fresh process, and a compilation of
+tens of seconds on a fresh install. A plan of a few steps asks about a few thousand states, which
+coal alone judges 3-4 us slower each than the filter does: tens of milliseconds. So a one-shot
+command starts with coal alone and builds the filter once the states it has asked about pass
+`after` (all its problems' together: a script's plans in changing scenes too). The rule is rent
+or buy: by then coal alone has spent about as much more than the filter would have as building
+the filter costs (benchmarks/filter_threshold.py measures both). Where numba has not
+compiled the kernels yet (a fresh install), the build costs a compilation, so the rule waits
 correspondingly longer: a first plan on a fresh machine costs what it costs warm unless it is
 one that would pay for the compilation anyway. A build inside a step is kept off the search's
 planning-time cap (core/collision/compiled.py). A process that has built one filter has the
@@ -34,6 +36,7 @@ from ..collision import (
     SphereFilter,
     add_setup_time,
     build_sphere_filter,
+    count_unfiltered,
     kernels_loaded,
     kernels_ready,
     scene_checkers,
@@ -45,10 +48,11 @@ __all__ = ["FILTER_AFTER_STATES", "FILTER_AFTER_STATES_UNCOMPILED", "Problem", "
 
 logger = logging.getLogger(__name__)
 
-FILTER_AFTER_STATES = 20_000
-"""States a one-shot command checks with coal alone before it builds the sphere filter (~0.3 s of hull checks)."""
-FILTER_AFTER_STATES_UNCOMPILED = 1_000_000
-"""The same when numba has yet to compile the kernels: ~15 s of hull checks, what the compilation costs."""
+FILTER_AFTER_STATES = 150_000
+"""States a one-shot command checks with coal alone before it builds the sphere filter: the build's ~0.5 s
+over the 3-3.8 us a state costs more without it (benchmarks/filter_threshold.py, MotionBenchMaker's Panda)."""
+FILTER_AFTER_STATES_UNCOMPILED = 6_000_000
+"""The same when numba has yet to compile the kernels: the compilation's ~20 s over the same 3-3.8 us."""
 
 
 def filter_threshold() -> int:
@@ -114,7 +118,8 @@ class OnDemandSpheres:
     ) -> None:
         """Answer for `robot` (joints outside the group at `base`); past `after` states, `build` and hand to `built`."""
         self._robot, self._base, self._build, self._built = robot, base, build, built
-        self._after = self._left = after
+        self._after = after
+        self.asked = 0  # states asked about before the filter was built: benchmarks/filter_threshold.py reads it
         self._filter: SphereFilter | None = None
         self._pending = True
 
@@ -146,20 +151,22 @@ class OnDemandSpheres:
         return (np.full(len(states), MAYBE, dtype=np.int8), self._robot.configurations(states, self._base).T,
                 np.zeros(len(states)))
 
-    def settle(self) -> None:
-        """Build the filter now if enough states were asked about, its time kept off any search's cap."""
-        if self._pending and self._left < 0:
-            self._pending = False
-            logger.debug("building the sphere filter after %d states checked by coal alone", self._after)
-            began = time.perf_counter()
-            self._filter = self._build()
-            add_setup_time(time.perf_counter() - began)
-            self._built(self._filter)
-
     def _spheres(self, count: int) -> SphereFilter | None:
-        """Return the filter once built, else None; count the states asked about until then, then build it."""
+        """Return the filter once built, else None; count the states asked about, and build it once they are enough.
+
+        Enough is more than `after` states judged without a filter in this process, in any problem.
+        """
         if self._pending:
-            self._left -= count
-            self.settle()
+            self.asked += count
+            if count_unfiltered(count) > self._after:
+                self._settle()
         return self._filter
 
+    def _settle(self) -> None:
+        """Build the filter now, its time kept off any search's cap; return None."""
+        self._pending = False
+        logger.debug("building the sphere filter after %d states checked by coal alone", self._after)
+        began = time.perf_counter()
+        self._filter = self._build()
+        add_setup_time(time.perf_counter() - began)
+        self._built(self._filter)

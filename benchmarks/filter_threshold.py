@@ -1,0 +1,109 @@
+"""What sets how long a one-shot `moveplan plan` checks with coal alone before it builds the sphere filter.
+
+Run from the repository root with moveplan installed:
+    python benchmarks/filter_threshold.py [--mbm DIR] [--count 3] [--fresh 5] [--compile]
+The rule (core/pipeline/_checks.py) is rent or buy: build the filter once the states asked about
+have cost, checked by coal alone, what building it costs. Printed:
+(a) building it in a fresh process: numba's import, its kernels loaded from its cache, the filter
+    made, and the kernels' first calls (a plan with the filter, less the same plan again), median
+    of --fresh processes; with --compile also into an empty numba cache (the compilation);
+(b) per MotionBenchMaker problem (the first --count of each scenario: the repository's, or --mbm a
+    folder with more), the step with coal alone and with the filter, each in a process of its own
+    and the best of two, over the states the step asks about: what a state costs more without the
+    filter; medians per scenario and overall;
+(c) the thresholds (a) / median (b): FILTER_AFTER_STATES and FILTER_AFTER_STATES_UNCOMPILED.
+Machines are shared and noisy: compare ratios and medians.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+from moveplan.core.config import MotionSettings
+from moveplan.core.pipeline import _checks, benchmark
+from moveplan.core.pipeline import plan as pipeline
+
+ROOT = Path(__file__).resolve().parents[1]
+NEVER = 10**15  # states: the filter is never built
+
+
+def main() -> None:
+    """Print the figures."""
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--mbm", type=Path, default=ROOT / "tests" / "data" / "mbm" / "problems",
+                        help="folder of MotionBenchMaker problems, with panda_robot beside it or in its parent")
+    parser.add_argument("--count", type=int, default=3, help="problems per scenario")
+    parser.add_argument("--fresh", type=int, default=5, help="fresh processes timing the build")
+    parser.add_argument("--compile", action="store_true", help="also time numba's compilation into an empty cache")
+    parser.add_argument("--worker", choices=("coal", "filter", "build"), help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    robot = next(p for p in (args.mbm / "panda_robot", args.mbm.parent / "panda_robot") if p.is_dir())
+    problems = benchmark.find_problems([args.mbm], args.count)
+    if args.worker:
+        print(json.dumps(_work(args.worker, robot, problems)))
+        return
+    build = statistics.median(_worker("build", args)[0][0] for _ in range(args.fresh))
+    coal, filtered = _worker("coal", args), _worker("filter", args)
+    extra: dict[str, list[float]] = {}
+    for problem, (coal_s, asked), (filter_s, _) in zip(problems, coal, filtered, strict=True):
+        extra.setdefault(problem.scenario, []).append((coal_s - filter_s) / asked)
+        print(f"  {problem.name}: {asked} states, coal alone {1e3 * coal_s:.1f} ms, "
+              f"with the filter {1e3 * filter_s:.1f} ms")
+    for scenario, values in extra.items():
+        print(f"  {scenario}: {1e6 * statistics.median(values):.2f} us a state more with coal alone (median)")
+    rent = statistics.median(value for values in extra.values() for value in values)
+    print(f"(a) the filter's build in a fresh process: median {1e3 * build:.0f} ms of {args.fresh}")
+    print(f"(b) a state checked with coal alone: {1e6 * rent:.2f} us more than with the filter (median of "
+          f"{len(problems)} problems)")
+    print(f"(c) FILTER_AFTER_STATES: {build / rent:,.0f} states (now {_checks.FILTER_AFTER_STATES:,})")
+    if args.compile:
+        with tempfile.TemporaryDirectory() as cache:
+            compiled = _worker("build", args, {"NUMBA_CACHE_DIR": cache})[0][0]
+        print(f"    compiled into an empty cache: {compiled:.1f} s; FILTER_AFTER_STATES_UNCOMPILED: "
+              f"{compiled / rent:,.0f} states (now {_checks.FILTER_AFTER_STATES_UNCOMPILED:,})")
+
+
+def _worker(kind: str, args: argparse.Namespace, env: dict[str, str] | None = None) -> Any:
+    """Return what a fresh process of this script measures as `kind`."""
+    command = [sys.executable, __file__, "--worker", kind, "--mbm", str(args.mbm), "--count", str(args.count)]
+    result = subprocess.run(command, capture_output=True, text=True, check=True, env={**os.environ, **(env or {})})
+    return json.loads(result.stdout)
+
+
+def _work(kind: str, robot: Path, problems: tuple[benchmark.ProblemFiles, ...]) -> list[tuple[float, int]]:
+    """Return per problem the best of two steps' planning time [s] and the states asked, with `kind`'s checks.
+
+    `build`: one pair, the build's cost [s] (the first problem planned with the filter, first in
+    the process after a plan with coal alone, less the same plan again) and no states.
+    """
+    if kind == "build":
+        _planned(robot, problems[0], NEVER)
+        return [(_planned(robot, problems[0], 0)[0] - _planned(robot, problems[0], 0)[0], 0)]
+    after = NEVER if kind == "coal" else 0
+    return [min(_planned(robot, problem, after)[1:], _planned(robot, problem, after)[1:]) for problem in problems]
+
+
+def _planned(robot: Path, problem: benchmark.ProblemFiles, after: int) -> tuple[float, float, int]:
+    """Return a plan's wall time [s], its steps' planning time [s] and the states asked, the filter after `after`."""
+    flags = pipeline.PlanFlags(robot=robot, scene=problem.scene, request=problem.request, seed=0,
+                               motion=MotionSettings(planner="RRTConnect", planning_time=1.0))
+    request = pipeline.resolve_request(None, flags)
+    began = time.perf_counter()
+    plan, problem_in = pipeline.planned(request, filter_after=after)
+    wall = time.perf_counter() - began
+    spheres = problem_in.checks.spheres
+    asked = spheres.asked if isinstance(spheres, _checks.OnDemandSpheres) else 0
+    return wall, sum(step.planning_time_s for step in plan.steps), asked
+
+
+if __name__ == "__main__":
+    main()
