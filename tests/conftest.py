@@ -106,6 +106,17 @@ def cli() -> Cli:
     return Cli()
 
 
+FILTERED_PLAN = ("import sys\nfrom pathlib import Path\nfrom moveplan.cli.options import setup_logging\n"
+                 "from moveplan.core.bag import write_plan\nfrom moveplan.core.config.tasks import load_task\n"
+                 "from moveplan.core.pipeline.plan import PlanFlags, plan, resolve_request\n"
+                 "setup_logging(False, False)\n"
+                 "request = resolve_request(load_task(Path(sys.argv[1])), PlanFlags(seed=0))\n"
+                 "write_plan(Path(sys.argv[2]), plan(request, filter_after=0))\n")
+"""Code for `python -c`: plan the task file argv[1] (seed 0) into argv[2], logging as `moveplan plan` does, with the
+sphere filter built at once, as `moveplan benchmark` builds it, so that its caches are used: a one-shot plan builds it
+only past FILTER_AFTER_STATES (core/pipeline/_checks.py)."""
+
+
 def run_process(*args: Any) -> subprocess.CompletedProcess[str]:
     """Run moveplan as its own process, as a user's shell would."""
     return subprocess.run([sys.executable, "-m", "moveplan.cli.app", *map(str, args)],

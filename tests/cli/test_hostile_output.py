@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import ROOT, SAMPLES, UR10E, Cli
+from conftest import FILTERED_PLAN, ROOT, SAMPLES, UR10E, Cli
 
 from moveplan.cli.errors import PIPE_CLOSED
 from moveplan.core.bag.container.writer import atomic_file
@@ -423,14 +423,7 @@ def test_partial_files_left_by_killed_runs_are_swept_when_the_entry_is_written(t
     assert sorted(p.name for p in tmp_path.iterdir()) == ["entry.pickle", young.name]
 
 
-# The shelf sample planned with the sphere filter built at once, as `moveplan benchmark` builds it, so that the
-# cache is used: a one-shot `moveplan plan` builds it only past FILTER_AFTER_STATES (core/pipeline/_checks.py).
-FILTERED_PLAN = ("import sys\nfrom pathlib import Path\nfrom moveplan.cli.options import setup_logging\n"
-                 "from moveplan.core.bag import write_plan\nfrom moveplan.core.config.tasks import load_task\n"
-                 "from moveplan.core.pipeline.plan import PlanFlags, plan, resolve_request\n"
-                 "setup_logging(False, False)\n"
-                 "request = resolve_request(load_task(Path(sys.argv[1])), PlanFlags(seed=0))\n"
-                 "write_plan(Path(sys.argv[2]), plan(request, filter_after=0))\n")
+# `moveplan benchmark` builds the sphere filter at once, so it reads and writes the cache (FILTERED_PLAN too).
 CACHE_BENCHMARK = ("benchmark", ROOT / "tests" / "data" / "mbm" / "problems" / "box_panda", "--robot",
                    ROOT / "tests" / "data" / "mbm" / "panda_robot", "--count", "1")
 

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from conftest import SAMPLES, UR10E, Cli
+from conftest import FILTERED_PLAN, SAMPLES, UR10E, Cli
 from mcap.reader import make_reader
 from mcap.writer import Writer
 
@@ -445,12 +445,11 @@ def test_cache_entry_of_an_unknown_type_is_not_written(tmp_path: Path) -> None:
 
 def test_planted_cache_entries_run_nothing_when_planning(tmp_path: Path) -> None:
     cache, marker = tmp_path / "cache", tmp_path / "ran"
-    task = (SAMPLES / "panda_shelf_bays.yaml", "--seed", "0")  # enough states to build the sphere filter
     env = {**os.environ, "MOVEPLAN_CACHE_DIR": str(cache)}
 
     def plan(out: str) -> subprocess.CompletedProcess[str]:
-        return subprocess.run([sys.executable, "-m", "moveplan.cli.app", "plan", *map(str, task), "-o",
-                               tmp_path / out], env=env, capture_output=True, text=True, timeout=300)
+        return subprocess.run([sys.executable, "-c", FILTERED_PLAN, SAMPLES / "panda_shelf_bays.yaml", tmp_path / out],
+                              env=env, capture_output=True, text=True, timeout=300)
 
     assert plan("first.mcap").returncode == 0
     entries = sorted(cache.iterdir())
