@@ -10,6 +10,7 @@ one-time work or a warning reads as the command's own.
 from __future__ import annotations
 
 import logging
+import logging.handlers
 import multiprocessing
 import queue as queue_module
 import traceback
@@ -77,18 +78,12 @@ def _levels() -> dict[str, int]:
             **{name: logger.level for name, logger in loggers if isinstance(logger, logging.Logger) and logger.level}}
 
 
-class _Forward(logging.Handler):
-    """Puts each record on the results queue, for the parent to handle."""
+class _Forward(logging.handlers.QueueHandler):
+    """Puts each record on the results queue for the parent to handle, its message formatted (QueueHandler's)."""
 
-    def __init__(self, results: Any) -> None:
-        """Forward to `results`."""
-        super().__init__()
-        self.results = results
-
-    def emit(self, record: logging.LogRecord) -> None:
-        """Put `record` on the queue, its message formatted and its arguments dropped (they may not pickle)."""
-        record.msg, record.args, record.exc_info, record.exc_text = record.getMessage(), None, None, None
-        self.results.put(("log", record))
+    def enqueue(self, record: logging.LogRecord) -> None:
+        """Put `record` on the queue as a ("log", record) result."""
+        self.queue.put_nowait(("log", record))
 
 
 def _serve(make: Callable[[], Any], queued: Any, results: Any, levels: dict[str, int]) -> None:
