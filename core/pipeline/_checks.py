@@ -86,7 +86,8 @@ def build_problem(
 ) -> Problem:
     """Return the problem of `robot` (other joints at `base`) in `scene`; the sphere filter comes after `after` states.
 
-    With `after` 0 the filter is built now, as a benchmark wants (its set-up outside the timed steps).
+    The states are those this process has had judged without a filter, in any problem. With
+    `after` 0 the filter is built now, as a benchmark wants (its set-up outside the timed steps).
     """
     return Problem(robot, scene, _checks(robot, scene, geometry, base, after))
 

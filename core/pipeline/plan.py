@@ -99,7 +99,7 @@ def plan(request: PlanRequest, config: RobotConfig | None = None, filter_after: 
     `config` is the loaded `request.robot` when the caller has it (a benchmark plans many
     problems with one robot); a config loaded here also warns about the group's joints that
     plan with the default acceleration limit (limits.DEFAULT_ACCELERATION). The sphere filter
-    is built after `filter_after` checked states (core/pipeline/_checks.py): 0, now.
+    is built after `filter_after` states checked without it in this process (core/pipeline/_checks.py): 0, now.
 
     Raises:
         MoveplanError: Any error while planning a step carries the step's name (`step`), and
