@@ -28,6 +28,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from moveplan.core.collision import count_unfiltered
 from moveplan.core.config import MotionSettings
 from moveplan.core.pipeline import _checks, benchmark
 from moveplan.core.pipeline import plan as pipeline
@@ -51,7 +52,7 @@ def main() -> None:
     if args.worker:
         print(json.dumps(_work(args.worker, robot, problems)))
         return
-    build = statistics.median(_worker("build", args)[0][0] for _ in range(args.fresh))
+    build = statistics.median(_worker("build", args) for _ in range(args.fresh))
     coal, filtered = _worker("coal", args), _worker("filter", args)
     extra: dict[str, list[float]] = {}
     ratios = []
@@ -70,7 +71,7 @@ def main() -> None:
     print(f"(c) FILTER_AFTER_STATES: {build / rent:,.0f} states (now {_checks.FILTER_AFTER_STATES:,})")
     if args.compile:
         with tempfile.TemporaryDirectory() as cache:
-            compiled = _worker("build", args, {"NUMBA_CACHE_DIR": cache})[0][0]
+            compiled = _worker("build", args, {"NUMBA_CACHE_DIR": cache})
         print(f"    compiled into an empty cache: {compiled:.1f} s; FILTER_AFTER_STATES_UNCOMPILED: "
               f"{compiled / rent:,.0f} states (now {_checks.FILTER_AFTER_STATES_UNCOMPILED:,})")
 
@@ -82,15 +83,15 @@ def _worker(kind: str, args: argparse.Namespace, env: dict[str, str] | None = No
     return json.loads(result.stdout)
 
 
-def _work(kind: str, robot: Path, problems: tuple[benchmark.ProblemFiles, ...]) -> list[tuple[float, int]]:
+def _work(kind: str, robot: Path, problems: tuple[benchmark.ProblemFiles, ...]) -> Any:
     """Return per problem the best of two steps' planning time [s] and the states asked, with `kind`'s checks.
 
-    `build`: one pair, the build's cost [s] (the first problem planned with the filter, first in
-    the process after a plan with coal alone, less the same plan again) and no states.
+    `build`: the build's cost [s] alone (the first problem planned with the filter, first in the
+    process after a plan with coal alone, less the same plan again).
     """
     if kind == "build":
         _planned(robot, problems[0], NEVER)
-        return [(_planned(robot, problems[0], 0)[0] - _planned(robot, problems[0], 0)[0], 0)]
+        return _planned(robot, problems[0], 0)[0] - _planned(robot, problems[0], 0)[0]
     after = NEVER if kind == "coal" else 0
     return [min(_planned(robot, problem, after)[1:], _planned(robot, problem, after)[1:]) for problem in problems]
 
@@ -100,12 +101,10 @@ def _planned(robot: Path, problem: benchmark.ProblemFiles, after: int) -> tuple[
     flags = pipeline.PlanFlags(robot=robot, scene=problem.scene, request=problem.request, seed=0,
                                motion=MotionSettings(planner="RRTConnect", planning_time=1.0))
     request = pipeline.resolve_request(None, flags)
-    began = time.perf_counter()
-    plan, problem_in = pipeline.planned(request, filter_after=after)
+    unfiltered, began = count_unfiltered(0), time.perf_counter()
+    plan = pipeline.plan(request, filter_after=after)
     wall = time.perf_counter() - began
-    spheres = problem_in.checks.spheres
-    asked = spheres.asked if isinstance(spheres, _checks.OnDemandSpheres) else 0
-    return wall, sum(step.planning_time_s for step in plan.steps), asked
+    return wall, sum(step.planning_time_s for step in plan.steps), count_unfiltered(0) - unfiltered
 
 
 if __name__ == "__main__":

@@ -120,7 +120,6 @@ class OnDemandSpheres:
         """Answer for `robot` (joints outside the group at `base`); past `after` states, `build` and hand to `built`."""
         self._robot, self._base, self._build, self._built = robot, base, build, built
         self._after = after
-        self.asked = 0  # states asked about before the filter was built: benchmarks/filter_threshold.py reads it
         self._filter: SphereFilter | None = None
         self._pending = True
 
@@ -157,10 +156,8 @@ class OnDemandSpheres:
 
         Enough is more than `after` states judged without a filter in this process, in any problem.
         """
-        if self._pending:
-            self.asked += count
-            if count_unfiltered(count) > self._after:
-                self._settle()
+        if self._pending and count_unfiltered(count) > self._after:
+            self._settle()
         return self._filter
 
     def _settle(self) -> None:
