@@ -6,7 +6,9 @@ Each problem is solved as `moveplan benchmark` solves it (one warm process, the 
 once, the plan written to a file), with the pipeline's phases timed where they are called: reading
 the request, the robot's group, the scene, setting up the collision checks, the step (its
 planning_time_s), assembling the plan (its /tf samples apart), /tf, writing the file. Prints the
-median of each phase and of the whole call, and the whole call over the step. With --one-shot N,
+median of each phase and of the whole call, and the whole call over the step; the step's own parts
+(search, simplify, timing, certification) as medians, and certification's share of all the steps'
+time with its tail: a path that grazes an obstacle for long takes many exact checks to certify. With --one-shot N,
 also the first N problems planned by a fresh `moveplan plan` process each, whose step starts
 without the sphere filter (its planning_time_s against the warm one's). Machines are shared and
 noisy: compare ratios and medians.
@@ -33,6 +35,7 @@ from moveplan.core.pipeline import plan as pipeline
 
 ROOT = Path(__file__).resolve().parents[1]
 PHASES = ("request", "robot", "scene", "checks", "step", "assemble", "tf", "write")
+STEP_PARTS = ("search", "simplify", "timing", "certify")  # the step's parts, as `moveplan benchmark` reports them
 _TIMED = {"request": (pipeline, "resolve_request"), "robot": (pipeline, "_robot"), "scene": (pipeline, "load_scene"),
           "checks": (pipeline, "build_problem"), "assemble": (pipeline, "assemble"), "tf": (pipeline, "_tf_samples"),
           "write": (bag, "write_plan")}
@@ -77,13 +80,21 @@ def main() -> None:
                 run = benchmark._solve(problem, config, "RRTConnect", seed, (1.0, None), False, output)
                 if run.ok:
                     rows.append({**spent, "step": run.planning_time_s, "whole": run.whole_call_s,
+                                 **{part: getattr(run, f"{part}_s") for part in STEP_PARTS},
                                  "assemble": spent["assemble"] - spent["tf"]})
         print(f"{len(rows)} solved runs of {len(problems)} problems x {args.seeds} seeds ({robot}); median ms:")
         for phase in (*PHASES, "whole"):
             print(f"  {phase:9s} {1e3 * statistics.median(r.get(phase, 0.0) for r in rows):7.2f}")
+            if phase == "step":
+                for part in STEP_PARTS:
+                    print(f"    {part:9s} {1e3 * statistics.median(r[part] for r in rows):7.2f}")
         fixed = [r["whole"] - r["step"] for r in rows]
         print(f"  whole call / step: median {statistics.median(r['whole'] / r['step'] for r in rows):.2f}; "
               f"fixed work (whole - step) median {1e3 * statistics.median(fixed):.2f} ms")
+        certify = sorted(r["certify"] for r in rows)
+        tail = ", ".join(f"p{q} {1e3 * certify[min(len(certify) - 1, len(certify) * q // 100)]:.1f}" for q in (90, 99))
+        print(f"  certification: {sum(certify) / sum(r['step'] for r in rows):.0%} of all the steps' time; "
+              f"{tail}, max {1e3 * certify[-1]:.1f} ms")
         if args.one_shot:
             _one_shot(problems[: args.one_shot], robot, config, output)
 
