@@ -3,7 +3,7 @@
 Up to three geometries answer, cheapest first. A sphere model (core/collision/sphere_filter.py)
 clears most states in microseconds; what it cannot clear goes to coal with the robot's
 meshes as convex hulls (~14 us a state), and what those cannot clear to coal with the
-real collision geometry (~55 us). The spheres enclose the hulls' meshes and the hulls
+real collision geometry (~55 us). The spheres enclose the hulls and the hulls
 enclose the meshes, so a state an earlier stage clears is free, and every answer is the
 real geometry's answer. The search may stop at the hulls (`conservative`): it then
 loses only the little space between a mesh and its hull.

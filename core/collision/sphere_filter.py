@@ -6,10 +6,12 @@ of the joint tree, then per owner (link or attached object) its bounding ball fi
 its spheres only if that ball touches something. Link pairs whose distance depends on
 one or two joints are looked up in distance tables instead (core/collision/_pair_tables.py). A
 state is "clear" only if no sphere touches an obstacle or another owner's sphere and
-every tabulated pair is apart; since the spheres enclose the real geometry
-(core/collision/_sphere_fit.py), a clear state is collision-free. A state where a ball inside a
-convex hull touches an obstacle or another link's inner ball, or a table says a pair
-overlaps, surely collides under the hulls. Anything else is "maybe": the caller asks coal.
+every tabulated pair is apart; since the spheres enclose the robot's convex hulls
+(core/collision/_sphere_fit.py), which enclose its meshes, a clear state is free under the hulls:
+the search, which stops at the hulls, gets the same answer with the spheres as without them. A
+state where a ball inside a convex hull touches an obstacle or another link's inner ball, or a
+table says a pair overlaps, surely collides under the hulls. Anything else is "maybe": the
+caller asks coal.
 """
 
 from __future__ import annotations
@@ -72,7 +74,7 @@ class SphereFilter:
         hulls: pin.GeometryModel | None = None,
         shapes: Mapping[str, coal.CollisionGeometry] | None = None,
     ) -> None:
-        """Fit spheres to `robot` (its `geometry`), add attached objects, and list what to check.
+        """Fit spheres to `robot` (its `hulls`, else `geometry`), add attached objects, and list what to check.
 
         States are the group's joint values; the other joints stay at `base` (default: the neutral
         configuration). Link pairs with distance tables are tabulated from `hulls` (the robot's
@@ -84,7 +86,7 @@ class SphereFilter:
         """
         model = robot.model
         base = robot.neutral() if base is None else base
-        part = _robot_part(robot, geometry, tuple(obj for obj in objects if obj.link), allowed, base, hulls or geometry)
+        part = _robot_part(robot, tuple(obj for obj in objects if obj.link), allowed, base, hulls or geometry)
         self.tabulated = part.tabulated
         world = [obj for obj in objects if not obj.link]
         check = _world_checks(part.names, part.owner_joint, world, allowed)
@@ -192,34 +194,33 @@ _ROBOT_PARTS: dict[tuple[Any, ...], _RobotPart] = {}
 
 
 def _robot_part(
-    robot: Robot, geometry: pin.GeometryModel, attached: tuple[CollisionObject, ...],
-    allowed: frozenset[frozenset[str]], base: NDArray[np.float64], hulls: pin.GeometryModel,
+    robot: Robot, attached: tuple[CollisionObject, ...], allowed: frozenset[frozenset[str]],
+    base: NDArray[np.float64], hulls: pin.GeometryModel,
 ) -> _RobotPart:
     """Return the robot's part of a filter: the same for every scene with nothing attached, so built once for them.
 
     A benchmark plans hundreds of scenes of one robot: fitting, grouping and packing its spheres
-    and tables again for each was half of a filter's 2 ms set-up. The key holds the geometry
-    models themselves (compared by identity: core/collision/checker.py builds them once per
+    and tables again for each was half of a filter's 2 ms set-up. The key holds the hulls'
+    geometry model itself (compared by identity: core/collision/checker.py builds it once per
     config), the URDF and SRDF, the group and the other joints' values.
     """
     def built() -> _RobotPart:
-        return _built_part(robot, geometry, attached, allowed, base, hulls)
+        return _built_part(robot, attached, allowed, base, hulls)
 
     if attached:
         return built()
-    key = (geometry, hulls, robot.config.urdf, robot.config.srdf.disabled_pairs, robot.joint_names, allowed,
-           base.tobytes())
+    key = (hulls, robot.config.urdf, robot.config.srdf.disabled_pairs, robot.joint_names, allowed, base.tobytes())
     return kept(_ROBOT_PARTS, key, built)
 
 
 def _built_part(
-    robot: Robot, geometry: pin.GeometryModel, attached: tuple[CollisionObject, ...],
-    allowed: frozenset[frozenset[str]], base: NDArray[np.float64], hulls: pin.GeometryModel,
+    robot: Robot, attached: tuple[CollisionObject, ...], allowed: frozenset[frozenset[str]],
+    base: NDArray[np.float64], hulls: pin.GeometryModel,
 ) -> _RobotPart:
-    """Return the robot's part of a filter, fitted, grouped and packed (see `_robot_part`)."""
+    """Return the robot's part of a filter, its spheres fitted to `hulls`, grouped and packed (see `_robot_part`)."""
     model = robot.model
     joints = _joint_arrays(model)  # first: an unsupported joint fails before the spheres are fitted
-    spheres, touch = _owned_spheres(robot, geometry, attached)
+    spheres, touch = _owned_spheres(robot, hulls, attached)
     names = spheres.names
     owner_joint, owner_centre, owner_radius = _owner_balls(spheres)
     disabled = robot.config.srdf.disabled_pairs | allowed

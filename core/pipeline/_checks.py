@@ -14,9 +14,10 @@ one that would pay for the compilation anyway. A build inside a step is kept off
 planning-time cap (core/collision/compiled.py). A process that has built one filter has the
 kernels loaded, and builds the next at once.
 
-Every verdict is the same either way: a state the spheres clear is free under the hulls, and
-one they find colliding collides under them (core/collision/motion.py). What changes is only
-how fast it is reached; a plan is byte for byte the same with or without the filter.
+Every verdict is the same either way: a state the spheres clear is free under the hulls (they
+are fitted to the hulls), and one they find colliding collides under them (core/collision/motion.py).
+What changes is only how fast it is reached; a plan is byte for byte the same with or without the
+filter (tests/pipeline/test_filter_rule.py).
 """
 
 from __future__ import annotations

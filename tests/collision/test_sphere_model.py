@@ -33,8 +33,9 @@ def _reach_past_hull(points: np.ndarray, centres: np.ndarray, radii: np.ndarray)
 
 def test_panda_spheres_reach_at_most_three_centimetres_past_each_link_hull() -> None:
     # The clustering fit this replaced reached up to 7 cm past the hulls (3.8 cm for the median sphere).
+    # The filter fits its spheres to the links' hulls (core/collision/sphere_filter.py).
     robot = Robot(load_robot_config(PANDA))
-    geometry = CollisionChecker(robot).robot_geometry
+    geometry = CollisionChecker(robot, geometry="convex").robot_geometry
     spheres = robot_spheres(robot.model, geometry, robot.config.urdf)
     owners = np.array(spheres.owners)
     reach = []
