@@ -6,6 +6,12 @@ between them, so their distance, as convex hulls, is tabulated once per robot ov
 grid of those joints. Between grid points the lower link moves relative to the upper
 one by at most half a grid step times each joint's lever arm (the table's margin):
 a pair whose tabulated distance at the nearest grid point exceeds the margin is apart.
+
+The grid has a budget of points per table. Where a pair sits closer than that grid's margin in
+most configurations (a UR5's upper arm passes ~13 mm over its base, its joints turn through
+two full turns, so the budget leaves a 25 mm margin), the table could never call it apart,
+and every state would go to coal: its grid is refined until the margin is about half the pair's
+median distance, up to a larger budget.
 """
 
 from __future__ import annotations
@@ -21,8 +27,9 @@ from ._certify import farthest_point, is_prismatic
 
 __all__ = ["PairTable", "pair_tables"]
 
-_VERSION = 1  # bump when the tables change, so cached ones are rebuilt
+_VERSION = 2  # bump when the tables change, so cached ones are rebuilt
 _GRID_POINTS = 20000  # per table: ~0.2 s to build, 160 kB
+_FINE_GRID_POINTS = 400_000  # the most a refined grid takes: ~4 s to build (once per robot), 3.2 MB
 _MEMORY: dict[str, tuple[PairTable, ...]] = {}
 
 
@@ -98,9 +105,13 @@ def _bounded(model: pin.Model, jid: int) -> bool:
 
 
 def _tables(
-    model: pin.Model, hulls: pin.GeometryModel, pairs: list[tuple[str, str]], joints: tuple[int, ...]
+    model: pin.Model, hulls: pin.GeometryModel, pairs: list[tuple[str, str]], joints: tuple[int, ...],
+    points: int = _GRID_POINTS,
 ) -> list[PairTable]:
-    """Return the distance tables of `pairs`, which all depend on `joints`, over one grid of those joints."""
+    """Return the distance tables of `pairs`, which all depend on `joints`, over one grid of those joints.
+
+    The grid has about `points` points, more where a pair is mostly nearer than its margin (`_finer`).
+    """
     pair_model = pin.GeometryModel()
     ids: dict[str, list[int]] = {}
     for obj in hulls.geometryObjects:
@@ -120,7 +131,7 @@ def _tables(
     starts = np.array([model.lowerPositionLimit[i] for i in index])
     spans = np.array([model.upperPositionLimit[i] for i in index]) - starts
     # Equal margin per axis, as fine as the grid budget allows.
-    per_axis = (np.prod(spans * widest) / _GRID_POINTS) ** (1 / len(joints)) / 2
+    per_axis = (np.prod(spans * widest) / points) ** (1 / len(joints)) / 2
     counts = np.maximum(2, np.ceil(spans * widest / (2 * per_axis)).astype(int) + 1)
     steps = spans / (counts - 1)
     grid = np.stack(np.meshgrid(*[a + d * np.arange(n) for a, d, n in zip(starts, steps, counts, strict=True)],
@@ -133,9 +144,24 @@ def _tables(
         q[index] = values
         pin.computeDistances(model, data, pair_model, geometry_data, q)
         distances[k] = [r.min_distance for r in results]
-    return [PairTable(upper, lower, tuple(int(i) for i in index), tuple(map(float, starts)), tuple(map(float, steps)),
-                      distances[:, where].min(axis=1).reshape(tuple(counts)), float(steps / 2 @ lever))
-            for (upper, lower), where, lever in zip(pairs, slices, levers, strict=True)]
+    tables = [PairTable(upper, lower, tuple(int(i) for i in index), tuple(map(float, starts)),
+                        tuple(map(float, steps)), distances[:, where].min(axis=1).reshape(tuple(counts)),
+                        float(steps / 2 @ lever))
+              for (upper, lower), where, lever in zip(pairs, slices, levers, strict=True)]
+    finer = _finer(tables, points, len(joints))
+    return tables if finer is None else _tables(model, hulls, pairs, joints, finer)
+
+
+def _finer(tables: list[PairTable], points: int, axes: int) -> int | None:
+    """Return the grid points that bring each table's margin to about half its pair's median distance, if needed.
+
+    A table needs more where its pair is no farther than its margin at most grid points: it
+    would call the pair apart almost nowhere. None if none does, or the grid is at its largest.
+    """
+    shrink = max((t.margin / (float(np.median(t.distances)) / 2) for t in tables
+                  if np.mean(t.distances > t.margin) < 0.5 and np.median(t.distances) > 0), default=1.0)
+    wanted = min(_FINE_GRID_POINTS, int(np.ceil(points * shrink**axes)))  # the margin goes as points^(-1/axes)
+    return wanted if wanted > points else None
 
 
 def _lever(model: pin.Model, hulls: pin.GeometryModel, lower: str, joint: int) -> float:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pinocchio as pin
 import pytest
 from conftest import UR10E
@@ -78,3 +79,72 @@ def test_tables_are_cached_on_disk(
     again = pair_tables.pair_tables(robot.model, hulls, robot.config.srdf.disabled_pairs, robot.config.urdf)
     assert [t.margin for t in again] == [t.margin for t in first]
     assert cached.stat().st_size > 0
+
+
+def _shoulder(folder: Path) -> Robot:
+    """Return an arm whose upper arm's hub sits 25 mm over its base however its two joints (two full turns each) turn.
+
+    As a UR5's upper arm passes ~13 mm over its base: a 20,000-point grid over two full turns
+    of each joint has a margin of tens of millimetres, more than the pair's distance.
+    """
+    (folder / "arm.urdf").write_text("""<?xml version="1.0"?>
+<robot name="arm">
+  <link name="base"><collision><origin xyz="0 0 0.05"/><geometry><box size="0.3 0.3 0.1"/></geometry></collision></link>
+  <link name="shoulder"/>
+  <link name="upper_arm">
+    <collision><geometry><sphere radius="0.05"/></geometry></collision>
+    <collision><origin xyz="0.2 0 0"/><geometry><box size="0.3 0.04 0.04"/></geometry></collision>
+  </link>
+  <joint name="pan" type="revolute"><parent link="base"/><child link="shoulder"/><origin xyz="0 0 0.1"/>
+    <axis xyz="0 0 1"/><limit lower="-6.283185307179586" upper="6.283185307179586" velocity="2" effort="1"/></joint>
+  <joint name="lift" type="revolute"><parent link="shoulder"/><child link="upper_arm"/><origin xyz="0 0 0.075"/>
+    <axis xyz="0 1 0"/><limit lower="-6.283185307179586" upper="6.283185307179586" velocity="2" effort="1"/></joint>
+</robot>
+""")
+    (folder / "arm.srdf").write_text(
+        '<robot name="arm"><group name="arm"><joint name="pan"/><joint name="lift"/></group></robot>')
+    return Robot(load_robot_config(folder))
+
+
+def test_a_pair_nearer_than_the_grids_margin_almost_everywhere_is_tabulated_finer_and_called_apart_where_apart(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    robot = _shoulder(tmp_path)
+    hulls = CollisionChecker(robot, geometry="convex").robot_geometry
+    monkeypatch.setenv("MOVEPLAN_CACHE_DIR", str(tmp_path / "cache"))
+
+    def tabulated() -> pair_tables.PairTable:
+        monkeypatch.setattr(pair_tables, "_MEMORY", {})
+        for cached in (tmp_path / "cache").glob("pairs-*.entry"):
+            cached.unlink()
+        [table] = pair_tables.pair_tables(robot.model, hulls, robot.config.srdf.disabled_pairs, robot.config.urdf)
+        return table
+
+    with monkeypatch.context() as grid:
+        grid.setattr(pair_tables, "_FINE_GRID_POINTS", pair_tables._GRID_POINTS)
+        coarse = tabulated()
+    assert np.mean(coarse.distances > coarse.margin) == 0  # that grid calls the pair apart nowhere
+    table = tabulated()
+    assert table.distances.size > pair_tables._GRID_POINTS
+    assert table.margin < 0.51 * np.median(table.distances)  # half, to the grid's rounding
+    assert np.mean(table.distances > table.margin) > 0.5
+    model, data = robot.model, robot.model.createData()
+    pair = pin.GeometryModel()
+    for obj in hulls.geometryObjects:
+        pair.addGeometryObject(obj.copy())
+    base = [k for k, g in enumerate(hulls.geometryObjects) if g.parentJoint == 0]
+    arm = [k for k, g in enumerate(hulls.geometryObjects) if g.parentJoint != 0]
+    for i in base:
+        for j in arm:
+            pair.addCollisionPair(pin.CollisionPair(i, j))
+    pair_data = pair.createData()
+    arrays = tuple(_table_arrays([table]).values())
+    said_apart = 0
+    for q in np.random.default_rng(0).uniform(-2 * np.pi, 2 * np.pi, size=(1500, 2)):
+        pin.computeDistances(model, data, pair, pair_data, q)
+        distance = min(r.min_distance for r in pair_data.distanceResults)
+        verdict = tabled(q, arrays)
+        assert distance > 0 or verdict != CLEAR, q
+        assert distance < 0 or verdict != COLLIDES, q
+        said_apart += verdict == CLEAR
+    assert said_apart > 500
