@@ -1,7 +1,7 @@
 """What sets how long a one-shot `moveplan plan` checks with coal alone before it builds the sphere filter.
 
 Run from the repository root with moveplan installed:
-    python benchmarks/filter_threshold.py [--mbm DIR] [--count 3] [--fresh 5] [--compile]
+    python benchmarks/filter_threshold.py [--mbm DIR] [--robot DIR] [--count 3] [--fresh 5] [--compile]
 The rule (core/pipeline/_checks.py) is rent or buy: build the filter once the states asked about
 have cost, checked by coal alone, what building it costs. Printed:
 (a) building it in a fresh process: numba's import, its kernels loaded from its cache, the filter
@@ -11,13 +11,16 @@ have cost, checked by coal alone, what building it costs. Printed:
     folder with more), the step with coal alone and with the filter, each in a process of its own
     and the best of two, over the states the step asks about: what a state costs more without the
     filter; medians per scenario and overall;
-(c) the thresholds (a) / median (b): FILTER_AFTER_STATES and FILTER_AFTER_STATES_UNCOMPILED.
+(c) the thresholds (a) / median (b): FILTER_AFTER_STATES and FILTER_AFTER_STATES_UNCOMPILED;
+(d) the problems whose plans differ with the filter and with coal alone (motions checked, path,
+    trajectory): the filter may change only how fast an answer comes, so none should.
 Machines are shared and noisy: compare ratios and medians.
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
 import statistics
@@ -42,12 +45,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--mbm", type=Path, default=ROOT / "tests" / "data" / "mbm" / "problems",
                         help="folder of MotionBenchMaker problems, with panda_robot beside it or in its parent")
+    parser.add_argument("--robot", type=Path, help="the problems' robot config (default: panda_robot beside them)")
     parser.add_argument("--count", type=int, default=3, help="problems per scenario")
     parser.add_argument("--fresh", type=int, default=5, help="fresh processes timing the build")
     parser.add_argument("--compile", action="store_true", help="also time numba's compilation into an empty cache")
     parser.add_argument("--worker", choices=("coal", "filter", "build"), help=argparse.SUPPRESS)
     args = parser.parse_args()
-    robot = next(p for p in (args.mbm / "panda_robot", args.mbm.parent / "panda_robot") if p.is_dir())
+    robot = args.robot or next(p for p in (args.mbm / "panda_robot", args.mbm.parent / "panda_robot") if p.is_dir())
     problems = benchmark.find_problems([args.mbm], args.count)
     if args.worker:
         print(json.dumps(_work(args.worker, robot, problems)))
@@ -56,7 +60,7 @@ def main() -> None:
     coal, filtered = _worker("coal", args), _worker("filter", args)
     extra: dict[str, list[float]] = {}
     ratios = []
-    for problem, (coal_s, asked), (filter_s, _) in zip(problems, coal, filtered, strict=True):
+    for problem, (coal_s, asked, _), (filter_s, _, _) in zip(problems, coal, filtered, strict=True):
         extra.setdefault(problem.scenario, []).append((coal_s - filter_s) / asked)
         ratios.append(coal_s / filter_s)
         print(f"  {problem.name}: {asked} states, coal alone {1e3 * coal_s:.1f} ms, "
@@ -69,6 +73,9 @@ def main() -> None:
           f"{len(problems)} problems); the step with coal alone over the step with the filter: median "
           f"{statistics.median(ratios):.2f}")
     print(f"(c) FILTER_AFTER_STATES: {build / rent:,.0f} states (now {_checks.FILTER_AFTER_STATES:,})")
+    differ = [problem.name for problem, a, b in zip(problems, coal, filtered, strict=True) if a[2] != b[2]]
+    print(f"(d) plans that differ with the filter and with coal alone: {len(differ)} of {len(problems)}"
+          + "".join(f"\n    {name}" for name in differ))
     if args.compile:
         with tempfile.TemporaryDirectory() as cache:
             compiled = _worker("build", args, {"NUMBA_CACHE_DIR": cache})
@@ -78,13 +85,14 @@ def main() -> None:
 
 def _worker(kind: str, args: argparse.Namespace, env: dict[str, str] | None = None) -> Any:
     """Return what a fresh process of this script measures as `kind`."""
-    command = [sys.executable, __file__, "--worker", kind, "--mbm", str(args.mbm), "--count", str(args.count)]
+    command = [sys.executable, __file__, "--worker", kind, "--mbm", str(args.mbm), "--count", str(args.count),
+               *(["--robot", str(args.robot)] if args.robot else [])]
     result = subprocess.run(command, capture_output=True, text=True, check=True, env={**os.environ, **(env or {})})
     return json.loads(result.stdout)
 
 
 def _work(kind: str, robot: Path, problems: tuple[benchmark.ProblemFiles, ...]) -> Any:
-    """Return per problem the best of two steps' planning time [s] and the states asked, with `kind`'s checks.
+    """Return per problem, with `kind`'s checks, the best of two steps' planning time [s], states asked, plan digest.
 
     `build`: the build's cost [s] alone (the first problem planned with the filter, first in the
     process after a plan with coal alone, less the same plan again).
@@ -96,15 +104,23 @@ def _work(kind: str, robot: Path, problems: tuple[benchmark.ProblemFiles, ...]) 
     return [min(_planned(robot, problem, after)[1:], _planned(robot, problem, after)[1:]) for problem in problems]
 
 
-def _planned(robot: Path, problem: benchmark.ProblemFiles, after: int) -> tuple[float, float, int]:
-    """Return a plan's wall time [s], its steps' planning time [s] and the states asked, the filter after `after`."""
+def _planned(robot: Path, problem: benchmark.ProblemFiles, after: int) -> tuple[float, float, int, str]:
+    """Return a plan's wall time [s], its steps' planning time [s], the states asked and a digest of what it plans.
+
+    The filter is built after `after` states. The digest covers each step's motions checked, path length and
+    timed trajectory.
+    """
     flags = pipeline.PlanFlags(robot=robot, scene=problem.scene, request=problem.request, seed=0,
                                motion=MotionSettings(planner="RRTConnect", planning_time=1.0))
     request = pipeline.resolve_request(None, flags)
     unfiltered, began = count_unfiltered(0), time.perf_counter()
     plan = pipeline.plan(request, filter_after=after)
     wall = time.perf_counter() - began
-    return wall, sum(step.planning_time_s for step in plan.steps), count_unfiltered(0) - unfiltered
+    digest = hashlib.sha256()
+    for step in plan.steps:
+        digest.update(repr((step.stats["checks"], step.stats["path_length"])).encode())
+        digest.update(step.trajectory.times_s.tobytes() + step.trajectory.positions.tobytes())
+    return wall, sum(step.planning_time_s for step in plan.steps), count_unfiltered(0) - unfiltered, digest.hexdigest()
 
 
 if __name__ == "__main__":
