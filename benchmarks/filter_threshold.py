@@ -1,17 +1,21 @@
 """What sets how long a one-shot `moveplan plan` checks with coal alone before it builds the sphere filter.
 
 Run from the repository root with moveplan installed:
-    python benchmarks/filter_threshold.py [--mbm DIR] [--robot DIR] [--count 3] [--fresh 5] [--compile]
+    python benchmarks/filter_threshold.py [--mbm DIR] [--robot DIR] [--count 3] [--fresh 5] [--fit] [--compile]
 The rule (core/pipeline/_checks.py) is rent or buy: build the filter once the states asked about
 have cost, checked by coal alone, what building it costs. Printed:
-(a) building it in a fresh process: numba's import, its kernels loaded from its cache, the filter
-    made, and the kernels' first calls (a plan with the filter, less the same plan again), median
-    of --fresh processes; with --compile also into an empty numba cache (the compilation);
+(a) building it in a fresh process: its kernels loaded (compiled ahead of time, or numba imported
+    and its cached kernels loaded, whichever this install has), the filter made, and the kernels'
+    first calls (a plan with the filter, less the same plan again), median of --fresh processes;
+    with --fit also into an empty moveplan cache (the robot's spheres and tables fitted), and
+    with --compile into an empty numba cache (the compilation);
 (b) per MotionBenchMaker problem (the first --count of each scenario: the repository's, or --mbm a
     folder with more), the step with coal alone and with the filter, each in a process of its own
     and the best of two, over the states the step asks about: what a state costs more without the
     filter; medians per scenario and overall;
-(c) the thresholds (a) / median (b): FILTER_AFTER_STATES and FILTER_AFTER_STATES_UNCOMPILED;
+(c) the thresholds (a) / median (b): FILTER_AFTER_STATES (numba's JIT), FILTER_AFTER_STATES_UNFITTED and
+    FILTER_AFTER_STATES_UNCOMPILED; a filter whose kernels are compiled ahead of time and whose robot is
+    fitted is built at once (AT_ONCE_IF_FITTED);
 (d) the problems whose plans differ with the filter and with coal alone (motions checked, path,
     trajectory): the filter may change only how fast an answer comes, so none should.
 Machines are shared and noisy: compare ratios and medians.
@@ -31,7 +35,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from moveplan.core.collision import count_unfiltered
+from moveplan.core.collision import count_unfiltered, kernels_native
 from moveplan.core.config import MotionSettings
 from moveplan.core.pipeline import _checks, benchmark
 from moveplan.core.pipeline import plan as pipeline
@@ -48,7 +52,8 @@ def main() -> None:
     parser.add_argument("--robot", type=Path, help="the problems' robot config (default: panda_robot beside them)")
     parser.add_argument("--count", type=int, default=3, help="problems per scenario")
     parser.add_argument("--fresh", type=int, default=5, help="fresh processes timing the build")
-    parser.add_argument("--compile", action="store_true", help="also time numba's compilation into an empty cache")
+    parser.add_argument("--fit", action="store_true", help="also time the build into an empty moveplan cache")
+    parser.add_argument("--compile", action="store_true", help="also time the compilation into an empty numba cache")
     parser.add_argument("--worker", choices=("coal", "filter", "build"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     robot = args.robot or next(p for p in (args.mbm / "panda_robot", args.mbm.parent / "panda_robot") if p.is_dir())
@@ -68,14 +73,21 @@ def main() -> None:
     for scenario, values in extra.items():
         print(f"  {scenario}: {1e6 * statistics.median(values):.2f} us a state more with coal alone (median)")
     rent = statistics.median(value for values in extra.values() for value in values)
-    print(f"(a) the filter's build in a fresh process: median {1e3 * build:.0f} ms of {args.fresh}")
+    kind = "compiled ahead of time" if kernels_native() else "numba's JIT"
+    print(f"(a) the filter's build in a fresh process ({kind}): median {1e3 * build:.0f} ms of {args.fresh}")
     print(f"(b) a state checked with coal alone: {1e6 * rent:.2f} us more than with the filter (median of "
           f"{len(problems)} problems); the step with coal alone over the step with the filter: median "
           f"{statistics.median(ratios):.2f}")
-    print(f"(c) FILTER_AFTER_STATES: {build / rent:,.0f} states (now {_checks.FILTER_AFTER_STATES:,})")
+    print(f"(c) the build is worth {build / rent:,.0f} states (FILTER_AFTER_STATES, for numba's JIT: "
+          f"{_checks.FILTER_AFTER_STATES:,}; compiled ahead of time, a fitted robot's filter is built at once)")
     differ = [problem.name for problem, a, b in zip(problems, coal, filtered, strict=True) if a[2] != b[2]]
     print(f"(d) plans that differ with the filter and with coal alone: {len(differ)} of {len(problems)}"
           + "".join(f"\n    {name}" for name in differ))
+    if args.fit:
+        with tempfile.TemporaryDirectory() as cache:
+            fitted = _worker("build", args, {"MOVEPLAN_CACHE_DIR": cache})
+        print(f"    into an empty moveplan cache: {fitted:.1f} s; FILTER_AFTER_STATES_UNFITTED: "
+              f"{fitted / rent:,.0f} states (now {_checks.FILTER_AFTER_STATES_UNFITTED:,})")
     if args.compile:
         with tempfile.TemporaryDirectory() as cache:
             compiled = _worker("build", args, {"NUMBA_CACHE_DIR": cache})

@@ -15,7 +15,7 @@ from ._verdicts import CLEAR
 
 # numba caches a kernel by this file's bytes alone; the line below changes them with the sources its
 # kernels compile in (tests/foundation/test_kernel_inputs.py says what it must read).
-# Compiled in (sha256): collision/_kernels.py 4b4870c854e5, collision/_verdicts.py 5c11907276b0
+# Compiled in (sha256): collision/_kernels.py 15ceb5d60f65, collision/_verdicts.py 5c11907276b0
 
 __all__ = ["certify", "clearance"]
 

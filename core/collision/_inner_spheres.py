@@ -8,6 +8,8 @@ coal: if one of them touches an obstacle, so does the hull.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import coal
 import numpy as np
 import pinocchio as pin
@@ -16,7 +18,7 @@ from numpy.typing import NDArray
 from . import _cache as disk_cache
 from ._sphere_fit import SphereSet
 
-__all__ = ["inner_spheres"]
+__all__ = ["inner_entry", "inner_spheres"]
 
 _VERSION = 1  # bump when the fit changes, so cached balls are rebuilt
 _MEMORY: dict[str, SphereSet] = {}
@@ -25,14 +27,19 @@ _SMALLEST = 0.3  # stop at balls smaller than this fraction of a shape's largest
 _GRID = 12  # candidate centres per axis of a shape's bounding box
 
 
+def inner_entry(hulls: pin.GeometryModel, urdf: str) -> tuple[str, Path]:
+    """Return the key of the balls inside the robot's hulls, and their cache entry."""
+    key = disk_cache.digest(f"inner {_VERSION}\n{urdf}", hulls)
+    return key, disk_cache.path(f"inner-{key[:32]}.entry")
+
+
 def inner_spheres(model: pin.Model, hulls: pin.GeometryModel, urdf: str) -> SphereSet:
     """Return balls inside the convex shapes of `hulls` (the robot's geometry as convex hulls), per joint.
 
     Cached in memory and on disk, keyed by the URDF and its meshes: they take ~0.1 s to find.
     """
-    key = disk_cache.digest(f"inner {_VERSION}\n{urdf}", hulls)
+    key, path = inner_entry(hulls, urdf)
     if key not in _MEMORY:
-        path = disk_cache.path(f"inner-{key[:32]}.entry")
         balls = disk_cache.read(path, SphereSet)
         if balls is None:
             balls = _fit(model, hulls)

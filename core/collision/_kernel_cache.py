@@ -1,32 +1,35 @@
 """Whether numba's disk cache already holds the sphere filter's kernels, found without importing numba.
 
-Building the filter loads its kernels in under a second when numba has cached them, and compiles
-them for 15-60 s when it has not (a fresh install, a new numba). A one-shot command asks first,
+Where the kernels could not be compiled ahead of time (core/_native.py), numba's JIT runs them:
+building the filter loads them in under a second when numba has cached them, and compiles them
+for 15-60 s when it has not (a fresh install, a new numba). A one-shot command asks first,
 so that it can stay with coal rather than pay a compilation a short plan does not need
 (core/pipeline/_checks.py). Importing numba to ask would cost half a second itself, so the index
 files are looked up where numba keeps them, as numba.core.caching names them.
 
 An index is pickled, and unpickling a file runs whatever code it names. numba unpickles its own
 cache when it loads the kernels: that is numba's trust in the folder it caches in (the
-__pycache__ beside moveplan's source, or NUMBA_CACHE_DIR). This look unpickles nothing: it
+__pycache__ beside moveplan's source, or NUMBA_CACHE_DIR), where the modules compiled ahead of
+time are kept too. This look unpickles nothing: it
 compares bytes, so asking whether the kernels are cached runs no code from that folder.
 """
 
 from __future__ import annotations
 
 import hashlib
-import os
 import pickle
 import sys
 from functools import cache
 from importlib import metadata
 from pathlib import Path
 
+from .._native import cache_folder
+
 __all__ = ["kernels_cached"]
 
 _CORE = Path(__file__).resolve().parent.parent
 _ENTRY_POINTS = {"collision/_kernels.py": ("classify", "edge"), "collision/_clearance.py": ("certify",),
-                 "collision/_states.py": ("trajectory_states",), "timing/_compiled.py": ("_speeds", "_peaks"),
+                 "collision/_states.py": ("trajectory_states",), "timing/_compiled.py": ("speeds", "peaks"),
                  "trajectory.py": ("_velocity_extreme",)}
 """The kernels a filter loads, called from Python, by source file under core/; numba caches each under its own index."""
 
@@ -42,7 +45,7 @@ def kernels_cached() -> bool:
         version = metadata.version("numba")
         for name, functions in _ENTRY_POINTS.items():
             source = _CORE / name
-            folder = _cache_folder(source.parent)
+            folder = cache_folder(source.parent)
             if folder is None:
                 return False
             text = source.read_bytes()
@@ -55,16 +58,6 @@ def kernels_cached() -> bool:
     except (OSError, KeyError, metadata.PackageNotFoundError):
         return False
     return True
-
-
-def _cache_folder(package: Path) -> Path | None:
-    """Return the folder numba caches the kernels of a package folder in (its first two locators), or None."""
-    configured = os.environ.get("NUMBA_CACHE_DIR")
-    if configured:
-        return Path(configured) / f"{package.name}_{hashlib.sha1(str(package).encode()).hexdigest()}"
-    if os.access(package, os.W_OK):
-        return package / "__pycache__"
-    return None
 
 
 def _first_lines(source: bytes) -> dict[str, int]:

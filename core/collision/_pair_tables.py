@@ -17,6 +17,7 @@ median distance, up to a larger budget.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -25,7 +26,7 @@ from numpy.typing import NDArray
 from . import _cache as disk_cache
 from ._certify import farthest_point, is_prismatic
 
-__all__ = ["PairTable", "pair_tables"]
+__all__ = ["PairTable", "pair_tables", "tables_entry"]
 
 _VERSION = 2  # bump when the tables change, so cached ones are rebuilt
 _GRID_POINTS = 20000  # per table: ~0.2 s to build, 160 kB
@@ -56,6 +57,12 @@ class PairTable:
     margin: float
 
 
+def tables_entry(hulls: pin.GeometryModel, disabled: frozenset[frozenset[str]], urdf: str) -> tuple[str, Path]:
+    """Return the key of the robot's distance tables (see `pair_tables`), and their cache entry."""
+    key = disk_cache.digest(f"pairs {_VERSION}\n{urdf}\n{sorted(map(sorted, disabled))}", hulls)
+    return key, disk_cache.path(f"pairs-{key[:32]}.entry")
+
+
 def pair_tables(
     model: pin.Model, hulls: pin.GeometryModel, disabled: frozenset[frozenset[str]], urdf: str
 ) -> tuple[PairTable, ...]:
@@ -63,9 +70,8 @@ def pair_tables(
 
     Cached in memory and on disk, keyed by the URDF, its meshes and the disabled pairs.
     """
-    key = disk_cache.digest(f"pairs {_VERSION}\n{urdf}\n{sorted(map(sorted, disabled))}", hulls)
+    key, path = tables_entry(hulls, disabled, urdf)
     if key not in _MEMORY:
-        path = disk_cache.path(f"pairs-{key[:32]}.entry")
         tables = disk_cache.read(path, tuple)
         if tables is None:
             disk_cache.announce(f"tabulating distances of wrist link pairs for {model.name}", path)

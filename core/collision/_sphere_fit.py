@@ -21,6 +21,7 @@ from __future__ import annotations
 import itertools
 import logging
 from dataclasses import dataclass
+from pathlib import Path
 
 import coal
 import numpy as np
@@ -30,7 +31,7 @@ from numpy.typing import NDArray
 from ..types import Shape
 from . import _cache as disk_cache
 
-__all__ = ["SphereSet", "fit_geometry", "fit_shape", "robot_spheres"]
+__all__ = ["SphereSet", "fit_geometry", "fit_shape", "robot_spheres", "spheres_entry"]
 
 logger = logging.getLogger(__name__)
 
@@ -52,15 +53,20 @@ class SphereSet:
     owners: tuple[str, ...]
 
 
-def robot_spheres(model: pin.Model, geometry: pin.GeometryModel, urdf: str) -> SphereSet:
-    """Return spheres enclosing every shape of the robot's collision `geometry`, cached in memory and on disk."""
+def spheres_entry(geometry: pin.GeometryModel, urdf: str) -> tuple[str, Path]:
+    """Return the key of the spheres fitted to the robot's collision `geometry`, and their cache entry."""
     # The fit's settings and each shape's kind (a mesh, or its hull) are part of the key.
     settings = (_VERSION, _EXCESS_M, _DETAIL, _MOST)
     kinds = [type(obj.geometry).__name__ for obj in geometry.geometryObjects]
     key = disk_cache.digest(f"{settings}\n{kinds}\n{urdf}", geometry)
+    return key, disk_cache.path(f"spheres-{key[:32]}.entry")
+
+
+def robot_spheres(model: pin.Model, geometry: pin.GeometryModel, urdf: str) -> SphereSet:
+    """Return spheres enclosing every shape of the robot's collision `geometry`, cached in memory and on disk."""
+    key, path = spheres_entry(geometry, urdf)
     if key in _CACHE:
         return _CACHE[key]
-    path = disk_cache.path(f"spheres-{key[:32]}.entry")
     spheres = disk_cache.read(path, SphereSet)
     if spheres is None:
         disk_cache.announce(f"fitting collision spheres for {model.name}", path)

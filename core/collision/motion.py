@@ -39,10 +39,10 @@ from ..types import JointTrajectory
 from . import _certify as certify
 from ._cover import RUN, needed, run_margins, uncovered_collision
 from .checker import CONTACT_M, CollisionChecker, GeometryMode, robot_geometry
-from .sphere_filter import CLEAR, COLLIDES, MAYBE, SphereFilter, UnsupportedJoint
+from .sphere_filter import CLEAR, COLLIDES, MAYBE, SphereFilter, UnsupportedJoint, filter_cached
 
 __all__ = ["CERTIFY_STEP_M", "MotionChecker", "build_sphere_filter", "exact_checks", "scene_checkers",
-           "scene_checks"]
+           "scene_checks", "sphere_filter_cached"]
 
 logger = logging.getLogger(__name__)
 
@@ -345,6 +345,11 @@ def build_sphere_filter(
     except UnsupportedJoint as exc:
         logger.info("no sphere filter (%s): every state is checked by coal", exc)
         return None
+
+
+def sphere_filter_cached(robot: Robot, checker: CollisionChecker, hulls: CollisionChecker | None) -> bool:
+    """Return True if what `build_sphere_filter` fits for `robot` is cached on disk: it builds in milliseconds."""
+    return filter_cached(robot, (hulls or checker).robot_geometry)
 
 
 def _hull_checker(robot: Robot, geometry: GeometryMode, scene: Scene) -> CollisionChecker | None:

@@ -1,10 +1,11 @@
 """A fast conservative collision filter: the robot's enclosing spheres against the scene and themselves.
 
-Compiled with numba (imported only when a filter is built, so commands that do not plan
-never pay its start-up). One call checks a batch of configurations: forward kinematics
-of the joint tree, then per owner (link or attached object) its bounding ball first and
-its spheres only if that ball touches something. Link pairs whose distance depends on
-one or two joints are looked up in distance tables instead (core/collision/_pair_tables.py). A
+Compiled with numba (ahead of time where it can be, core/collision/compiled.py; loaded only
+when a filter is built, so commands that do not plan never pay for it). One call checks a
+batch of configurations: forward kinematics of the joint tree, then per owner (link or
+attached object) its bounding ball first and its spheres only if that ball touches
+something. Link pairs whose distance depends on one or two joints are looked up in distance
+tables instead (core/collision/_pair_tables.py). A
 state is "clear" only if no sphere touches an obstacle or another owner's sphere and
 every tabulated pair is apart; since the spheres enclose the robot's convex hulls
 (core/collision/_sphere_fit.py), which enclose its meshes, a clear state is free under the hulls:
@@ -30,13 +31,14 @@ from ..model import Robot
 from ..types import CollisionObject, JointTrajectory
 from . import _certify as certify
 from ._cache import announce_compilation
-from ._inner_spheres import inner_spheres
-from ._pair_tables import PairTable, pair_tables
-from ._sphere_fit import SphereSet, fit_shape, robot_spheres
+from ._inner_spheres import inner_entry, inner_spheres
+from ._packing import pack, pack_robot
+from ._pair_tables import PairTable, pair_tables, tables_entry
+from ._sphere_fit import SphereSet, fit_shape, robot_spheres, spheres_entry
 from ._verdicts import CLEAR, COLLIDES, MAYBE
-from .compiled import kernels_loaded, kernels_ready, mark_kernels_loaded
+from .compiled import collision_kernels, kernels_loaded, kernels_ready, mark_kernels_loaded
 
-__all__ = ["CLEAR", "COLLIDES", "MAYBE", "SphereFilter", "UnsupportedJoint"]
+__all__ = ["CLEAR", "COLLIDES", "MAYBE", "SphereFilter", "UnsupportedJoint", "filter_cached"]
 
 
 # Joint kinds the kernel knows; anything else (planar, free-flyer, ...) makes the filter unavailable.
@@ -92,22 +94,20 @@ class SphereFilter:
         check = _world_checks(part.names, part.owner_joint, world, allowed)
         # the peak rates the states are placed by, and the timing passes of a plan with a filter
         from ..timing import compiled_fastest_speeds, compiled_quintic_peak_rates
-        from . import _clearance, _states  # numba too: the certification walk, the states it walks
-        from . import _kernels as sphere_kernels  # numba: compiled once, then loaded from its disk cache
 
-        self._kernels, self._clearance, self._states = sphere_kernels, _clearance, _states
+        if not kernels_loaded():  # before the kernels are asked for: they may be compiled now
+            announce_compilation("compiling the collision kernels (once per install)", compiled=kernels_ready())
+        self._kernels = collision_kernels()
         self._peak_rates = compiled_quintic_peak_rates
         # Packed once: the kernels run thousands of times per search, and a call costs per argument; the
         # robot's arrays (660 kB with its distance tables) were packed with its part, only the world's are added.
-        self._packed = sphere_kernels.pack(part.packed, {**_obstacles(world, shapes or {}), "check": check})
+        self._packed = pack(part.packed, {**_obstacles(world, shapes or {}), "check": check})
         self._nq = model.nq
         # Reused by every `edge` call: returning fresh arrays from compiled code costs more than judging a state.
         self._verdicts, self._unclear = np.empty(64, dtype=np.int8), np.empty((64, model.nq))
         if kernels_loaded():
             return
-        # Compile (or load) the kernels now, not mid-search.
-        announce_compilation("compiling the collision kernels (once per install; numba caches them)",
-                             compiled=kernels_ready())
+        # Compile (or load) every kernel now, not mid-search: numba's JIT compiles on a first call.
         self.classify(robot.values(base)[None, :])
         self.edge(robot.values(base), robot.values(base), 1.0)
         self.certify(robot.values(base)[None, :], np.zeros(1), 0.0)
@@ -145,7 +145,7 @@ class SphereFilter:
         q = np.empty((len(values), self._nq))
         out = np.empty(len(values), dtype=np.int8)
         radius = np.empty(len(values))
-        self._clearance.certify(_plain(values), _plain(travel), CLEARANCE_CAP_M, floor, *self._packed, q, out, radius)
+        self._kernels.certify(_plain(values), _plain(travel), CLEARANCE_CAP_M, floor, *self._packed, q, out, radius)
         return out, q, radius
 
     def trajectory_states(
@@ -161,7 +161,7 @@ class SphereFilter:
                                               trajectory.accelerations))
         peak_v, peak_a = self._peak_rates(knots, p, v, a)
         certify.state_count(float(peak_v @ reach_m) * float(knots[-1] - knots[0]), step_m)  # before numba places them
-        states = self._states.trajectory_states(knots, p, v, a, peak_v, peak_a, _plain(reach_m), step_m, certify.PIECE)
+        states = self._kernels.trajectory_states(knots, p, v, a, peak_v, peak_a, _plain(reach_m), step_m, certify.PIECE)
         return cast(tuple[NDArray[np.float64], NDArray[np.float64]], states)
 
     def edge(
@@ -181,13 +181,24 @@ class SphereFilter:
         return worst, self._verdicts[:kept], self._unclear[:kept]
 
 
+def filter_cached(robot: Robot, hulls: pin.GeometryModel) -> bool:
+    """Return True if the robot's spheres, distance tables and inner balls (fitted to `hulls`) are cached on disk.
+
+    Then a filter of it is built in milliseconds; else it fits them first, for seconds.
+    """
+    urdf = robot.config.urdf
+    entries = (spheres_entry(hulls, urdf), tables_entry(hulls, robot.config.srdf.disabled_pairs, urdf),
+               inner_entry(hulls, urdf))
+    return all(path.is_file() for _, path in entries)
+
+
 class _RobotPart(NamedTuple):
     """What a filter of one robot holds whatever the world: owners, tabulated pairs and the kernels' robot arrays."""
 
     names: tuple[str, ...]  # owners: links, then attached objects
     owner_joint: NDArray[np.int64]
     tabulated: tuple[tuple[str, str], ...]
-    packed: tuple[Any, Any]  # the kernels' robot arrays, before and after the world's (_kernels.pack_robot)
+    packed: tuple[Any, Any]  # the kernels' robot arrays, before and after the world's (_packing.pack_robot)
 
 
 _ROBOT_PARTS: dict[tuple[Any, ...], _RobotPart] = {}
@@ -234,8 +245,6 @@ def _built_part(
         "centres": spheres.centre, "radii": spheres.radius, "sjoint": spheres.joint, "start": spheres.start,
         "ojoint": owner_joint, "ocentre": owner_centre, "oradius": owner_radius, **_inner_arrays(inner, names),
         "pairs": np.reshape(pairs, (-1, 2)), **_mimic_arrays(robot)}
-    from ._kernels import pack_robot  # numba, which the filter these arrays are for loads next
-
     return _RobotPart(tuple(names), owner_joint, tuple((t.upper, t.lower) for t in tables), pack_robot(arrays))
 
 

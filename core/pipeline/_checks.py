@@ -1,18 +1,20 @@
-"""A problem's collision checks, built once per robot and scene; the sphere filter only once it pays for itself.
+"""A problem's collision checks, built once per robot and scene; the sphere filter once it pays for itself.
 
-The sphere filter (core/collision/sphere_filter.py) clears a state in microseconds, but building
-it imports numba and loads its compiled kernels: ~0.5 s in a fresh process, and a compilation of
-tens of seconds on a fresh install. A plan of a few steps asks about a few thousand states, which
-coal alone judges 3-4 us slower each than the filter does: tens of milliseconds. So a one-shot
-command starts with coal alone and builds the filter once the states it has asked about pass
-`after` (all its problems' together: a script's plans in changing scenes too). The rule is rent
-or buy: by then coal alone has spent about as much more than the filter would have as building
-the filter costs (benchmarks/filter_threshold.py measures both). Where numba has not
-compiled the kernels yet (a fresh install), the build costs a compilation, so the rule waits
-correspondingly longer: a first plan on a fresh machine costs what it costs warm unless it is
-one that would pay for the compilation anyway. A build inside a step is kept off the search's
-planning-time cap (core/collision/compiled.py). A process that has built one filter has the
-kernels loaded, and builds the next at once.
+The sphere filter (core/collision/sphere_filter.py) clears a state in microseconds. Its kernels
+are compiled once per install, ahead of time where a C compiler allows (core/_native.py): then a
+fresh process builds the filter in ~15 ms without numba, and every problem gets it with its
+collision set-up, as a benchmark's does. Where numba's JIT runs them instead (an ahead-of-time
+build failed), building the filter imports numba: ~0.7 s in a fresh process. A plan of a few
+steps asks about a few thousand states, which coal alone judges 3-4 us slower each than the
+filter does: tens of milliseconds. So there a one-shot command starts with coal alone and builds
+the filter once the states it has asked about pass `after` (all its problems' together: a
+script's plans in changing scenes too). The rule is rent or buy: by then coal alone has spent
+about as much more than the filter would have as building the filter costs
+(benchmarks/filter_threshold.py measures both). Where the kernels are not compiled yet (a fresh
+install), the build costs a compilation, so the rule waits correspondingly longer: a first plan
+on a fresh machine costs what it costs warm unless it is one that would pay for the compilation
+anyway. A build inside a step is kept off the search's planning-time cap (core/collision/compiled.py).
+A process that has built one filter has the kernels loaded, and builds the next at once.
 
 Every verdict is the same either way: a state the spheres clear is free under the hulls (they
 are fitted to the hulls), and one they find colliding collides under them (core/collision/motion.py).
@@ -39,25 +41,36 @@ from ..collision import (
     build_sphere_filter,
     count_unfiltered,
     kernels_loaded,
+    kernels_native,
     kernels_ready,
     scene_checkers,
+    sphere_filter_cached,
 )
 from ..model import Robot, Scene
 from ..trajectory import interpolate
 
-__all__ = ["FILTER_AFTER_STATES", "FILTER_AFTER_STATES_UNCOMPILED", "Problem", "build_problem", "filter_threshold"]
+__all__ = ["AT_ONCE_IF_FITTED", "FILTER_AFTER_STATES", "FILTER_AFTER_STATES_UNCOMPILED", "FILTER_AFTER_STATES_UNFITTED",
+           "Problem", "build_problem", "filter_threshold"]
 
 logger = logging.getLogger(__name__)
 
 FILTER_AFTER_STATES = 150_000
 """States a one-shot command checks with coal alone before it builds the sphere filter: the build's ~0.5 s
 over the 3-3.8 us a state costs more without it (benchmarks/filter_threshold.py, MotionBenchMaker's Panda)."""
+FILTER_AFTER_STATES_UNFITTED = 1_000_000
+"""The same when the kernels are compiled ahead of time but the robot's spheres and distance tables are not fitted
+yet: 2-7 s (1.2 s the Panda's spheres, 1.5-4.9 s tables) over the same 3-3.8 us. Fitted, the filter is built at once."""
+AT_ONCE_IF_FITTED = -1
+"""`after` where the kernels are compiled ahead of time: the filter at once if the robot's spheres and tables are
+cached (a build of ~15 ms), else after FILTER_AFTER_STATES_UNFITTED states."""
 FILTER_AFTER_STATES_UNCOMPILED = 6_000_000
 """The same when numba has yet to compile the kernels: the compilation's ~20 s over the same 3-3.8 us."""
 
 
 def filter_threshold() -> int:
     """Return how many states a one-shot command checks with coal before it builds the sphere filter."""
+    if kernels_native():
+        return AT_ONCE_IF_FITTED
     return FILTER_AFTER_STATES if kernels_ready() else FILTER_AFTER_STATES_UNCOMPILED
 
 
@@ -88,7 +101,8 @@ def build_problem(
     """Return the problem of `robot` (other joints at `base`) in `scene`; the sphere filter comes after `after` states.
 
     The states are those this process has had judged without a filter, in any problem. With
-    `after` 0 the filter is built now, as a benchmark wants (its set-up outside the timed steps).
+    `after` 0 the filter is built now, as a benchmark wants (its set-up outside the timed steps);
+    with AT_ONCE_IF_FITTED, now if it takes milliseconds (the robot's spheres and tables cached).
     """
     return Problem(robot, scene, _checks(robot, scene, geometry, base, after))
 
@@ -102,6 +116,8 @@ def _checks(
     def build() -> SphereFilter | None:
         return build_sphere_filter(robot, checker, hulls, scene, base)
 
+    if after == AT_ONCE_IF_FITTED:
+        after = 0 if sphere_filter_cached(robot, checker, hulls) else FILTER_AFTER_STATES_UNFITTED
     if after <= 0 or kernels_loaded():
         return MotionChecker(robot, checker, base, build(), hulls)
     motion = MotionChecker(robot, checker, base, None, hulls)

@@ -4,7 +4,8 @@ numpy's versions spend a sixth of a median MotionBenchMaker plan step in array c
 hundred numbers and in plain Python loops. These repeat each of their floating-point operations
 in the same order (numba, like numpy, contracts nothing into fused multiply-adds), so a plan is
 byte for byte the same whichever runs; tests/timing/test_timing_properties.py holds them together.
-Imported only once the sphere filter has loaded numba (core/pipeline/_step.py).
+Compiled ahead of time into an extension module, or run by numba's JIT where that cannot be built
+(core/timing/_twins.py): imported only then.
 """
 
 from __future__ import annotations
@@ -13,54 +14,15 @@ from typing import Any
 
 import numba
 import numpy as np
-from numpy.typing import NDArray
 
 from .. import trajectory
-from ..errors import PlanningFailed
-from ._topp import STILL, SpeedProfile
+from ._topp import STILL
 
 # numba caches a kernel by this file's bytes alone; the line below changes them with the sources its
 # kernels compile in (tests/foundation/test_kernel_inputs.py says what it must read).
 # Compiled in (sha256): trajectory.py 3f2cffe29b89, timing/_topp.py bd237749bcf1
 
-__all__ = ["compiled_fastest_speeds", "compiled_quintic_peak_rates"]
-
-
-def compiled_fastest_speeds(
-    grid: NDArray[np.float64],
-    first: NDArray[np.float64],
-    second: NDArray[np.float64],
-    straight: NDArray[np.bool_],
-    max_velocity: NDArray[np.float64],
-    max_acceleration: NDArray[np.float64],
-    min_interval_s: float = 0.0,
-) -> SpeedProfile:
-    """Return topp.fastest_speeds(...) (same arguments, same result), computed by compiled code."""
-    s, squared, finite = _speeds(*(_plain(x, np.float64) for x in (grid, first, second, max_velocity,
-                                                                     max_acceleration)),
-                                 _plain(straight, np.bool_), float(min_interval_s))
-    if not finite:
-        raise PlanningFailed("time parameterisation found no motion along the path within the limits")
-    return SpeedProfile(s, squared)
-
-
-def compiled_quintic_peak_rates(
-    knots: NDArray[np.float64], p: NDArray[np.float64], v: NDArray[np.float64], a: NDArray[np.float64]
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Return trajectory.quintic_peak_rates(...) (same arguments, same result), computed by compiled code."""
-    if len(knots) == 1:
-        return np.abs(v[0]), np.abs(a[0])
-    return _peaks(*(_plain(x, np.float64) for x in (knots, p, v, a)))
-
-
-def _plain(values: NDArray[Any], dtype: type) -> NDArray[Any]:
-    """Return `values` as a writable C-ordered array of `dtype`, copied only if it is not one already.
-
-    numba compiles a version per array type, read-only ones included: seconds, mid-plan.
-    """
-    if values.dtype == dtype and values.flags.c_contiguous and values.flags.writeable:
-        return values
-    return np.array(values, dtype=dtype, order="C")
+__all__ = ["KERNELS"]
 
 
 # The Newton search is plain Python on floats: numba compiles the very function numpy's version calls.
@@ -222,3 +184,22 @@ def _peaks(knots: Any, p: Any, v: Any, a: Any) -> Any:
                                                     at[k, s, j], at[k + 1, s, j], acc[k, s, j], acc[k + 1, s, j]))
                     found[j] = _max(found[j], extreme)
     return found, peak_a
+
+
+# pycc compiles an exported function with numba's default error model (a division by zero raises),
+# whatever its decorator asks: the entry points below call the kernels, which keep the one they ask for.
+@numba.njit(cache=True)
+def speeds(grid: Any, first: Any, second: Any, max_velocity: Any, max_acceleration: Any, straight: Any,
+           min_interval_s: float) -> Any:
+    """Return `_speeds(...)`, called from Python."""
+    return _speeds(grid, first, second, max_velocity, max_acceleration, straight, min_interval_s)
+
+
+@numba.njit(cache=True)
+def peaks(knots: Any, p: Any, v: Any, a: Any) -> Any:
+    """Return `_peaks(...)`, called from Python."""
+    return _peaks(knots, p, v, a)
+
+
+KERNELS = {"speeds": speeds, "peaks": peaks}
+"""The kernels called from Python (core/timing/_twins.py), by the name they are compiled under."""

@@ -76,8 +76,8 @@ def time_parameterize(
         max_step: Corners are rounded within 0.44 of a step from their waypoint, the
             segments divided into equal steps of at most max_step [rad] in every joint:
             closer to the polyline than a cubic spline through those steps.
-        compiled: Use the compiled twins of the speed and peak computations (core/timing/_compiled.py):
-            the same trajectory to the bit, in less time where numba is loaded already.
+        compiled: Use the compiled twins of the speed and peak computations (core/timing/_twins.py):
+            the same trajectory to the bit, in less time where they are loaded already.
 
     Raises:
         PlanningFailed: If a shape is wrong, a waypoint is not finite, a limit or max_step is
@@ -91,7 +91,7 @@ def time_parameterize(
         return _nudge(joint_names, points[0], points[-1], max_velocity, max_acceleration)
     path = blended_path(distinct, max_step, _CORNER_FRACTION)
     if compiled:
-        from . import _compiled as twins  # numba: loaded already with the sphere filter's kernels
+        from . import _twins as twins  # compiled: loaded already with the sphere filter's kernels
 
         speeds, peaks = twins.compiled_fastest_speeds, twins.compiled_quintic_peak_rates
     else:

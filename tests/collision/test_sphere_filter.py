@@ -126,11 +126,18 @@ def test_read_only_states_are_judged_without_compiling_the_kernels_again(
     robot, _, _, spheres = panda_in_box
     before = len(sphere_kernels.edge.signatures), len(sphere_kernels.classify.signatures)
     path = np.array([robot.values(robot.neutral()), robot.upper * 0.5])
+    writable = [(worst, verdicts.copy(), unclear.copy()) for worst, verdicts, unclear in
+                [spheres.edge(path[0], path[1], 0.05)]], spheres.classify(path)
     path.setflags(write=False)  # as a planned path's frozen waypoints
-    spheres.edge(path[0], path[1], 0.05)
-    spheres.classify(path)
+    worst, verdicts, unclear = spheres.edge(path[0], path[1], 0.05)
+    judged = spheres.classify(path)
     # Compiling another version takes seconds on a fresh machine, inside a clocked search.
     assert (len(sphere_kernels.edge.signatures), len(sphere_kernels.classify.signatures)) == before
+    assert worst == writable[0][0][0]
+    np.testing.assert_array_equal(verdicts, writable[0][0][1])
+    np.testing.assert_array_equal(unclear, writable[0][0][2])
+    for got, want in zip(judged, writable[1], strict=True):
+        np.testing.assert_array_equal(got, want)
 
 
 def test_edges_and_states_are_judged_alike_with_and_without_the_spheres_and_hulls(
@@ -217,7 +224,7 @@ def test_a_filter_for_the_next_scene_of_a_robot_judges_as_one_built_from_nothing
 def test_the_robot_packed_once_and_a_world_added_are_the_arrays_packed_at_once() -> None:
     # The kernels read every array where LAYOUT puts it: the robot's two pieces and a scene's obstacles,
     # packed apart, must give the very arrays and head that packing all of them together gives.
-    from moveplan.core.collision import _kernels, sphere_filter
+    from moveplan.core.collision import _packing, sphere_filter
 
     robot = Robot(load_robot_config(PANDA))
     scene = load_scene(MBM / "problems" / "box_panda" / "scene0001.yaml", robot)
@@ -225,17 +232,17 @@ def test_the_robot_packed_once_and_a_world_added_are_the_arrays_packed_at_once()
     built = SphereFilter(robot, checker.robot_geometry, scene.objects, scene.allowed)
     part = next(iter(sphere_filter._ROBOT_PARTS.values()))
     arrays = {name: np.arange(7 * (k + 1)).reshape((-1, 7) if ndim == 2 else (-1, 1, 7) if ndim == 3 else (-1,))
-              for k, (name, ndim, _) in enumerate(_kernels.LAYOUT)}
-    robot_arrays = {name: value for name, value in arrays.items() if name not in _kernels.WORLD}
-    world = {name: arrays[name] for name in _kernels.WORLD}
-    together = _kernels._piece(arrays, range(len(_kernels.LAYOUT)))
-    for got, want in zip(_kernels.pack(_kernels.pack_robot(robot_arrays), world), together, strict=True):
+              for k, (name, ndim, _) in enumerate(_packing.LAYOUT)}
+    robot_arrays = {name: value for name, value in arrays.items() if name not in _packing.WORLD}
+    world = {name: arrays[name] for name in _packing.WORLD}
+    together = _packing._piece(arrays, range(len(_packing.LAYOUT)))
+    for got, want in zip(_packing.pack(_packing.pack_robot(robot_arrays), world), together, strict=True):
         np.testing.assert_array_equal(got, want)
         assert got.dtype == want.dtype
     # And a real filter's: the scene's obstacles sit where unpack reads them.
     floats, _, head = built._packed
     obstacles = sphere_filter._obstacles([obj for obj in scene.objects if not obj.link], {})
-    k = [name for name, _, _ in _kernels.LAYOUT].index("osize")
+    k = [name for name, _, _ in _packing.LAYOUT].index("osize")
     at, rows, columns = head[k, :3]
     assert len(part.packed) == 2 and rows == len(obstacles["osize"]) > 0
     np.testing.assert_array_equal(floats[at:at + rows * columns].reshape(rows, columns), obstacles["osize"])

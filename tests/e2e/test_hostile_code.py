@@ -22,6 +22,7 @@ from conftest import FILTERED_PLAN, SAMPLES, UR10E, Cli
 from mcap.reader import make_reader
 from mcap.writer import Writer
 
+from moveplan.core import _native
 from moveplan.core.collision import _cache
 from moveplan.core.collision import _kernel_cache as kernel_cache
 from moveplan.core.collision._pair_tables import PairTable
@@ -467,7 +468,7 @@ def test_numba_index_is_checked_without_unpickling(tmp_path: Path, monkeypatch: 
     marker = tmp_path / "ran"
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "numba"))
     source = Path(kernel_cache.__file__).resolve().parent.parent / "collision" / "_kernels.py"
-    folder = kernel_cache._cache_folder(source.parent)
+    folder = _native.cache_folder(source.parent)
     assert folder is not None
     folder.mkdir(parents=True)
     text = source.read_bytes()
