@@ -39,6 +39,7 @@ Signatures = Mapping[str, str]
 """Per exported name, the numba signature it is compiled for: the types its callers pass, exactly."""
 Dispatchers = Callable[[], Mapping[str, Any]]
 """Returns, per exported name, its numba dispatcher: asked for only when needed, since it imports numba."""
+_SAID: set[str] = set()  # why builds failed in this process, each warned about once
 
 
 def kernels(name: str, sources: Sequence[Path], signatures: Signatures, dispatchers: Dispatchers) -> Any:
@@ -178,10 +179,14 @@ def build(name: str, sources: Sequence[Path], signatures: Signatures, dispatcher
             os.replace(staged, path)
             os.replace(Path(scratch, _checksum(path).name), _checksum(path))
     except Exception as exc:  # noqa: BLE001 - whatever stops an optional build, numba's JIT does the work
-        reason = str(exc).strip().splitlines()[-1] if str(exc).strip() else type(exc).__name__
-        logger.warning("kernels %s not compiled ahead of time (%s): numba's JIT runs them, which adds ~0.7 s to "
-                       "every process that plans with them; with a C compiler and Python's headers, remove %s to try "
-                       "again", module_name, reason, mark)
+        # The first sentence: numba's own message goes on with advice for conda.
+        reason = str(exc).strip().splitlines()[0].split(". ")[0] if str(exc).strip() else type(exc).__name__
+        # Said once per process: without a compiler every kernel set fails alike.
+        logger.log(logging.DEBUG if reason in _SAID else logging.WARNING,
+                   "kernels %s not compiled ahead of time (%s): numba's JIT runs them, which adds ~0.7 s to every "
+                   "process that plans with them; with a C compiler and Python's headers, remove %s to try again",
+                   module_name, reason, mark)
+        _SAID.add(reason)
         try:
             mark.write_text(f"{exc}\n")
         except OSError:

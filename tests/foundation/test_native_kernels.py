@@ -106,6 +106,7 @@ def test_a_failed_build_is_said_once_and_numbas_jit_serves_the_kernels(
 ) -> None:
     source = _kernel_file(tmp_path / "pkg", 0.5)
     monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
+    monkeypatch.setattr(_native, "_SAID", set())  # as in a fresh process
     with caplog.at_level("WARNING", logger="moveplan.core._native"):
         first = _native.kernels("demo", [source], SIGNATURES, _dispatchers(source))
         second = _native.kernels("demo", [source], SIGNATURES, _dispatchers(source))
