@@ -120,6 +120,16 @@ def _intact(path: Path) -> bool:
         return False
 
 
+def _remove_stale(name: str, module_name: str, folder: Path) -> None:
+    """Remove the modules of `name` built for other sources (an upgrade, an edit) from `folder`; return None.
+
+    A process still running one keeps it: the file goes, its mapping stays.
+    """
+    for stale in folder.glob(f"{name}_*"):
+        if not stale.name.startswith(f"{module_name}."):
+            stale.unlink(missing_ok=True)
+
+
 def _failure_mark(module_name: str, path: Path) -> Path:
     """Return the file that marks a failed build of the module."""
     return path.with_name(f"{module_name}.failed")
@@ -178,6 +188,7 @@ def build(name: str, sources: Sequence[Path], signatures: Signatures, dispatcher
             Path(scratch, _checksum(path).name).write_text(hashlib.sha256(staged.read_bytes()).hexdigest())
             os.replace(staged, path)
             os.replace(Path(scratch, _checksum(path).name), _checksum(path))
+        _remove_stale(name, module_name, path.parent)
     except Exception as exc:  # noqa: BLE001 - whatever stops an optional build, numba's JIT does the work
         # The first sentence: numba's own message goes on with advice for conda.
         reason = str(exc).strip().splitlines()[0].split(". ")[0] if str(exc).strip() else type(exc).__name__

@@ -84,6 +84,7 @@ def test_a_changed_kernel_file_is_built_again_not_served_stale(built: Path, tmp_
     _kernel_file(folder, 2.0)  # a constant compiled in, as a kernel's inputs are
     assert _native.load("demo", [source], SIGNATURES) is None
     assert _native.kernels("demo", [source], SIGNATURES, _dispatchers(source)).scaled(np.ones(1), 1.0).tolist() == [3.0]
+    assert len(list((folder / "__pycache__").glob("demo_*.so"))) == 1  # the stale one removed
 
 
 def test_a_damaged_module_is_refused_not_loaded(built: Path, tmp_path: Path) -> None:
