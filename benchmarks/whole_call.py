@@ -1,7 +1,7 @@
 """Where a whole `moveplan plan` call goes, phase by phase, on MotionBenchMaker problems: fixed work against the step.
 
 Run from the repository root with moveplan installed:
-    python benchmarks/whole_call.py [--mbm DIR] [--count 30] [--seeds 1] [--one-shot 5]
+    python benchmarks/whole_call.py [--mbm DIR] [--robot DIR] [--count 30] [--seeds 1] [--one-shot 5]
 Each problem is solved as `moveplan benchmark` solves it (one warm process, the robot config loaded
 once, the plan written to a file), with the pipeline's phases timed where they are called: reading
 the request, the robot's group, the scene, setting up the collision checks, the step (its
@@ -63,11 +63,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--mbm", type=Path, default=ROOT / "tests" / "data" / "mbm" / "problems",
                         help="folder of MotionBenchMaker problems, with panda_robot beside it or in its parent")
+    parser.add_argument("--robot", type=Path, help="the problems' robot config (default: panda_robot beside them)")
     parser.add_argument("--count", type=int, default=30, help="problems per scenario")
     parser.add_argument("--seeds", type=int, default=1)
     parser.add_argument("--one-shot", type=int, default=0, help="also plan the first N problems one process each")
     args = parser.parse_args()
-    robot = next(p for p in (args.mbm / "panda_robot", args.mbm.parent / "panda_robot") if p.is_dir())
+    robot = args.robot or next(p for p in (args.mbm / "panda_robot", args.mbm.parent / "panda_robot") if p.is_dir())
     problems = benchmark.find_problems([args.mbm], args.count)
     config = load_robot_config(robot)
     spent: dict[str, float] = defaultdict(float)
