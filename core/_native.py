@@ -1,16 +1,16 @@
 """numba kernels compiled ahead of time into an extension module, loaded in milliseconds without numba.
 
-numba's own disk cache still costs a fresh process ~0.7 s before the first kernel runs: importing
+numba's own disk cache still costs a fresh process 0.5-0.7 s before the first kernel runs: importing
 numba (~0.3 s), its typing and lowering registries (which import scipy.linalg for BLAS), then
 each kernel's machine code. Too much for a one-shot plan whose step takes milliseconds, so such a
 plan did without the sphere filter. numba's `pycc` compiles the same Python functions through the
 same pipeline into a plain CPython extension module: imported in ~2 ms, no numba at run time,
 the same numbers (tests/foundation/test_native_kernels.py).
 
-A kernel set is built once per install (as numba's cache is: ~20 s) and kept where numba keeps
-its cache for that package (beside the source in __pycache__, or under NUMBA_CACHE_DIR): the
-same trust as numba's cache, never moveplan's own cache folder, whose entries are data only
-(docs/formats.md). Its file name carries a hash of the kernel sources and signatures, so a
+A kernel set is built once per install (~35 s for both; numba's own compilation took ~20 s) and
+kept where numba keeps its cache for that package (beside the source in __pycache__, or under
+NUMBA_CACHE_DIR): the same trust as numba's cache, never moveplan's own cache folder, whose
+entries are data only (docs/formats.md). Its file name carries a hash of the kernel sources and signatures, so a
 changed source is never served stale code. Where no module can be built (no C compiler, a numba
 without pycc) the caller falls back to numba's JIT: the same functions, the same numbers, and
 numba's start-up cost.

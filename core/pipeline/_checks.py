@@ -2,7 +2,7 @@
 
 The sphere filter (core/collision/sphere_filter.py) clears a state in microseconds. Its kernels
 are compiled once per install, ahead of time where a C compiler allows (core/_native.py): then a
-fresh process builds the filter in ~15 ms without numba, and every problem gets it with its
+fresh process builds the filter in ~11 ms without numba, and every problem gets it with its
 collision set-up, as a benchmark's does. Where numba's JIT runs them instead (an ahead-of-time
 build failed), building the filter imports numba: ~0.7 s in a fresh process. A plan of a few
 steps asks about a few thousand states, which coal alone judges 3-4 us slower each than the
@@ -59,10 +59,10 @@ FILTER_AFTER_STATES = 150_000
 over the 3-3.8 us a state costs more without it (benchmarks/filter_threshold.py, MotionBenchMaker's Panda)."""
 FILTER_AFTER_STATES_UNFITTED = 1_000_000
 """The same when the kernels are compiled ahead of time but the robot's spheres and distance tables are not fitted
-yet: 2-7 s (1.2 s the Panda's spheres, 1.5-4.9 s tables) over the same 3-3.8 us. Fitted, the filter is built at once."""
+yet: 1.7-2.0 s the Panda's, 7 s a UR5's, over the 4 us a state costs more. Fitted, the filter is built at once."""
 AT_ONCE_IF_FITTED = -1
 """`after` where the kernels are compiled ahead of time: the filter at once if the robot's spheres and tables are
-cached (a build of ~15 ms), else after FILTER_AFTER_STATES_UNFITTED states."""
+cached (a build of ~11 ms), else after FILTER_AFTER_STATES_UNFITTED states."""
 FILTER_AFTER_STATES_UNCOMPILED = 6_000_000
 """The same when numba has yet to compile the kernels: the compilation's ~20 s over the same 3-3.8 us."""
 
