@@ -19,6 +19,12 @@ def _run(code: str, env: dict[str, str] | None = None) -> subprocess.CompletedPr
                           env={**os.environ, **(env or {})}, timeout=300)
 
 
+def _cli(argv: list[str], then: str) -> str:
+    """Return code for a fresh interpreter: `moveplan ARGV` run to success, then the statement `then`."""
+    return (f"import sys\nsys.argv = ['moveplan', *{argv!r}]\nfrom moveplan.cli.app import main\ntry:\n    main()\n"
+            f"except SystemExit as exc:\n    assert not exc.code, exc.code\n{then}")
+
+
 def test_help_imports_no_numba_pinocchio_or_scipy() -> None:
     result = _run("import sys\nfrom moveplan.cli.app import app\nfrom typer.testing import CliRunner\n"
                   "assert CliRunner().invoke(app, ['--help']).exit_code == 0\n"
@@ -28,10 +34,9 @@ def test_help_imports_no_numba_pinocchio_or_scipy() -> None:
 
 
 def test_single_joint_goal_plan_imports_no_numba_scipy_or_pydantic(tmp_path: Path) -> None:
-    code = ("import sys\nsys.argv = ['moveplan', 'plan', '--robot', 'ur10e', '--start-named', 'home', '--joints',\n"
-            f"            '0.5,-1.2,-1.8,0,1.57,0', '-o', {str(tmp_path / 'plan.mcap')!r}, '-q']\n"
-            "from moveplan.cli.app import main\ntry:\n    main()\nexcept SystemExit as exc:\n    assert not exc.code\n"
-            "print(sorted(m for m in ('numba', 'scipy', 'pydantic') if m in sys.modules))")
+    code = _cli(["plan", "--robot", "ur10e", "--start-named", "home", "--joints", "0.5,-1.2,-1.8,0,1.57,0", "-o",
+                 str(tmp_path / "plan.mcap"), "-q"],
+                "print(sorted(m for m in ('numba', 'scipy', 'pydantic') if m in sys.modules))")
     result = _run(code)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "[]"
@@ -67,9 +72,8 @@ def test_fresh_machine_plans_without_compiling_the_kernels(tmp_path: Path) -> No
     subprocess.run([sys.executable, "-m", "moveplan.cli.app", "plan", "samples/panda_shelf_bays.yaml", "-o", str(warm)],
                    check=True, cwd=ROOT, capture_output=True, timeout=600)
     cold = tmp_path / "cold.mcap"
-    code = ("import sys\nsys.argv = ['moveplan', 'plan', 'samples/panda_shelf_bays.yaml', '-o', "
-            f"{str(cold)!r}]\nfrom moveplan.cli.app import main\ntry:\n    main()\nexcept SystemExit as exc:\n"
-            "    assert not exc.code\nprint(sorted(m for m in ('numba', 'scipy') if m in sys.modules))")
+    code = _cli(["plan", "samples/panda_shelf_bays.yaml", "-o", str(cold)],
+                "print(sorted(m for m in ('numba', 'scipy') if m in sys.modules))")
     result = _run(code, {"NUMBA_CACHE_DIR": str(tmp_path / "numba"), "MOVEPLAN_CACHE_DIR": str(tmp_path / "cache")})
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip().splitlines()[-1] == "[]"
@@ -112,13 +116,11 @@ _SLOW_LOAD = (  # the filter's first kernel call takes 1.5 s longer, as on a loa
 def test_a_one_shot_plan_builds_the_filter_at_once_and_imports_no_numba(tmp_path: Path) -> None:
     """Kernels compiled ahead of time and the robot's spheres cached: a fresh process has the filter in milliseconds."""
     _compile_kernels()  # the benchmark fits the Panda's spheres and tables too
-    code = ("import sys\nsys.argv = ['moveplan', 'plan', '--robot', 'tests/data/mbm/panda_robot', '--scene',\n"
-            "            'tests/data/mbm/problems/box_panda/scene0001.yaml', '--request',\n"
-            "            'tests/data/mbm/problems/box_panda/request0001.yaml', '-o', "
-            f"{str(tmp_path / 'plan.mcap')!r}, '-q']\n"
-            "from moveplan.cli.app import main\nfrom moveplan.core.collision import compiled\ntry:\n    main()\n"
-            "except SystemExit as exc:\n    assert not exc.code\n"
-            "print(compiled.kernels_loaded(), 'numba' in sys.modules)")
+    problem = "tests/data/mbm/problems/box_panda"
+    code = _cli(["plan", "--robot", "tests/data/mbm/panda_robot", "--scene", f"{problem}/scene0001.yaml", "--request",
+                 f"{problem}/request0001.yaml", "-o", str(tmp_path / "plan.mcap"), "-q"],
+                "from moveplan.core.collision import compiled\n"
+                "print(compiled.kernels_loaded(), 'numba' in sys.modules)")
     result = _run(code)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "True False"
@@ -170,8 +172,7 @@ def test_plan_execute_and_check_never_load_numpy_ma(tmp_path: Path) -> None:
                 ["execute", str(plan), "--fake", "-o", str(executed)],
                 ["check-tolerances", str(plan), str(executed)]]
     for argv in commands:
-        code = (f"import sys\nsys.argv = ['moveplan', *{argv!r}]\nfrom moveplan.cli.app import main\ntry:\n    main()\n"
-                "except SystemExit as exc:\n    assert not exc.code, exc.code\nprint('numpy.ma' in sys.modules)")
+        code = _cli(argv, "print('numpy.ma' in sys.modules)")
         result = _run(code)
         assert result.returncode == 0, result.stderr
         assert result.stdout.strip().splitlines()[-1] == "False", argv[0]
