@@ -73,12 +73,18 @@ def _file_digest(file: str, mtime_ns: int, size: int) -> bytes:
     return hashlib.sha256(Path(file).read_bytes()).digest()
 
 
-def _module_path(name: str, sources: Sequence[Path], signatures: Signatures) -> tuple[str, Path] | None:
-    """Return the module's name and file, in the cache folder of the first source's package; None if none."""
+def _where(name: str, sources: Sequence[Path], signatures: Signatures) -> tuple[str, Path] | None:
+    """Return the module's name and file, in the cache folder of the first source's package; None if none.
+
+    None too where the sources cannot be read.
+    """
     folder = cache_folder(sources[0].parent)
     if folder is None:
         return None
-    module = _module_name(name, sources, signatures)
+    try:
+        module = _module_name(name, sources, signatures)
+    except OSError:
+        return None
     # The interpreter's own extension suffix (ABI and platform): sysconfig's would cost 5 ms to initialise.
     return module, folder / f"{module}{importlib.machinery.EXTENSION_SUFFIXES[0]}"
 
@@ -93,14 +99,6 @@ def failed(name: str, sources: Sequence[Path], signatures: Signatures) -> bool:
     """Return True if building the module for these sources and signatures failed here: numba's JIT serves them."""
     where = _where(name, sources, signatures)
     return where is not None and _failure_mark(*where).is_file()
-
-
-def _where(name: str, sources: Sequence[Path], signatures: Signatures) -> tuple[str, Path] | None:
-    """Return `_module_path`, or None where the sources cannot be read either."""
-    try:
-        return _module_path(name, sources, signatures)
-    except OSError:
-        return None
 
 
 def _checksum(path: Path) -> Path:
